@@ -1,0 +1,468 @@
+// Byte streams: POSIX file descriptors for files and stdio, zlib for gzip, mkstemp + rename
+// for atomic output, and a signal-safe table of temporary paths to unlink on Ctrl-C.
+#include "io/byte_stream.hpp"
+
+#include "io/error.hpp"
+
+#include <atomic>
+#include <cerrno>
+#include <csignal>
+#include <cstdlib>
+#include <cstring>
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+#include <zlib.h>
+
+namespace meshstream::io {
+namespace {
+
+std::string errno_text() { return std::strerror(errno); }
+
+class FdInput : public RawInput {
+public:
+    FdInput(int fd, bool owned, std::string name) : fd_(fd), owned_(owned), name_(std::move(name)) {
+        struct stat st;
+        if (fstat(fd_, &st) == 0 && S_ISREG(st.st_mode)) size_ = static_cast<uint64_t>(st.st_size);
+    }
+    ~FdInput() override { if (owned_) ::close(fd_); }
+    size_t read(void* dst, size_t n) override {
+        for (;;) {
+            ssize_t got = ::read(fd_, dst, n);
+            if (got >= 0) { pos_ += static_cast<uint64_t>(got); return static_cast<size_t>(got); }
+            if (errno == EINTR) continue;
+            throw Error(name_, pos_, 0, "read failed: " + errno_text());
+        }
+    }
+    std::optional<uint64_t> size() const override { return size_; }
+
+private:
+    int fd_;
+    bool owned_;
+    std::string name_;
+    uint64_t pos_ = 0;
+    std::optional<uint64_t> size_;
+};
+
+// Inflates a gzip stream (several concatenated members allowed, as pigz and `cat a.gz b.gz`
+// produce). The bytes already read while sniffing the magic are handed in as `prefix`.
+class GzipInput : public RawInput {
+public:
+    GzipInput(std::unique_ptr<RawInput> raw, std::vector<std::byte> prefix, std::string name)
+        : raw_(std::move(raw)), name_(std::move(name)), in_(size_t{1} << 18) {
+        std::memset(&zs_, 0, sizeof zs_);
+        if (inflateInit2(&zs_, 16 + MAX_WBITS) != Z_OK) throw Error(name_, "zlib inflateInit failed");
+        std::memcpy(in_.data(), prefix.data(), prefix.size());
+        zs_.next_in = reinterpret_cast<Bytef*>(in_.data());
+        zs_.avail_in = static_cast<uInt>(prefix.size());
+        compressed_ = prefix.size();
+    }
+    ~GzipInput() override { inflateEnd(&zs_); }
+
+    size_t read(void* dst, size_t n) override {
+        if (done_) return 0;
+        zs_.next_out = static_cast<Bytef*>(dst);
+        zs_.avail_out = static_cast<uInt>(std::min<size_t>(n, 1u << 30));
+        const uInt want = zs_.avail_out;
+        while (zs_.avail_out == want) {
+            if (zs_.avail_in == 0) {
+                size_t got = raw_->read(in_.data(), in_.size());
+                if (got == 0) {
+                    if (member_started_)
+                        throw Error(name_, compressed_, 0,
+                                    "gzip stream is truncated (ends inside a compressed block)");
+                    done_ = true;  // clean end after a complete member
+                    break;
+                }
+                compressed_ += got;
+                zs_.next_in = reinterpret_cast<Bytef*>(in_.data());
+                zs_.avail_in = static_cast<uInt>(got);
+            }
+            member_started_ = true;
+            int rc = inflate(&zs_, Z_NO_FLUSH);
+            if (rc == Z_STREAM_END) {
+                member_started_ = false;
+                inflateReset(&zs_);
+                continue;
+            }
+            if (rc != Z_OK && rc != Z_BUF_ERROR)
+                throw Error(name_, compressed_ - zs_.avail_in, 0,
+                            std::string("corrupt gzip data: ") + (zs_.msg ? zs_.msg : "inflate failed"));
+        }
+        return want - zs_.avail_out;
+    }
+
+private:
+    std::unique_ptr<RawInput> raw_;
+    std::string name_;
+    std::vector<std::byte> in_;
+    z_stream zs_;
+    uint64_t compressed_ = 0;
+    bool member_started_ = false;
+    bool done_ = false;
+};
+
+// ---- temporary path table, unlinked by the signal handler ----
+constexpr int kMaxTempPaths = 128;
+constexpr size_t kMaxPathBytes = 1024;
+char g_temp_paths[kMaxTempPaths][kMaxPathBytes];
+std::atomic<bool> g_temp_used[kMaxTempPaths];
+
+extern "C" void cleanup_and_reraise(int sig) {
+    for (int i = 0; i < kMaxTempPaths; ++i)
+        if (g_temp_used[i].load()) ::unlink(g_temp_paths[i]);
+    std::signal(sig, SIG_DFL);
+    std::raise(sig);
+}
+
+mode_t default_file_mode() {
+    static const mode_t mode = [] {
+        mode_t mask = ::umask(0);
+        ::umask(mask);
+        return static_cast<mode_t>(0666 & ~mask);
+    }();
+    return mode;
+}
+
+void write_all(int fd, const void* data, size_t n, const std::string& name, uint64_t offset) {
+    auto* p = static_cast<const char*>(data);
+    while (n > 0) {
+        ssize_t put = ::write(fd, p, n);
+        if (put < 0) {
+            if (errno == EINTR) continue;
+            throw Error(name, offset, 0, "write failed: " + errno_text());
+        }
+        p += put;
+        n -= static_cast<size_t>(put);
+        offset += static_cast<uint64_t>(put);
+    }
+}
+
+std::string make_temp(std::string pattern, int* fd, const std::string& what) {
+    std::vector<char> buf(pattern.begin(), pattern.end());
+    buf.push_back('\0');
+    *fd = ::mkstemp(buf.data());
+    if (*fd < 0) throw Error(what, "cannot create temporary file " + pattern + ": " + errno_text());
+    return std::string(buf.data());
+}
+
+}  // namespace
+
+int register_temp_path(const std::string& path) {
+    if (path.size() >= kMaxPathBytes) return -1;
+    for (int i = 0; i < kMaxTempPaths; ++i) {
+        bool expected = false;
+        if (!g_temp_used[i].load() ) {
+            std::memcpy(g_temp_paths[i], path.c_str(), path.size() + 1);
+            if (g_temp_used[i].compare_exchange_strong(expected, true)) return i;
+        }
+    }
+    return -1;  // table full: the file is still removed by its destructor
+}
+
+void unregister_temp_path(int slot) {
+    if (slot >= 0) g_temp_used[slot].store(false);
+}
+
+void install_cleanup_handlers() {
+    for (int sig : {SIGINT, SIGTERM, SIGHUP}) std::signal(sig, cleanup_and_reraise);
+}
+
+std::string parent_dir(const std::string& path) {
+    size_t slash = path.find_last_of('/');
+    if (slash == std::string::npos) return ".";
+    if (slash == 0) return "/";
+    return path.substr(0, slash);
+}
+
+// ---------------- ByteSource ----------------
+
+std::unique_ptr<ByteSource> ByteSource::open(const std::string& path) {
+    std::unique_ptr<RawInput> raw;
+    if (path == "-") {
+        raw = std::make_unique<FdInput>(0, false, "<stdin>");
+        return std::make_unique<ByteSource>(std::move(raw), "<stdin>");
+    }
+    int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) throw Error(path, "cannot open: " + errno_text());
+    struct stat st;
+    if (fstat(fd, &st) == 0 && S_ISDIR(st.st_mode)) {
+        ::close(fd);
+        throw Error(path, "is a directory");
+    }
+    raw = std::make_unique<FdInput>(fd, true, path);
+    bool regular = S_ISREG(st.st_mode);
+    auto source = std::make_unique<ByteSource>(std::move(raw), path);
+    if (regular && !source->gzip()) source->regular_path_ = path;
+    return source;
+}
+
+ByteSource::ByteSource(std::unique_ptr<RawInput> raw, std::string name)
+    : raw_(std::move(raw)), name_(std::move(name)), buf_(kBufferBytes) {
+    // Sniff the gzip magic (1f 8b) before anything else sees the bytes.
+    size_t got = 0;
+    while (got < 2) {
+        size_t n = raw_->read(buf_.data() + got, 2 - got);
+        if (n == 0) break;
+        got += n;
+    }
+    if (got == 2 && buf_[0] == std::byte{0x1f} && buf_[1] == std::byte{0x8b}) {
+        std::vector<std::byte> prefix(buf_.begin(), buf_.begin() + 2);
+        raw_ = std::make_unique<GzipInput>(std::move(raw_), std::move(prefix), name_);
+        gzip_ = true;
+    } else {
+        end_ = got;
+        if (got < 2) eof_ = true;
+    }
+}
+
+ByteSource::~ByteSource() = default;
+
+std::optional<uint64_t> ByteSource::size() const {
+    if (gzip_) return std::nullopt;
+    return raw_->size();
+}
+
+bool ByteSource::fill(size_t want) {
+    if (end_ - begin_ >= want) return true;
+    if (begin_ > 0) {  // carry the unconsumed tail to the front
+        std::memmove(buf_.data(), buf_.data() + begin_, end_ - begin_);
+        end_ -= begin_;
+        begin_ = 0;
+    }
+    while (end_ < want && !eof_) {
+        size_t n = raw_->read(buf_.data() + end_, buf_.size() - end_);
+        if (n == 0) eof_ = true;
+        end_ += n;
+    }
+    return end_ - begin_ >= want;
+}
+
+size_t ByteSource::read(void* dst, size_t n) {
+    auto* out = static_cast<std::byte*>(dst);
+    size_t done = 0;
+    while (done < n) {
+        if (begin_ == end_) {
+            // Large reads bypass the buffer.
+            if (n - done >= buf_.size() && !eof_) {
+                size_t got = raw_->read(out + done, n - done);
+                if (got == 0) { eof_ = true; break; }
+                done += got;
+                offset_ += got;
+                continue;
+            }
+            if (!fill(1)) break;
+        }
+        size_t take = std::min(n - done, end_ - begin_);
+        std::memcpy(out + done, buf_.data() + begin_, take);
+        begin_ += take;
+        done += take;
+        offset_ += take;
+    }
+    return done;
+}
+
+std::span<const std::byte> ByteSource::peek(size_t n) {
+    if (n > buf_.size()) n = buf_.size();
+    fill(n);
+    return {buf_.data() + begin_, std::min(n, end_ - begin_)};
+}
+
+std::span<const std::byte> ByteSource::window() {
+    if (begin_ == end_) fill(1);
+    return {buf_.data() + begin_, end_ - begin_};
+}
+
+void ByteSource::consume(size_t n) {
+    begin_ += n;
+    offset_ += n;
+}
+
+uint64_t ByteSource::skip(uint64_t n) {
+    uint64_t done = 0;
+    while (done < n) {
+        auto w = window();
+        if (w.empty()) break;
+        size_t take = static_cast<size_t>(std::min<uint64_t>(n - done, w.size()));
+        consume(take);
+        done += take;
+    }
+    return done;
+}
+
+bool ByteSource::at_end() { return window().empty(); }
+
+void ByteSource::fail(const std::string& message) const { throw Error(name_, offset_, 0, message); }
+
+// ---------------- ByteSink ----------------
+
+struct ByteSink::Gzip {
+    z_stream zs;
+    std::vector<std::byte> out = std::vector<std::byte>(size_t{1} << 18);
+};
+
+std::unique_ptr<ByteSink> ByteSink::open(const std::string& path, const SinkOptions& options) {
+    std::unique_ptr<ByteSink> sink(new ByteSink());
+    sink->name_ = path == "-" ? "<stdout>" : path;
+    sink->buf_.reserve(kBufferBytes);
+    if (path == "-") {
+        sink->fd_ = 1;
+    } else {
+        struct stat st;
+        if (::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode)) throw Error(path, "is a directory");
+        sink->temp_path_ = make_temp(path + ".tmp-XXXXXX", &sink->fd_, path);
+        ::fchmod(sink->fd_, default_file_mode());
+        register_temp_path(sink->temp_path_);
+    }
+    if (options.gzip_level >= 0) {
+        sink->gz_ = std::make_unique<Gzip>();
+        std::memset(&sink->gz_->zs, 0, sizeof(z_stream));
+        if (deflateInit2(&sink->gz_->zs, std::min(options.gzip_level, 9), Z_DEFLATED, 16 + MAX_WBITS, 8,
+                         Z_DEFAULT_STRATEGY) != Z_OK)
+            throw Error(sink->name_, "zlib deflateInit failed");
+    }
+    return sink;
+}
+
+ByteSink::~ByteSink() {
+    if (gz_) deflateEnd(&gz_->zs);
+    if (!temp_path_.empty()) {
+        if (fd_ >= 0) ::close(fd_);
+        if (!committed_) ::unlink(temp_path_.c_str());
+        for (int i = 0; i < kMaxTempPaths; ++i)
+            if (g_temp_used[i].load() && temp_path_ == g_temp_paths[i]) unregister_temp_path(i);
+    }
+}
+
+void ByteSink::write_raw(const void* data, size_t n) {
+    if (!gz_) {
+        write_all(fd_, data, n, name_, offset_);
+        return;
+    }
+    z_stream& zs = gz_->zs;
+    zs.next_in = static_cast<Bytef*>(const_cast<void*>(data));
+    zs.avail_in = static_cast<uInt>(n);
+    while (zs.avail_in > 0) {
+        zs.next_out = reinterpret_cast<Bytef*>(gz_->out.data());
+        zs.avail_out = static_cast<uInt>(gz_->out.size());
+        deflate(&zs, Z_NO_FLUSH);
+        write_all(fd_, gz_->out.data(), gz_->out.size() - zs.avail_out, name_, offset_);
+    }
+}
+
+void ByteSink::flush_buffer() {
+    if (buf_.empty()) return;
+    write_raw(buf_.data(), buf_.size());
+    buf_.clear();
+}
+
+void ByteSink::write(const void* data, size_t n) {
+    if (buf_.size() + n > kBufferBytes) {
+        flush_buffer();
+        if (n >= kBufferBytes) {
+            write_raw(data, n);
+            offset_ += n;
+            return;
+        }
+    }
+    auto* p = static_cast<const std::byte*>(data);
+    buf_.insert(buf_.end(), p, p + n);
+    offset_ += n;
+}
+
+bool ByteSink::patchable() const { return !gz_ && !temp_path_.empty(); }
+
+void ByteSink::patch(uint64_t offset, const void* data, size_t n) {
+    flush_buffer();
+    auto* p = static_cast<const char*>(data);
+    while (n > 0) {
+        ssize_t put = ::pwrite(fd_, p, n, static_cast<off_t>(offset));
+        if (put < 0) {
+            if (errno == EINTR) continue;
+            throw Error(name_, offset, 0, "write failed: " + errno_text());
+        }
+        p += put;
+        n -= static_cast<size_t>(put);
+        offset += static_cast<uint64_t>(put);
+    }
+}
+
+void ByteSink::commit() {
+    flush_buffer();
+    if (gz_) {
+        z_stream& zs = gz_->zs;
+        zs.avail_in = 0;
+        int rc;
+        do {
+            zs.next_out = reinterpret_cast<Bytef*>(gz_->out.data());
+            zs.avail_out = static_cast<uInt>(gz_->out.size());
+            rc = deflate(&zs, Z_FINISH);
+            write_all(fd_, gz_->out.data(), gz_->out.size() - zs.avail_out, name_, offset_);
+        } while (rc != Z_STREAM_END);
+    }
+    if (temp_path_.empty()) {
+        committed_ = true;
+        return;
+    }
+    if (::close(fd_) != 0) {
+        fd_ = -1;
+        throw Error(name_, "write failed on close: " + errno_text());
+    }
+    fd_ = -1;
+    if (::rename(temp_path_.c_str(), name_.c_str()) != 0)
+        throw Error(name_, "cannot rename " + temp_path_ + " into place: " + errno_text());
+    committed_ = true;
+}
+
+// ---------------- TempFile ----------------
+
+TempFile::TempFile(const std::string& dir, const std::string& stem) {
+    std::string d = dir;
+    if (d.empty()) {
+        const char* env = std::getenv("TMPDIR");
+        d = env && *env ? env : "/tmp";
+    }
+    path_ = make_temp(d + "/" + stem + "-XXXXXX", &fd_, d);
+    register_temp_path(path_);
+    buf_.reserve(size_t{1} << 20);
+}
+
+TempFile::~TempFile() {
+    if (fd_ >= 0) ::close(fd_);
+    ::unlink(path_.c_str());
+    for (int i = 0; i < kMaxTempPaths; ++i)
+        if (g_temp_used[i].load() && path_ == g_temp_paths[i]) unregister_temp_path(i);
+}
+
+void TempFile::write(const void* data, size_t n) {
+    if (buf_.size() + n > buf_.capacity()) flush();
+    if (n >= buf_.capacity()) {
+        write_all(fd_, data, n, path_, offset_);
+        offset_ += n;
+        return;
+    }
+    auto* p = static_cast<const std::byte*>(data);
+    buf_.insert(buf_.end(), p, p + n);
+}
+
+void TempFile::flush() {
+    if (buf_.empty()) return;
+    write_all(fd_, buf_.data(), buf_.size(), path_, offset_);
+    offset_ += buf_.size();
+    buf_.clear();
+}
+
+void TempFile::read_at(uint64_t offset, void* dst, size_t n) {
+    flush();
+    auto* p = static_cast<char*>(dst);
+    while (n > 0) {
+        ssize_t got = ::pread(fd_, p, n, static_cast<off_t>(offset));
+        if (got < 0 && errno == EINTR) continue;
+        if (got <= 0) throw Error(path_, offset, 0, "short read from temporary file");
+        p += got;
+        n -= static_cast<size_t>(got);
+        offset += static_cast<uint64_t>(got);
+    }
+}
+
+}  // namespace meshstream::io

@@ -1,0 +1,161 @@
+// Byte streams under every reader and writer: files, stdin/stdout ("-") and gzip (zlib) on
+// both sides. Sources are buffered (1 MiB refills) and give parsers a contiguous window so
+// they can tokenize in place; gzip input is recognised by its magic bytes 1f 8b whatever the
+// name. Sinks write to a temporary file beside the target and rename it into place on
+// commit(), so a failed run never leaves a half-written file under the target's name.
+// Offsets and sizes are 64-bit throughout (files over 4 GiB work).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace meshstream::io {
+
+// The unbuffered producer under a ByteSource (a file descriptor, a zlib stream, or a test
+// double that fakes huge sizes). read() returns 0 only at end of stream; throws io::Error.
+class RawInput {
+public:
+    virtual ~RawInput() = default;
+    virtual size_t read(void* dst, size_t n) = 0;
+    // Total size in bytes when known before reading (regular uncompressed files).
+    virtual std::optional<uint64_t> size() const { return std::nullopt; }
+};
+
+class ByteSource {
+public:
+    static constexpr size_t kBufferBytes = size_t{1} << 20;
+
+    // Opens `path` ("-" = stdin). Gzip is detected by magic bytes and decoded transparently.
+    // Throws io::Error when the file cannot be opened.
+    static std::unique_ptr<ByteSource> open(const std::string& path);
+    // Wraps any RawInput (tests, in-memory data). Gzip is detected here too.
+    ByteSource(std::unique_ptr<RawInput> raw, std::string name);
+    ~ByteSource();
+    ByteSource(const ByteSource&) = delete;
+    ByteSource& operator=(const ByteSource&) = delete;
+
+    // Copies up to n bytes into dst; returns fewer only at end of stream.
+    size_t read(void* dst, size_t n);
+    // Returns up to n (<= kBufferBytes) buffered bytes without consuming them; fewer only at
+    // end of stream.
+    std::span<const std::byte> peek(size_t n);
+    // The currently buffered bytes (refilling when empty); empty only at end of stream.
+    std::span<const std::byte> window();
+    // Consumes n bytes of the current window (n <= window().size()).
+    void consume(size_t n);
+    // Skips n bytes; returns how many were skipped (fewer only at end of stream).
+    uint64_t skip(uint64_t n);
+    bool at_end();
+
+    // Bytes consumed so far (of the decoded stream for gzip).
+    uint64_t offset() const { return offset_; }
+    // Decoded total size when known up front: plain regular files only.
+    std::optional<uint64_t> size() const;
+    const std::string& name() const { return name_; }
+    bool gzip() const { return gzip_; }
+    // The filesystem path when the source is a plain (not gzip) regular file, for readers that
+    // can mmap parts of it; empty otherwise.
+    const std::string& regular_file_path() const { return regular_path_; }
+
+    // Throws io::Error at the current offset (helper for readers).
+    [[noreturn]] void fail(const std::string& message) const;
+
+private:
+    bool fill(size_t want);  // makes at least `want` bytes buffered if the stream has them
+
+    std::unique_ptr<RawInput> raw_;
+    std::string name_;
+    std::string regular_path_;
+    bool gzip_ = false;
+    std::vector<std::byte> buf_;
+    size_t begin_ = 0, end_ = 0;
+    uint64_t offset_ = 0;
+    bool eof_ = false;
+};
+
+struct SinkOptions {
+    // zlib level 0–9 when the output is gzip-compressed; -1 = not compressed.
+    int gzip_level = -1;
+};
+
+// The consumer under every writer. Writes go to `<target>.tmp-XXXXXX` in the target's
+// directory (or straight to stdout for "-"); commit() flushes and renames into place; a sink
+// destroyed without commit() deletes its temporary file.
+class ByteSink {
+public:
+    static constexpr size_t kBufferBytes = size_t{1} << 20;
+
+    // Throws io::Error when the temporary file cannot be created.
+    static std::unique_ptr<ByteSink> open(const std::string& path, const SinkOptions& options = {});
+    ~ByteSink();
+    ByteSink(const ByteSink&) = delete;
+    ByteSink& operator=(const ByteSink&) = delete;
+
+    void write(const void* data, size_t n);
+    void write(std::string_view s) { write(s.data(), s.size()); }
+    // Bytes written so far (uncompressed).
+    uint64_t offset() const { return offset_; }
+    // True when earlier bytes can be overwritten with patch(): plain files, not stdout or gzip.
+    bool patchable() const;
+    // Overwrites bytes at `offset` (< offset() - n + 1). Precondition: patchable().
+    void patch(uint64_t offset, const void* data, size_t n);
+    // Flushes, closes and renames into place. Throws io::Error (e.g. disk full).
+    void commit();
+    const std::string& name() const { return name_; }
+
+private:
+    ByteSink() = default;
+    void flush_buffer();
+    void write_raw(const void* data, size_t n);
+
+    std::string name_;       // the target path as given
+    std::string temp_path_;  // empty for stdout
+    int fd_ = -1;
+    bool committed_ = false;
+    struct Gzip;
+    std::unique_ptr<Gzip> gz_;
+    std::vector<std::byte> buf_;
+    uint64_t offset_ = 0;
+};
+
+// A temporary file for spills, runs and bodies that are assembled later. Registered so a
+// SIGINT/SIGTERM handler (install_cleanup_handlers) can unlink it; removed by the destructor.
+class TempFile {
+public:
+    // Creates the file in `dir` (empty: $TMPDIR or /tmp). Throws io::Error.
+    explicit TempFile(const std::string& dir = {}, const std::string& stem = "meshstream");
+    ~TempFile();
+    TempFile(const TempFile&) = delete;
+    TempFile& operator=(const TempFile&) = delete;
+
+    const std::string& path() const { return path_; }
+    int fd() const { return fd_; }
+    // Buffered sequential writing; offset() counts bytes written.
+    void write(const void* data, size_t n);
+    void flush();
+    uint64_t size() const { return offset_ + buf_.size(); }
+    // Reads n bytes at `offset` (pread), flushing pending writes first. Throws on short read.
+    void read_at(uint64_t offset, void* dst, size_t n);
+
+private:
+    std::string path_;
+    int fd_ = -1;
+    uint64_t offset_ = 0;
+    std::vector<std::byte> buf_;
+};
+
+// Registers a path to unlink if the process is interrupted; returns a slot for unregister.
+int register_temp_path(const std::string& path);
+void unregister_temp_path(int slot);
+// Installs SIGINT/SIGTERM/SIGHUP handlers that unlink every registered path, then re-raise.
+void install_cleanup_handlers();
+
+// Directory part of a path ("." when there is none).
+std::string parent_dir(const std::string& path);
+
+}  // namespace meshstream::io

@@ -1,0 +1,43 @@
+// io::Error: formats what() like a compiler diagnostic.
+#include "io/error.hpp"
+
+#include <cstdio>
+
+namespace meshstream::io {
+namespace {
+
+std::string format_what(const std::string& file, uint64_t byte_offset, uint64_t line,
+                        const std::string& message) {
+    std::string out = file.empty() ? std::string("<input>") : file;
+    if (line != 0) out += ":" + std::to_string(line);
+    if (byte_offset != Error::kNoOffset) out += ": byte " + std::to_string(byte_offset);
+    out += ": " + message;
+    return out;
+}
+
+}  // namespace
+
+Error::Error(std::string file, uint64_t byte_offset, uint64_t line, std::string message)
+    : std::runtime_error(format_what(file, byte_offset, line, message)),
+      file_(std::move(file)), byte_offset_(byte_offset), line_(line), message_(std::move(message)) {}
+
+Error::Error(std::string file, std::string message) : Error(std::move(file), kNoOffset, 0, std::move(message)) {}
+
+std::string quote_token(std::string_view token) {
+    std::string out = "'";
+    size_t n = 0;
+    for (char c : token) {
+        if (++n > 32) { out += "..."; break; }
+        unsigned char u = static_cast<unsigned char>(c);
+        if (u >= 0x20 && u < 0x7f) {
+            out += c;
+        } else {
+            char buf[8];
+            std::snprintf(buf, sizeof buf, "\\x%02x", u);
+            out += buf;
+        }
+    }
+    return out + "'";
+}
+
+}  // namespace meshstream::io

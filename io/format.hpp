@@ -1,0 +1,135 @@
+// Readers, writers and the format descriptor. A format describes itself next to its code
+// (PDAL's StaticPluginInfo, OpenMesh's get_extensions/get_magic); io/registry.cpp lists them.
+// Adding a format = io/<fmt>.{hpp,cpp} + one line in registry.cpp + its CMake source line.
+#pragma once
+
+#include "io/byte_stream.hpp"
+#include "io/chunk.hpp"
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+namespace meshstream::io {
+
+struct Bounds {
+    std::array<float, 3> min{}, max{};
+};
+
+// What a reader knows from the file's header, before or while streaming. Every field is
+// optional: formats fill what they know.
+struct MeshHeader {
+    std::optional<uint64_t> triangle_count;  // total triangles (after fan triangulation)
+    std::optional<uint64_t> vertex_count;    // indexed formats
+    std::optional<int> sorted_axis;          // 0,1,2 when the file says it is sorted (meshstream sort)
+    std::optional<Bounds> bounds;            // when the header states it (glTF accessors)
+    Channels channels;                       // channels the reader will fill
+    std::string variant;                     // e.g. "binary", "ascii", "binary_big_endian"
+    std::vector<std::pair<std::string, std::string>> notes;  // extra facts for `info`
+};
+
+class Reader {
+public:
+    virtual ~Reader() = default;
+    // Fills `chunk` (cleared first) with up to chunk.capacity() triangles; returns false once
+    // the input is exhausted (chunk then empty). Throws io::Error on bad input and never emits
+    // a partial triangle.
+    virtual bool next(TriangleChunk& chunk) = 0;
+    // Facts from the header; triangle_count is set when the format states it up front.
+    const MeshHeader& header() const { return header_; }
+    std::optional<uint64_t> triangle_count() const { return header_.triangle_count; }
+
+protected:
+    MeshHeader header_;
+};
+
+class Writer {
+public:
+    virtual ~Writer() = default;
+    // Consumes one chunk. Throws io::Error.
+    virtual void write(const TriangleChunk& chunk) = 0;
+    // Completes the output (footer, header counts). The caller then commits the ByteSink;
+    // a writer destroyed without finish() leaves output that is discarded.
+    virtual void finish() = 0;
+};
+
+struct ReadOptions {
+    uint64_t memory_budget_bytes = uint64_t{256} << 20;  // --memory: spill indexed tables past this
+    std::string tmpdir;                                  // empty: system temp dir
+    bool strict = false;                                 // --strict: skip-with-warning becomes error
+};
+
+struct WriteOptions {
+    uint64_t memory_budget_bytes = uint64_t{256} << 20;  // for writers that weld or spool
+    std::string tmpdir;
+    std::optional<uint64_t> triangle_count;  // total to be written, when known up front
+    std::optional<int> sorted_axis;          // recorded in the header when the format has room
+    std::string comment;                     // free text for formats with comments
+    // Draco / glTF
+    int draco_position_bits = 14;  // --draco-qp
+    int draco_normal_bits = 10;    // --draco-qn
+    int draco_level = 7;           // --draco-cl, 0–10
+    bool normals = false;          // --normals: write smooth vertex normals where supported
+    bool draco = true;             // glTF: KHR_draco_mesh_compression (--no-draco turns off)
+};
+
+struct Format {
+    std::string_view name;         // for --from/--to: "stl", "stl-ascii", "ply", ...
+    std::string_view extensions;   // space separated, lower case, without dot: "stl"
+    std::string_view description;  // one line for --help and docs
+    // True when `head` (the first bytes, up to 4 KiB) is this format. `file_size` is the
+    // decoded size when known. May be null (never detected by content).
+    bool (*probe)(std::span<const std::byte> head, std::optional<uint64_t> file_size);
+    // May be null (write-only format). Throws io::Error.
+    std::unique_ptr<Reader> (*open_reader)(ByteSource& source, const ReadOptions& options);
+    // May be null (read-only format). Throws io::Error.
+    std::unique_ptr<Writer> (*open_writer)(ByteSink& sink, const WriteOptions& options);
+};
+
+// All registered formats, in probe priority order.
+std::span<const Format* const> formats();
+// The format named `name` (exact, case-sensitive), or null.
+const Format* find_format(std::string_view name);
+// The first readable format whose extension matches `path` (".gz" stripped), or null.
+const Format* format_for_extension(std::string_view path, bool for_writing);
+// Detection for reading: magic bytes first, then the extension. Throws io::Error naming the
+// file when neither identifies a readable format.
+const Format& detect_input_format(ByteSource& source);
+// For writing: by extension (".gz" stripped). Throws io::Error when unknown.
+const Format& detect_output_format(const std::string& path);
+// True when an output path asks for gzip (ends in ".gz").
+bool wants_gzip(std::string_view path);
+
+// An opened input: the byte source and its reader (reader destroyed first).
+struct Input {
+    std::unique_ptr<ByteSource> source;
+    std::unique_ptr<Reader> reader;
+    const Format* format = nullptr;
+};
+// Opens `path` ("-" = stdin) with the format `from` (empty: detect). Throws io::Error.
+Input open_input(const std::string& path, std::string_view from = {}, const ReadOptions& options = {});
+
+// An opened output. finish() completes the writer and renames the file into place; if it is
+// destroyed without finish(), nothing is left under the target name.
+struct Output {
+    std::unique_ptr<ByteSink> sink;
+    std::unique_ptr<Writer> writer;
+    const Format* format = nullptr;
+    void write(const TriangleChunk& chunk) { writer->write(chunk); }
+    void finish() {
+        writer->finish();
+        sink->commit();
+    }
+};
+// Opens `path` ("-" = stdout) as format `to` (empty: by extension). gzip_level applies when
+// the path ends in ".gz" (or always when force_gzip). Throws io::Error.
+Output open_output(const std::string& path, std::string_view to, const WriteOptions& options,
+                   int gzip_level = 6, bool force_gzip = false);
+
+}  // namespace meshstream::io
