@@ -1,0 +1,12 @@
+// One add_<cmd>(CLI::App&) per subcommand file (CLI11's examples/subcom_in_files). Each
+// registers its options and a callback that runs the command and throws io::Error on failure.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace meshstream::tools {
+
+void add_info(CLI::App& app);
+void add_convert(CLI::App& app);
+
+}  // namespace meshstream::tools

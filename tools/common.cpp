@@ -1,0 +1,154 @@
+// Shared CLI helpers: option groups, sizes, progress bar, warnings.
+#include "tools/common.hpp"
+
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <unistd.h>
+
+namespace meshstream::tools {
+
+uint64_t parse_bytes(const std::string& text) {
+    double value = 0;
+    const char* begin = text.data();
+    const char* end = begin + text.size();
+    auto [p, ec] = std::from_chars(begin, end, value);
+    if (ec != std::errc() || value < 0) throw CLI::ValidationError("size", "expected a size like 64M or 1G, got '" + text + "'");
+    std::string suffix(p, end);
+    for (char& c : suffix) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+    double mult = 1;
+    if (suffix.empty() || suffix == "B") mult = 1;
+    else if (suffix == "K" || suffix == "KB" || suffix == "KIB") mult = 1024.0;
+    else if (suffix == "M" || suffix == "MB" || suffix == "MIB") mult = 1024.0 * 1024;
+    else if (suffix == "G" || suffix == "GB" || suffix == "GIB") mult = 1024.0 * 1024 * 1024;
+    else if (suffix == "T" || suffix == "TB" || suffix == "TIB") mult = 1024.0 * 1024 * 1024 * 1024;
+    else throw CLI::ValidationError("size", "unknown size suffix in '" + text + "' (use K, M, G or T)");
+    return static_cast<uint64_t>(value * mult);
+}
+
+io::ReadOptions ReadFlags::options() const {
+    io::ReadOptions o;
+    o.memory_budget_bytes = parse_bytes(memory);
+    o.tmpdir = tmpdir;
+    o.strict = strict;
+    return o;
+}
+
+void add_read_flags(CLI::App* cmd, ReadFlags& flags) {
+    cmd->add_option("--from", flags.from, "Input format, overriding detection (e.g. stl, stl-ascii)");
+    cmd->add_option("--memory", flags.memory,
+                    "Memory budget for tables, spills and sort runs, e.g. 64M, 1G (default 256M)");
+    cmd->add_option("--tmpdir", flags.tmpdir, "Directory for temporary files (default: $TMPDIR or /tmp)");
+    cmd->add_flag("--strict", flags.strict, "Treat skippable input problems (NaN, degenerate faces) as errors");
+}
+
+io::WriteOptions WriteFlags::options(const ReadFlags& read) const {
+    io::WriteOptions o;
+    o.memory_budget_bytes = parse_bytes(read.memory);
+    o.tmpdir = read.tmpdir;
+    o.draco = draco;
+    o.normals = normals;
+    o.draco_position_bits = draco_qp;
+    o.draco_normal_bits = draco_qn;
+    o.draco_level = draco_cl;
+    return o;
+}
+
+void add_write_flags(CLI::App* cmd, WriteFlags& flags) {
+    cmd->add_option("--to", flags.to, "Output format, overriding the extension (e.g. stl, stl-ascii)");
+    cmd->add_option("--gzip-level", flags.gzip_level, "zlib level 0-9 for outputs ending in .gz (default 6)")
+        ->check(CLI::Range(0, 9));
+}
+
+Global& global() {
+    static Global g;
+    return g;
+}
+
+Progress::Progress(std::string label, std::optional<uint64_t> total, std::string unit)
+    : label_(std::move(label)), total_(total), unit_(std::move(unit)),
+      enabled_(!global().quiet && ::isatty(2)), start_(std::chrono::steady_clock::now()), last_(start_) {}
+
+Progress::~Progress() { done(); }
+
+void Progress::phase(std::string label, std::optional<uint64_t> total) {
+    label_ = std::move(label);
+    total_ = total;
+    done_ = 0;
+    start_ = std::chrono::steady_clock::now();
+    draw(true);
+}
+
+void Progress::update(uint64_t done) {
+    done_ = done;
+    if (enabled_) draw(false);
+}
+
+void Progress::draw(bool force) {
+    if (!enabled_) return;
+    auto now = std::chrono::steady_clock::now();
+    if (!force && now - last_ < std::chrono::milliseconds(200)) return;
+    last_ = now;
+    double secs = std::chrono::duration<double>(now - start_).count();
+    double rate = secs > 0 ? done_ / secs : 0;
+    char line[256];
+    if (total_ && *total_ > 0) {
+        double frac = std::min(1.0, static_cast<double>(done_) / static_cast<double>(*total_));
+        int filled = static_cast<int>(frac * 24);
+        std::string bar(filled, '#');
+        bar.resize(24, '.');
+        double eta = rate > 0 ? (static_cast<double>(*total_) - done_) / rate : 0;
+        std::snprintf(line, sizeof line, "\r%s [%s] %5.1f%% %s %s, %s/s, ETA %.0fs\x1b[K", label_.c_str(), bar.c_str(),
+                      100 * frac, human_count(done_).c_str(), unit_.c_str(), human_count(rate).c_str(), eta);
+    } else {
+        std::snprintf(line, sizeof line, "\r%s %s %s, %s/s, %.0fs\x1b[K", label_.c_str(), human_count(done_).c_str(),
+                      unit_.c_str(), human_count(rate).c_str(), secs);
+    }
+    std::fputs(line, stderr);
+    drawn_ = true;
+}
+
+void Progress::done() {
+    if (enabled_ && drawn_) std::fputs("\r\x1b[K", stderr);
+    drawn_ = false;
+}
+
+void Warnings::print() const {
+    for (const auto& [kind, count] : counts_) std::fprintf(stderr, "meshstream: warning: %s (%llu)\n", kind.c_str(),
+                                                           static_cast<unsigned long long>(count));
+}
+
+std::string human_count(double n) {
+    char buf[32];
+    if (n >= 1e9) std::snprintf(buf, sizeof buf, "%.2f G", n / 1e9);
+    else if (n >= 1e6) std::snprintf(buf, sizeof buf, "%.2f M", n / 1e6);
+    else if (n >= 1e4) std::snprintf(buf, sizeof buf, "%.1f k", n / 1e3);
+    else std::snprintf(buf, sizeof buf, "%.0f", n);
+    return buf;
+}
+
+std::string human_bytes(double bytes) {
+    char buf[32];
+    if (bytes >= 1e9) std::snprintf(buf, sizeof buf, "%.2f GB", bytes / 1e9);
+    else if (bytes >= 1e6) std::snprintf(buf, sizeof buf, "%.1f MB", bytes / 1e6);
+    else if (bytes >= 1e3) std::snprintf(buf, sizeof buf, "%.1f kB", bytes / 1e3);
+    else std::snprintf(buf, sizeof buf, "%.0f B", bytes);
+    return buf;
+}
+
+uint64_t peak_rss_bytes() {
+    std::ifstream status("/proc/self/status");
+    std::string key;
+    while (status >> key) {
+        if (key == "VmHWM:") {
+            uint64_t kb = 0;
+            status >> kb;
+            return kb * 1024;
+        }
+        status.ignore(1 << 16, '\n');
+    }
+    return 0;
+}
+
+}  // namespace meshstream::tools

@@ -1,0 +1,90 @@
+// Shared pieces of the `meshstream` subcommands: command-line option groups for reading and
+// writing, byte-size parsing, the stderr progress bar, and the warning channel. Only tools/
+// prints; the libraries report through return values and io::Error.
+#pragma once
+
+#include "io/format.hpp"
+
+#include <CLI/CLI.hpp>
+
+#include <chrono>
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+
+namespace meshstream::tools {
+
+// Parses "256M", "64MiB", "1G", "1.5g", "4096" (bytes; K/M/G/T are binary multiples).
+// Throws CLI::ValidationError on bad text.
+uint64_t parse_bytes(const std::string& text);
+
+// Options every command that reads a mesh accepts.
+struct ReadFlags {
+    std::string from;  // --from: force the input format
+    std::string memory = "256M";
+    std::string tmpdir;
+    bool strict = false;
+    io::ReadOptions options() const;
+};
+void add_read_flags(CLI::App* cmd, ReadFlags& flags);
+
+// Options every command that writes a mesh accepts.
+struct WriteFlags {
+    std::string to;  // --to: force the output format
+    int gzip_level = 6;
+    bool draco = true;
+    bool normals = false;
+    int draco_qp = 14, draco_qn = 10, draco_cl = 7;
+    io::WriteOptions options(const ReadFlags& read) const;
+};
+// `with_memory`: false when add_read_flags already added --memory/--tmpdir to `cmd`.
+void add_write_flags(CLI::App* cmd, WriteFlags& flags);
+
+// Global flags (set by main before a subcommand runs).
+struct Global {
+    bool quiet = false;
+};
+Global& global();
+
+// A one-line progress bar on stderr, drawn only when stderr is a terminal and --quiet is not
+// given: phase label, count, rate, and percent + ETA when the total is known. Redraws at most
+// 5 times a second, so calling update() per chunk costs nothing.
+class Progress {
+public:
+    Progress(std::string label, std::optional<uint64_t> total, std::string unit = "triangles");
+    ~Progress();
+    void update(uint64_t done);
+    // Starts a new phase (keeps the bar); total may change.
+    void phase(std::string label, std::optional<uint64_t> total);
+    void done();  // clears the line
+
+private:
+    void draw(bool force);
+    std::string label_;
+    std::optional<uint64_t> total_;
+    std::string unit_;
+    uint64_t done_ = 0;
+    bool enabled_;
+    bool drawn_ = false;
+    std::chrono::steady_clock::time_point start_, last_;
+};
+
+// Counted warnings, summarised once at the end of a command on stderr ("warning: ...").
+class Warnings {
+public:
+    void add(const std::string& kind, uint64_t count = 1) { counts_[kind] += count; }
+    bool empty() const { return counts_.empty(); }
+    void print() const;
+
+private:
+    std::map<std::string, uint64_t> counts_;
+};
+
+// "1.23 M" style numbers and "12.3 MB" sizes for summaries.
+std::string human_count(double n);
+std::string human_bytes(double bytes);
+// Peak resident set size of this process in bytes (from /proc/self/status VmHWM).
+uint64_t peak_rss_bytes();
+
+}  // namespace meshstream::tools

@@ -1,0 +1,56 @@
+// `meshstream convert IN OUT`: streams triangles between any two registered formats, one chunk
+// at a time. Memory: one chunk plus whatever the two formats need (see docs/formats.md).
+#include "io/error.hpp"
+#include "tools/commands.hpp"
+#include "tools/common.hpp"
+
+#include <cstdio>
+#include <memory>
+
+namespace meshstream::tools {
+namespace {
+
+struct ConvertOptions {
+    std::string input, output;
+    ReadFlags read;
+    WriteFlags write;
+};
+
+void run_convert(const ConvertOptions& opt) {
+    io::Input in = io::open_input(opt.input, opt.read.from, opt.read.options());
+    const io::MeshHeader& header = in.reader->header();
+    io::WriteOptions wo = opt.write.options(opt.read);
+    wo.triangle_count = header.triangle_count;
+    wo.sorted_axis = header.sorted_axis;
+    io::Output out = io::open_output(opt.output, opt.write.to, wo, opt.write.gzip_level);
+
+    io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, header.channels);
+    uint64_t done = 0;
+    Progress progress("converting", header.triangle_count);
+    while (in.reader->next(chunk)) {
+        out.write(chunk);
+        done += chunk.size();
+        progress.update(done);
+    }
+    progress.done();
+    if (header.triangle_count && done != *header.triangle_count)
+        throw io::Error(in.source->name(), "header promises " + std::to_string(*header.triangle_count) +
+                                               " triangles, read " + std::to_string(done));
+    out.finish();
+}
+
+}  // namespace
+
+void add_convert(CLI::App& app) {
+    auto opt = std::make_shared<ConvertOptions>();
+    CLI::App* cmd = app.add_subcommand(
+        "convert", "Convert between formats (detected by magic bytes, then extension; '-' = stdin/stdout).\n"
+                   "The output appears under its name only when complete; '.gz' outputs are gzip-compressed.");
+    cmd->add_option("input", opt->input, "Input mesh ('-' = stdin)")->required();
+    cmd->add_option("output", opt->output, "Output mesh ('-' = stdout, needs --to)")->required();
+    add_read_flags(cmd, opt->read);
+    add_write_flags(cmd, opt->write);
+    cmd->callback([opt] { run_convert(*opt); });
+}
+
+}  // namespace meshstream::tools

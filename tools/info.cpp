@@ -1,0 +1,131 @@
+// `meshstream info FILE`: format, counts, bounding box, file size and degenerate triangles,
+// in one streaming pass (memory: one chunk), as plain text or --json.
+#include "io/error.hpp"
+#include "tools/commands.hpp"
+#include "tools/common.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <memory>
+
+namespace meshstream::tools {
+namespace {
+
+struct InfoOptions {
+    std::string input;
+    bool json = false;
+    ReadFlags read;
+};
+
+struct InfoStats {
+    uint64_t triangles = 0;
+    uint64_t degenerate = 0;  // zero area (collinear or repeated corners)
+    uint64_t non_finite = 0;  // a NaN or infinite coordinate
+    float min[3] = {std::numeric_limits<float>::infinity(), std::numeric_limits<float>::infinity(),
+                    std::numeric_limits<float>::infinity()};
+    float max[3] = {-std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity(),
+                    -std::numeric_limits<float>::infinity()};
+};
+
+void accumulate(const io::TriangleChunk& chunk, InfoStats& s) {
+    auto xyz = chunk.xyz();
+    for (size_t t = 0; t < chunk.size(); ++t) {
+        const float* p = &xyz[9 * t];
+        bool finite = true;
+        for (int k = 0; k < 9; ++k) finite &= std::isfinite(p[k]);
+        if (!finite) {
+            ++s.non_finite;
+            continue;
+        }
+        for (int v = 0; v < 3; ++v)
+            for (int a = 0; a < 3; ++a) {
+                s.min[a] = std::min(s.min[a], p[3 * v + a]);
+                s.max[a] = std::max(s.max[a], p[3 * v + a]);
+            }
+        // Exact zero-area test in double: the cross product of two edges vanishes.
+        double e1[3], e2[3];
+        for (int a = 0; a < 3; ++a) {
+            e1[a] = double(p[3 + a]) - p[a];
+            e2[a] = double(p[6 + a]) - p[a];
+        }
+        double cx = e1[1] * e2[2] - e1[2] * e2[1], cy = e1[2] * e2[0] - e1[0] * e2[2], cz = e1[0] * e2[1] - e1[1] * e2[0];
+        if (cx == 0 && cy == 0 && cz == 0) ++s.degenerate;
+    }
+    s.triangles += chunk.size();
+}
+
+void run_info(const InfoOptions& opt) {
+    io::Input in = io::open_input(opt.input, opt.read.from, opt.read.options());
+    const io::MeshHeader& header = in.reader->header();
+    InfoStats stats;
+    io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, header.channels);
+    {
+        Progress progress("reading", header.triangle_count);
+        while (in.reader->next(chunk)) {
+            accumulate(chunk, stats);
+            progress.update(stats.triangles);
+        }
+    }
+    std::optional<uint64_t> file_size = in.source->gzip() ? std::nullopt : in.source->size();
+    uint64_t decoded_bytes = in.source->offset();
+    bool has_box = stats.triangles > stats.non_finite;
+    static const char* kAxes[] = {"x", "y", "z"};
+
+    if (opt.json) {
+        nlohmann::ordered_json j;
+        j["file"] = opt.input;
+        j["format"] = std::string(in.format->name);
+        if (!header.variant.empty()) j["variant"] = header.variant;
+        j["gzip"] = in.source->gzip();
+        if (file_size) j["file_bytes"] = *file_size;
+        if (in.source->gzip()) j["decoded_bytes"] = decoded_bytes;
+        j["triangles"] = stats.triangles;
+        if (header.vertex_count) j["vertices"] = *header.vertex_count;
+        j["degenerate_triangles"] = stats.degenerate;
+        j["non_finite_triangles"] = stats.non_finite;
+        if (has_box) {
+            j["bbox_min"] = {stats.min[0], stats.min[1], stats.min[2]};
+            j["bbox_max"] = {stats.max[0], stats.max[1], stats.max[2]};
+        } else {
+            j["bbox_min"] = nullptr;
+            j["bbox_max"] = nullptr;
+        }
+        if (header.sorted_axis) j["sorted_axis"] = kAxes[*header.sorted_axis];
+        for (const auto& [k, v] : header.notes) j["notes"][k] = v;
+        std::printf("%s\n", j.dump(2).c_str());
+        return;
+    }
+    std::printf("file:        %s\n", opt.input.c_str());
+    std::printf("format:      %s%s%s%s\n", std::string(in.format->name).c_str(),
+                header.variant.empty() ? "" : " (", header.variant.c_str(), header.variant.empty() ? "" : ")");
+    if (in.source->gzip()) std::printf("compression: gzip (%llu bytes decoded)\n", (unsigned long long)decoded_bytes);
+    if (file_size) std::printf("file size:   %llu bytes\n", (unsigned long long)*file_size);
+    std::printf("triangles:   %llu\n", (unsigned long long)stats.triangles);
+    if (header.vertex_count) std::printf("vertices:    %llu\n", (unsigned long long)*header.vertex_count);
+    std::printf("degenerate:  %llu (zero area)\n", (unsigned long long)stats.degenerate);
+    if (stats.non_finite) std::printf("non-finite:  %llu (NaN or infinite coordinates)\n", (unsigned long long)stats.non_finite);
+    if (has_box) {
+        std::printf("bbox min:    %.9g %.9g %.9g\n", stats.min[0], stats.min[1], stats.min[2]);
+        std::printf("bbox max:    %.9g %.9g %.9g\n", stats.max[0], stats.max[1], stats.max[2]);
+    } else {
+        std::printf("bbox:        empty\n");
+    }
+    if (header.sorted_axis) std::printf("sorted along: %s\n", kAxes[*header.sorted_axis]);
+    for (const auto& [k, v] : header.notes) std::printf("%-12s %s\n", (k + ":").c_str(), v.c_str());
+}
+
+}  // namespace
+
+void add_info(CLI::App& app) {
+    auto opt = std::make_shared<InfoOptions>();
+    CLI::App* cmd = app.add_subcommand("info", "Print format, triangle count, bounding box, file size and degenerate triangles");
+    cmd->add_option("file", opt->input, "Mesh file ('-' = stdin; gzip is detected)")->required();
+    cmd->add_flag("--json", opt->json, "Print JSON instead of text");
+    add_read_flags(cmd, opt->read);
+    cmd->callback([opt] { run_info(*opt); });
+}
+
+}  // namespace meshstream::tools

@@ -1,0 +1,38 @@
+// The `meshstream` command: parses the command line, runs one subcommand, and turns every
+// failure into one diagnostic line and an exit code (0 ok, 1 failed, 2 bad command line).
+#include "io/byte_stream.hpp"
+#include "io/error.hpp"
+#include "tools/commands.hpp"
+#include "tools/common.hpp"
+
+#include <cstdio>
+#include <exception>
+#include <new>
+
+int main(int argc, char** argv) {
+    using namespace meshstream;
+    CLI::App app{"meshstream: convert, sort and decimate triangle meshes larger than memory, in one streaming pass"};
+    app.set_help_all_flag("--help-all", "Show help for every command");
+    app.add_flag("-q,--quiet", tools::global().quiet, "No progress bar");
+    app.require_subcommand(1);
+    tools::add_info(app);
+    tools::add_convert(app);
+
+    io::install_cleanup_handlers();
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        int code = app.exit(e);  // prints help (code 0) or the parse error
+        return code == 0 ? 0 : 2;
+    } catch (const meshstream::io::Error& e) {
+        std::fprintf(stderr, "meshstream: error: %s\n", e.what());
+        return 1;
+    } catch (const std::bad_alloc&) {
+        std::fprintf(stderr, "meshstream: error: out of memory\n");
+        return 1;
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "meshstream: error: %s\n", e.what());
+        return 1;
+    }
+    return 0;
+}
