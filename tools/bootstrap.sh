@@ -1,0 +1,54 @@
+#!/usr/bin/env bash
+# Sets up a Debian 12 machine for meshstream and builds it, then runs one job:
+#   tools/bootstrap.sh demo   install what is missing, build, decimate the bunny fixture to 10 % as .glb
+#   tools/bootstrap.sh test   install what is missing, build, run the whole test suite (ctest)
+#   tools/bootstrap.sh build  install what is missing and build only
+# Idempotent: packages already installed and an up-to-date build are not redone.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+mode=${1:-build}
+build_dir=${MESHSTREAM_BUILD_DIR:-build}
+tools_dir=${MESHSTREAM_TOOLS_DIR:-/opt/meshstream-tools}   # npm tools used by the tests
+jobs=$(nproc 2>/dev/null || echo 2)
+
+as_root() { if [ "$(id -u)" = 0 ]; then "$@"; else sudo "$@"; fi; }
+
+# Debian packages: build tools, libraries, and the real clients the tests check output with.
+packages="cmake g++ make pkg-config libgtest-dev zlib1g-dev libdraco-dev draco libtinygltf-dev \
+nlohmann-json3-dev libcli11-dev"
+command -v node >/dev/null 2>&1 || packages="$packages nodejs"
+command -v npm >/dev/null 2>&1 || packages="$packages npm"
+missing=""
+for p in $packages; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"
+done
+if [ -n "$missing" ]; then
+  echo "meshstream setup: installing$missing" >&2
+  as_root apt-get update -qq
+  as_root env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends $missing >/dev/null
+fi
+
+# The Khronos glTF validator (npm), which the tests run on every glTF they write.
+if [ ! -f "$tools_dir/node_modules/gltf-validator/package.json" ]; then
+  echo "meshstream setup: installing gltf-validator into $tools_dir" >&2
+  as_root mkdir -p "$tools_dir"
+  as_root npm install --silent --no-audit --no-fund --prefix "$tools_dir" gltf-validator@2.0.0-dev.3.10 >/dev/null
+fi
+
+if [ ! -f "$build_dir/CMakeCache.txt" ]; then
+  cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release -DMESHSTREAM_TOOLS_DIR="$tools_dir" >/dev/null
+fi
+cmake --build "$build_dir" -j"$jobs"
+
+case "$mode" in
+  build) ;;
+  demo)
+    "$build_dir/tools/meshstream" decimate fixtures/bunny_from_draco.bin.stl bunny_10.glb --ratio 0.1
+    "$build_dir/tools/meshstream" info bunny_10.glb
+    ;;
+  test)
+    ctest --test-dir "$build_dir" --output-on-failure -j"$jobs"
+    ;;
+  *) echo "usage: $0 demo|test|build" >&2; exit 2 ;;
+esac
