@@ -1,0 +1,251 @@
+// Multiple-choice half-edge collapses (Wu & Kobbelt 2003, §4.3) with the validity tests
+// that keep the in-core mesh a manifold: the link condition (Dey et al.; Hoppe's "edge
+// collapse legality"), normal flip/fold and degeneracy checks as in meshoptimizer's
+// simplifier and Garland & Heckbert's implementation.
+#include "decimate/collapse.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace meshstream::decimate {
+namespace {
+
+// A remaining face may turn by at most ~84° (cos > 0.1): more is a flip or a fold.
+constexpr double kMinNormalCos = 0.1;
+// |n|² / (Σ edge²)² below this is a needle or cap (0.083 for an equilateral triangle).
+constexpr double kMinShapeQuality = 1e-8;
+
+void sub(const double a[3], const double b[3], double out[3]) {
+    out[0] = a[0] - b[0]; out[1] = a[1] - b[1]; out[2] = a[2] - b[2];
+}
+void cross(const double a[3], const double b[3], double out[3]) {
+    out[0] = a[1] * b[2] - a[2] * b[1];
+    out[1] = a[2] * b[0] - a[0] * b[2];
+    out[2] = a[0] * b[1] - a[1] * b[0];
+}
+double dot(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+bool boundary_eligible(const HalfEdgeBuffer& buffer, uint32_t h) {
+    if (buffer.twin(h) != kOpenEdge) return false;
+    const Vertex& p = buffer.vertex(buffer.corner_vertex(h));
+    if ((p.flags & (kInHash | kFrozen | kNonManifold)) != 0 || p.open_edges != 2) return false;
+    const Vertex& q = buffer.vertex(buffer.corner_vertex(next_in_face(h)));
+    return (q.flags & (kInHash | kNonManifold)) == 0;
+}
+
+}  // namespace
+
+// Shared by writing.cpp: would moving vertex v from `from` to `to` flip, fold or degenerate
+// any of its faces other than `skip0`/`skip1`?
+bool moves_keep_faces_valid(const HalfEdgeBuffer& buffer, uint32_t v, const double from[3],
+                            const double to[3], uint32_t skip0, uint32_t skip1) {
+    for (uint32_t c = buffer.vertex(v).first_corner; c != kNoIndex; c = buffer.next_corner(c)) {
+        const uint32_t f = c / 3;
+        if (f == skip0 || f == skip1) continue;
+        double a[3], b[3];
+        buffer.position(buffer.corner_vertex(next_in_face(c)), a);
+        buffer.position(buffer.corner_vertex(prev_in_face(c)), b);
+        double ea[3], eb[3], n_old[3], n_new[3];
+        sub(a, from, ea); sub(b, from, eb); cross(ea, eb, n_old);
+        sub(a, to, ea); sub(b, to, eb); cross(ea, eb, n_new);
+        const double old_len2 = dot(n_old, n_old), new_len2 = dot(n_new, n_new);
+        double ab[3];
+        sub(a, b, ab);
+        const double edges2 = dot(ea, ea) + dot(eb, eb) + dot(ab, ab);
+        const bool was_degenerate = old_len2 <= kMinShapeQuality * edges2 * edges2 || old_len2 == 0;
+        if (was_degenerate) continue;  // nothing to preserve; do not let it block the mesh
+        if (new_len2 <= kMinShapeQuality * edges2 * edges2) return false;
+        if (dot(n_old, n_new) <= kMinNormalCos * std::sqrt(old_len2 * new_len2)) return false;
+    }
+    return true;
+}
+
+bool collapse_eligible(const HalfEdgeBuffer& buffer, uint32_t h) {
+    const Vertex& p = buffer.vertex(buffer.corner_vertex(h));
+    if ((p.flags & (kInHash | kFrozen | kNonManifold)) != 0 || p.open_edges != 0) return false;
+    if (!is_half_edge(buffer.twin(h))) return false;
+    const Vertex& q = buffer.vertex(buffer.corner_vertex(next_in_face(h)));
+    return (q.flags & (kInHash | kNonManifold)) == 0;
+}
+
+double collapse_error(const HalfEdgeBuffer& buffer, uint32_t h) {
+    const uint32_t p = buffer.corner_vertex(h), q = buffer.corner_vertex(next_in_face(h));
+    double x[3];
+    buffer.position(q, x);
+    return (buffer.quadric(p) + buffer.quadric(q)).error(x);
+}
+
+bool collapse_valid(HalfEdgeBuffer& buffer, uint32_t h) {
+    const uint32_t p = buffer.corner_vertex(h), q = buffer.corner_vertex(next_in_face(h));
+    const uint32_t t = buffer.twin(h);
+    const bool boundary = !is_half_edge(t);
+    const uint32_t r = buffer.corner_vertex(prev_in_face(h));
+    const uint32_t s = boundary ? kNoIndex : buffer.corner_vertex(prev_in_face(t));
+    if (r == s) return false;
+    const Vertex& vp = buffer.vertex(p);
+    const Vertex& vq = buffer.vertex(q);
+
+    // p's faces must form one fan reachable from h (a closed one for an interior edge, an
+    // open one starting at h for a boundary edge): a vertex where two fans touch is not a
+    // manifold vertex and must not move.
+    uint32_t count = 0;
+    for (uint32_t cur = h;;) {
+        if (++count > vp.face_count) return false;
+        const uint32_t around = buffer.twin(prev_in_face(cur));
+        if (!is_half_edge(around)) {
+            if (!boundary) return false;
+            break;
+        }
+        cur = around;
+        if (cur == h) {
+            if (boundary) return false;
+            break;
+        }
+    }
+    if (count != vp.face_count) return false;
+    if (!boundary && vp.face_count == 3 && vq.face_count == 3) return false;  // tetrahedron
+
+    // Link condition: the common neighbours of p and q are exactly r (and s).
+    const uint32_t mark = buffer.new_stamp();
+    for (uint32_t c = vq.first_corner; c != kNoIndex; c = buffer.next_corner(c)) {
+        buffer.stamp(buffer.corner_vertex(next_in_face(c))) = mark;
+        buffer.stamp(buffer.corner_vertex(prev_in_face(c))) = mark;
+    }
+    for (uint32_t c = vp.first_corner; c != kNoIndex; c = buffer.next_corner(c)) {
+        const uint32_t x = buffer.corner_vertex(next_in_face(c));
+        const uint32_t y = buffer.corner_vertex(prev_in_face(c));
+        if (x != q && x != r && x != s && buffer.stamp(x) == mark) return false;
+        if (y != q && y != r && y != s && buffer.stamp(y) == mark) return false;
+    }
+
+    double from[3], to[3];
+    buffer.position(p, from);
+    buffer.position(q, to);
+    return moves_keep_faces_valid(buffer, p, from, to, h / 3, boundary ? kNoIndex : t / 3);
+}
+
+void apply_collapse(HalfEdgeBuffer& buffer, uint32_t h) {
+    const uint32_t p = buffer.corner_vertex(h), q = buffer.corner_vertex(next_in_face(h));
+    const uint32_t t = buffer.twin(h);
+    const bool boundary = !is_half_edge(t);
+    const uint32_t r = buffer.corner_vertex(prev_in_face(h));
+    const uint32_t s = boundary ? kNoIndex : buffer.corner_vertex(prev_in_face(t));
+
+    auto drop_open = [&](uint32_t e) {
+        if (buffer.twin(e) == kOpenEdge) {
+            --buffer.vertex(buffer.corner_vertex(e)).open_edges;
+            --buffer.vertex(buffer.corner_vertex(next_in_face(e))).open_edges;
+        }
+    };
+    // The outer neighbours across the two remaining edges of a removed face become twins.
+    auto join = [&](uint32_t x, uint32_t y) {
+        const bool real_x = is_half_edge(x), real_y = is_half_edge(y);
+        if (real_x) buffer.set_twin(x, y);
+        if (real_y) buffer.set_twin(y, x);
+        if (real_x != real_y && (real_x ? y : x) == kOpenEdge) {
+            const uint32_t e = real_x ? x : y;
+            ++buffer.vertex(buffer.corner_vertex(e)).open_edges;
+            ++buffer.vertex(buffer.corner_vertex(next_in_face(e))).open_edges;
+        }
+    };
+
+    const uint32_t h1 = next_in_face(h), h2 = prev_in_face(h);
+    const uint32_t o1 = buffer.twin(h1), o2 = buffer.twin(h2);
+    drop_open(h);
+    drop_open(h1);
+    drop_open(h2);
+    uint32_t u1 = kNoIndex, u2 = kNoIndex;
+    if (!boundary) {
+        const uint32_t t1 = next_in_face(t), t2 = prev_in_face(t);
+        u1 = buffer.twin(t1);
+        u2 = buffer.twin(t2);
+        drop_open(t1);
+        drop_open(t2);
+        buffer.detach_face(t / 3);
+    }
+    buffer.detach_face(h / 3);
+    join(o1, o2);
+    if (!boundary) join(u1, u2);
+
+    buffer.move_corners(p, q);
+    buffer.quadric(q) += buffer.quadric(p);
+    Vertex& vp = buffer.vertex(p);
+    buffer.vertex(q).open_edges += vp.open_edges;
+    vp.open_edges = 0;
+    buffer.free_vertex(p);
+    // An ear collapse can leave a vertex without faces.
+    for (uint32_t v : {q, r, s}) {
+        if (v == kNoIndex) continue;
+        const Vertex& x = buffer.vertex(v);
+        if ((x.flags & kAlive) && x.face_count == 0 && (x.flags & kInHash) == 0) buffer.free_vertex(v);
+    }
+}
+
+bool decimate_once(HalfEdgeBuffer& buffer, Rng& rng, int candidates) {
+    struct Candidate {
+        uint32_t h;
+        double error;
+    };
+    constexpr int kMaxCandidates = 64;
+    const int wanted = std::clamp(candidates, 1, kMaxCandidates);
+    Candidate best[kMaxCandidates];
+    int found = 0;
+    const FaceSet& live = buffer.live_faces();
+    const uint64_t size = live.size();
+    if (size == 0) return false;
+    for (int tries = 0; tries < 8 * wanted && found < wanted; ++tries) {
+        const uint64_t bits = rng.next();
+        const uint32_t f = live.at(static_cast<size_t>(((bits >> 32) * size) >> 32));
+        const uint32_t h = 3 * f + static_cast<uint32_t>((bits & 0xffff) % 3);
+        if (!collapse_eligible(buffer, h)) continue;
+        Candidate c{h, collapse_error(buffer, h)};
+        int i = found++;
+        while (i > 0 && best[i - 1].error > c.error) {
+            best[i] = best[i - 1];
+            --i;
+        }
+        best[i] = c;
+    }
+    for (int i = 0; i < found; ++i) {
+        if (i > 0 && best[i].h == best[i - 1].h) continue;
+        if (collapse_valid(buffer, best[i].h)) {
+            apply_collapse(buffer, best[i].h);
+            return true;
+        }
+    }
+    return false;
+}
+
+bool collapse_one_boundary_edge(HalfEdgeBuffer& buffer) {
+    constexpr int kKeep = 16;
+    struct Candidate {
+        uint32_t h;
+        double error;
+    };
+    Candidate best[kKeep];
+    int found = 0;
+    const FaceSet& live = buffer.live_faces();
+    for (size_t i = 0; i < live.size(); ++i) {
+        for (uint32_t k = 0; k < 3; ++k) {
+            const uint32_t h = 3 * live.at(i) + k;
+            if (!boundary_eligible(buffer, h)) continue;
+            Candidate c{h, collapse_error(buffer, h)};
+            if (found == kKeep && c.error >= best[kKeep - 1].error) continue;
+            int j = found < kKeep ? found++ : kKeep - 1;
+            while (j > 0 && best[j - 1].error > c.error) {
+                best[j] = best[j - 1];
+                --j;
+            }
+            best[j] = c;
+        }
+    }
+    for (int i = 0; i < found; ++i) {
+        if (collapse_valid(buffer, best[i].h)) {
+            apply_collapse(buffer, best[i].h);
+            return true;
+        }
+    }
+    return false;
+}
+
+}  // namespace meshstream::decimate

@@ -1,0 +1,51 @@
+// DECIMATE by multiple-choice half-edge collapses (Wu & Kobbelt 2003, §4.3): sample a few
+// random eligible half-edges, rate each collapse p→q by the quadric error (Q_p + Q_q)(q), and
+// perform the cheapest one that keeps the mesh valid. Eligibility encodes the boundary rules
+// of §4: half-edges from a boundary vertex (P_in, P_out, holes, non-manifold) never collapse;
+// half-edges into a P_in vertex never collapse (its quadric is incomplete); half-edges into a
+// P_out vertex may (q keeps its frozen position, so P_out does not move).
+#pragma once
+
+#include "decimate/halfedge_buffer.hpp"
+#include "decimate/random.hpp"
+
+#include <cstdint>
+
+namespace meshstream::decimate {
+
+// Topological eligibility of half-edge h = p→q from flags alone (cheap, used for sampling):
+// p interior (closed fan, not on P_in/P_out, manifold), q manifold and not on P_in.
+bool collapse_eligible(const HalfEdgeBuffer& buffer, uint32_t h);
+
+// The quadric error of collapsing h = p→q: (Q_p + Q_q) evaluated at q.
+double collapse_error(const HalfEdgeBuffer& buffer, uint32_t h);
+
+// Full validity of an eligible collapse p→q: p's fan is a single closed (or, for a boundary
+// half-edge, a single open) fan; the link condition holds (the common neighbours of p and q
+// are exactly the vertices opposite the edge), no tetrahedron collapses; no remaining face
+// around p flips or folds (normal turns by more than ~84°) or becomes degenerate.
+bool collapse_valid(HalfEdgeBuffer& buffer, uint32_t h);
+
+// Performs the half-edge collapse p→q: removes the one or two faces on the edge, re-links
+// their outer neighbours, moves p's corners to q and adds Q_p to Q_q, frees p.
+// Precondition: collapse_valid(buffer, h).
+void apply_collapse(HalfEdgeBuffer& buffer, uint32_t h);
+
+// True when moving vertex v from `from` to `to` (relative coordinates) flips, folds or
+// degenerates none of its faces other than `skip0`/`skip1` (kNoIndex: none). Faces that were
+// already degenerate are ignored.
+bool moves_keep_faces_valid(const HalfEdgeBuffer& buffer, uint32_t v, const double from[3],
+                            const double to[3], uint32_t skip0, uint32_t skip1);
+
+// DECIMATE(1) of §4.3: draws up to `candidates` eligible half-edges (at most 8·candidates
+// random draws), collapses the valid one with the smallest error. Returns false when no
+// candidate was found or none was valid (the caller decides whether that means "stalled").
+bool decimate_once(HalfEdgeBuffer& buffer, Rng& rng, int candidates);
+
+// A boundary collapse removing exactly one face, used once at the end of input to land on an
+// odd target count: the valid collapse p→q along a true-boundary half-edge (no partner, p not
+// on P_in or P_out) with the smallest error, found by a scan of the buffer. Returns false when
+// there is none (closed meshes have an even face count).
+bool collapse_one_boundary_edge(HalfEdgeBuffer& buffer);
+
+}  // namespace meshstream::decimate

@@ -1,0 +1,391 @@
+// The in-core half-edge buffer: pools, welding hash table, READ (Wu & Kobbelt 2003, §4.2)
+// and the bookkeeping of the boundary polygons P_in and P_out (§4).
+#include "decimate/halfedge_buffer.hpp"
+
+#include <bit>
+#include <cassert>
+#include <cmath>
+#include <cstring>
+
+namespace meshstream::decimate {
+
+FaceSet::FaceSet(size_t capacity)
+    : items_(new uint32_t[capacity]), where_(new uint32_t[capacity]) {}
+
+void FaceSet::insert(uint32_t f) {
+    if (where_[f] != kNoIndex) return;
+    where_[f] = static_cast<uint32_t>(size_);
+    items_[size_++] = f;
+}
+
+void FaceSet::erase(uint32_t f) {
+    const uint32_t i = where_[f];
+    if (i == kNoIndex) return;
+    const uint32_t last = items_[--size_];
+    items_[i] = last;
+    where_[last] = i;
+    where_[f] = kNoIndex;
+}
+
+namespace {
+
+size_t pow2_at_least(size_t n) { return std::bit_ceil(n < 16 ? size_t{16} : n); }
+
+uint64_t mix64(uint64_t x) {
+    x ^= x >> 33;
+    x *= 0xff51afd7ed558ccdull;
+    x ^= x >> 33;
+    x *= 0xc4ceb9fe1a85ec53ull;
+    x ^= x >> 33;
+    return x;
+}
+
+uint32_t float_key(float x) {
+    if (x == 0.0f) x = 0.0f;  // −0 welds with +0
+    uint32_t bits;
+    std::memcpy(&bits, &x, 4);
+    return bits;
+}
+
+}  // namespace
+
+HalfEdgeBuffer::HalfEdgeBuffer(size_t triangle_capacity, double weld_eps)
+    : face_capacity_(triangle_capacity),
+      // Worst case every in-core face owns three vertices; orphans left by forced writes
+      // are evicted when the pool runs short.
+      vertex_capacity_(3 * triangle_capacity + 3),
+      weld_eps_(weld_eps),
+      corner_vertex_(new uint32_t[3 * triangle_capacity]),
+      twin_(new uint32_t[3 * triangle_capacity]),
+      next_corner_(new uint32_t[3 * triangle_capacity]),
+      pin_count_(new uint8_t[triangle_capacity]),
+      touches_out_(new uint8_t[triangle_capacity]),
+      free_faces_(new uint32_t[triangle_capacity]),
+      live_(triangle_capacity),
+      interior_(triangle_capacity),
+      frontier_(triangle_capacity),
+      vertex_(new Vertex[vertex_capacity_]),
+      quadric_(new Quadric[vertex_capacity_]),
+      stamp_(new uint32_t[vertex_capacity_]),
+      free_vertices_(new uint32_t[vertex_capacity_]) {
+    assert(triangle_capacity >= 4 && triangle_capacity < (size_t{1} << 30));
+    const size_t slots = pow2_at_least(2 * vertex_capacity_);
+    hash_.reset(new uint32_t[slots]);
+    std::fill_n(hash_.get(), slots, kNoIndex);
+    hash_mask_ = slots - 1;
+    const size_t stub_slots = pow2_at_least(triangle_capacity / 8);
+    stubs_.reset(new Stub[stub_slots]);
+    for (size_t i = 0; i < stub_slots; ++i) stubs_[i].a = kNoIndex;
+    stub_mask_ = stub_slots - 1;
+}
+
+bool HalfEdgeBuffer::same_key(const float a[3], const float b[3]) const {
+    if (weld_eps_ == 0) {
+        return float_key(a[0]) == float_key(b[0]) && float_key(a[1]) == float_key(b[1]) &&
+               float_key(a[2]) == float_key(b[2]);
+    }
+    for (int i = 0; i < 3; ++i)
+        if (std::floor(double(a[i]) / weld_eps_) != std::floor(double(b[i]) / weld_eps_))
+            return false;
+    return true;
+}
+
+size_t HalfEdgeBuffer::hash_slot(const float p[3]) const {
+    uint64_t k[3];
+    for (int i = 0; i < 3; ++i)
+        k[i] = weld_eps_ == 0 ? float_key(p[i])
+                              : static_cast<uint64_t>(
+                                    static_cast<int64_t>(std::floor(double(p[i]) / weld_eps_)));
+    return mix64(k[0] * 0x9e3779b97f4a7c15ull ^ mix64(k[1] + 0x632be59bd9b4e019ull) ^
+                 (k[2] * 0xc2b2ae3d27d4eb4full)) &
+           hash_mask_;
+}
+
+uint32_t HalfEdgeBuffer::alloc_vertex() {
+    assert(vertex_used_ < vertex_capacity_);
+    uint32_t v;
+    if (free_vertex_stack_ > 0) {
+        v = free_vertices_[--free_vertex_stack_];  // generation already bumped by free_vertex
+    } else {
+        v = vertex_high_++;
+        vertex_[v].generation = 1;
+    }
+    ++vertex_used_;
+    if (vertex_used_ > vertex_used_peak_) vertex_used_peak_ = vertex_used_;
+    Vertex& x = vertex_[v];
+    x.first_corner = kNoIndex;
+    x.face_count = 0;
+    x.open_edges = 0;
+    x.flags = kAlive;
+    x.id = 0;
+    quadric_[v] = Quadric{};
+    stamp_[v] = 0;
+    return v;
+}
+
+void HalfEdgeBuffer::free_vertex(uint32_t v) {
+    Vertex& x = vertex_[v];
+    assert(x.face_count == 0 && (x.flags & kInHash) == 0);
+    x.flags = 0;
+    ++x.generation;
+    free_vertices_[free_vertex_stack_++] = v;
+    --vertex_used_;
+}
+
+uint32_t HalfEdgeBuffer::weld(const float p[3]) {
+    size_t slot = hash_slot(p);
+    for (;;) {
+        const uint32_t v = hash_[slot];
+        if (v == kNoIndex) break;
+        if (same_key(vertex_[v].pos, p)) {
+            Vertex& x = vertex_[v];
+            if (weld_eps_ != 0 && (x.flags & kWeldMerged) == 0 &&
+                (float_key(x.pos[0]) != float_key(p[0]) || float_key(x.pos[1]) != float_key(p[1]) ||
+                 float_key(x.pos[2]) != float_key(p[2]))) {
+                x.flags |= kWeldMerged;
+                ++vertices_merged_;
+            }
+            return v;
+        }
+        slot = (slot + 1) & hash_mask_;
+    }
+    const uint32_t v = alloc_vertex();
+    Vertex& x = vertex_[v];
+    // The first position seen in a weld cell represents the cell (less distortion than
+    // moving every vertex to the grid point).
+    for (int i = 0; i < 3; ++i) x.pos[i] = p[i] == 0.0f ? 0.0f : p[i];
+    x.flags |= kInHash;
+    hash_[slot] = v;
+    return v;
+}
+
+void HalfEdgeBuffer::hash_erase(uint32_t v) {
+    size_t slot = hash_slot(vertex_[v].pos);
+    while (hash_[slot] != v) {
+        assert(hash_[slot] != kNoIndex);
+        slot = (slot + 1) & hash_mask_;
+    }
+    // Backward-shift deletion keeps linear probing free of tombstones.
+    size_t hole = slot;
+    for (size_t i = (hole + 1) & hash_mask_;; i = (i + 1) & hash_mask_) {
+        const uint32_t w = hash_[i];
+        if (w == kNoIndex) break;
+        const size_t home = hash_slot(vertex_[w].pos);
+        // Move w into the hole when its home is not cyclically within (hole, i].
+        const bool home_in_range = hole <= i ? (home > hole && home <= i) : (home > hole || home <= i);
+        if (!home_in_range) {
+            hash_[hole] = w;
+            hole = i;
+        }
+    }
+    hash_[hole] = kNoIndex;
+}
+
+uint32_t HalfEdgeBuffer::find_half_edge(uint32_t from, uint32_t to) const {
+    for (uint32_t c = vertex_[from].first_corner; c != kNoIndex; c = next_corner_[c])
+        if (corner_vertex_[next_in_face(c)] == to) return c;
+    return kNoIndex;
+}
+
+void HalfEdgeBuffer::update_face_sets(uint32_t f) {
+    if (pin_count_[f] == 0) {
+        interior_.insert(f);
+        if (touches_out_[f]) frontier_.insert(f);
+        else frontier_.erase(f);
+    } else {
+        interior_.erase(f);
+        frontier_.erase(f);
+    }
+}
+
+bool HalfEdgeBuffer::take_written_stub(uint32_t a, uint32_t b) {
+    if (stub_count_ == 0) return false;
+    const uint32_t ga = vertex_[a].generation, gb = vertex_[b].generation;
+    size_t slot = mix64((uint64_t(a) << 32) ^ b) & stub_mask_;
+    for (;; slot = (slot + 1) & stub_mask_) {
+        Stub& s = stubs_[slot];
+        if (s.a == kNoIndex) return false;
+        if (s.a == a && s.b == b && s.gen_a == ga && s.gen_b == gb) break;
+    }
+    // Backward-shift deletion.
+    size_t hole = slot;
+    for (size_t i = (hole + 1) & stub_mask_;; i = (i + 1) & stub_mask_) {
+        const Stub& w = stubs_[i];
+        if (w.a == kNoIndex) break;
+        const size_t home = mix64((uint64_t(w.a) << 32) ^ w.b) & stub_mask_;
+        const bool home_in_range = hole <= i ? (home > hole && home <= i) : (home > hole || home <= i);
+        if (!home_in_range) {
+            stubs_[hole] = w;
+            hole = i;
+        }
+    }
+    stubs_[hole].a = kNoIndex;
+    --stub_count_;
+    return true;
+}
+
+void HalfEdgeBuffer::add_written_stub(uint32_t a, uint32_t b) {
+    // Keep the table at most half full; past that the edge simply stays open (its vertices
+    // then leave P_in only when finalized).
+    if (2 * (stub_count_ + 1) > stub_mask_ + 1) return;
+    size_t slot = mix64((uint64_t(a) << 32) ^ b) & stub_mask_;
+    while (stubs_[slot].a != kNoIndex) slot = (slot + 1) & stub_mask_;
+    stubs_[slot] = Stub{a, vertex_[a].generation, b, vertex_[b].generation};
+    ++stub_count_;
+}
+
+HalfEdgeBuffer::Added HalfEdgeBuffer::add_triangle(const float tri[9]) {
+    assert(!full() && free_vertex_count() >= 3);
+    Added added;
+    for (int k = 0; k < 3; ++k) added.vertex[k] = weld(tri + 3 * k);
+    const uint32_t* v = added.vertex;
+    if (!origin_set_) {
+        for (int i = 0; i < 3; ++i) origin_[i] = tri[i];
+        origin_set_ = true;
+    }
+    if (v[0] == v[1] || v[1] == v[2] || v[2] == v[0]) {
+        added.face = kNoIndex;
+        return added;
+    }
+    // Area-weighted plane quadric, added to all three corners (§4.2).
+    double p[3][3];
+    for (int k = 0; k < 3; ++k) position(v[k], p[k]);
+    const Quadric q = Quadric::from_triangle(p[0], p[1], p[2]);
+    for (int k = 0; k < 3; ++k) quadric_[v[k]] += q;
+
+    const uint32_t f = free_face_count_ > 0 ? free_faces_[--free_face_count_] : face_high_++;
+    live_.reset(f);
+    interior_.reset(f);
+    frontier_.reset(f);
+    // Connect each half-edge a→b to an open partner b→a. Anything else (a second a→b, or
+    // b→a already taken) makes the edge non-manifold: the new half-edge stays unconnected and
+    // both ends are frozen against collapses.
+    for (int k = 0; k < 3; ++k) {
+        const uint32_t a = v[k], b = v[(k + 1) % 3], h = 3 * f + k;
+        corner_vertex_[h] = a;
+        const uint32_t same = find_half_edge(a, b);
+        const uint32_t opposite = find_half_edge(b, a);
+        if (same == kNoIndex && opposite != kNoIndex && twin_[opposite] == kOpenEdge) {
+            twin_[h] = opposite;
+            twin_[opposite] = h;
+            --vertex_[a].open_edges;
+            --vertex_[b].open_edges;
+        } else if (same == kNoIndex && opposite == kNoIndex) {
+            if (take_written_stub(b, a)) {
+                twin_[h] = kWrittenEdge;  // the partner was force-written earlier
+                --vertex_[a].open_edges;
+                --vertex_[b].open_edges;
+            } else {
+                twin_[h] = kOpenEdge;
+                ++vertex_[a].open_edges;
+                ++vertex_[b].open_edges;
+            }
+        } else {
+            twin_[h] = kNonManifoldEdge;
+            vertex_[a].flags |= kNonManifold;
+            vertex_[b].flags |= kNonManifold;
+            ++nonmanifold_edges_;
+        }
+    }
+    bool out = false;
+    for (int k = 0; k < 3; ++k) {
+        Vertex& x = vertex_[v[k]];
+        next_corner_[3 * f + k] = x.first_corner;
+        x.first_corner = 3 * f + k;
+        ++x.face_count;
+        out |= (x.flags & kFrozen) != 0;
+    }
+    // Every corner was found through (or entered into) the hash table, so all three are on
+    // P_in; vertices whose fan just closed leave it.
+    pin_count_[f] = 3;
+    touches_out_[f] = out;
+    live_.insert(f);
+    for (int k = 0; k < 3; ++k)
+        if (vertex_[v[k]].open_edges == 0) finalize_vertex(v[k]);
+    update_face_sets(f);
+    added.face = f;
+    return added;
+}
+
+void HalfEdgeBuffer::finalize_vertex(uint32_t v) {
+    Vertex& x = vertex_[v];
+    if ((x.flags & kInHash) == 0) return;
+    hash_erase(v);
+    x.flags &= ~kInHash;
+    for (uint32_t c = x.first_corner; c != kNoIndex; c = next_corner_[c]) {
+        const uint32_t f = c / 3;
+        --pin_count_[f];
+        update_face_sets(f);
+    }
+    if (x.face_count == 0) free_vertex(v);
+}
+
+void HalfEdgeBuffer::freeze(uint32_t v, uint64_t id) {
+    Vertex& x = vertex_[v];
+    assert((x.flags & kFrozen) == 0);
+    x.flags |= kFrozen;
+    x.id = id;
+    for (uint32_t c = x.first_corner; c != kNoIndex; c = next_corner_[c]) {
+        const uint32_t f = c / 3;
+        if (!touches_out_[f]) {
+            touches_out_[f] = 1;
+            update_face_sets(f);
+        }
+    }
+}
+
+void HalfEdgeBuffer::detach_face(uint32_t f) {
+    for (int k = 0; k < 3; ++k) {
+        const uint32_t c = 3 * f + k;
+        Vertex& x = vertex_[corner_vertex_[c]];
+        uint32_t* link = &x.first_corner;
+        while (*link != c) link = &next_corner_[*link];
+        *link = next_corner_[c];
+        --x.face_count;
+    }
+    live_.erase(f);
+    interior_.erase(f);
+    frontier_.erase(f);
+    free_faces_[free_face_count_++] = f;
+}
+
+void HalfEdgeBuffer::move_corners(uint32_t p, uint32_t q) {
+    Vertex& from = vertex_[p];
+    Vertex& to = vertex_[q];
+    const bool q_frozen = (to.flags & kFrozen) != 0;
+    uint32_t c = from.first_corner;
+    while (c != kNoIndex) {
+        const uint32_t next = next_corner_[c];
+        corner_vertex_[c] = q;
+        next_corner_[c] = to.first_corner;
+        to.first_corner = c;
+        ++to.face_count;
+        const uint32_t f = c / 3;
+        if (q_frozen && !touches_out_[f]) {
+            touches_out_[f] = 1;
+            update_face_sets(f);
+        }
+        c = next;
+    }
+    from.first_corner = kNoIndex;
+    from.face_count = 0;
+}
+
+void HalfEdgeBuffer::finalize_all() {
+    for (uint32_t v = 0; v < vertex_high_; ++v)
+        if ((vertex_[v].flags & (kAlive | kInHash)) == (kAlive | kInHash)) finalize_vertex(v);
+}
+
+size_t HalfEdgeBuffer::evict_orphans() {
+    size_t evicted = 0;
+    for (uint32_t v = 0; v < vertex_high_; ++v) {
+        const Vertex& x = vertex_[v];
+        if ((x.flags & (kAlive | kInHash)) == (kAlive | kInHash) && x.face_count == 0) {
+            finalize_vertex(v);
+            ++evicted;
+        }
+    }
+    return evicted;
+}
+
+}  // namespace meshstream::decimate

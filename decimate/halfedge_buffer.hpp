@@ -1,0 +1,195 @@
+// The in-core portion of the mesh (Wu & Kobbelt 2003, §4 and §4.2): a half-edge mesh over
+// fixed-capacity pools, allocated once for `--buffer N` triangles and reused for the whole
+// stream. Half-edge h = 3·f + k runs from corner k of face f to corner (k+1) mod 3; its twin
+// is the opposite half-edge of the neighbouring face or one of three markers:
+//   kOpenEdge        no partner yet: the edge lies on P_in (towards unread input) or on a hole,
+//   kWrittenEdge     the partner was written (the edge lies on P_out),
+//   kNonManifoldEdge a third face on an edge, a duplicate or an orientation conflict: frozen.
+// Every vertex also keeps a singly linked list of its corners, so its full neighbourhood is
+// known even where the input is not manifold (the link condition needs that).
+//
+// READ (§4.2) welds vertices on exact position (or on a grid of `weld_eps`) through an
+// open-addressing hash table that holds only vertices still open towards unread input (P_in):
+// a vertex leaves the table once every incident edge has a partner, or when it is finalized
+// (end of input, sorted sweep, eviction). Each incoming triangle adds its area-weighted plane
+// quadric to its three vertices.
+//
+// Two dense index sets serve the writer (§4.4): faces touching no P_in vertex ("interior"),
+// and the subset of those touching P_out (a frozen, already written vertex).
+//
+// Memory bound: for capacity N triangles, about 52·N bytes of faces, 3·N vertices of
+// 40 + 80 (quadric) + 12 bytes, and a 4-byte hash slot per 1/2 vertex: about 470·N bytes
+// reserved, of which only the touched part becomes resident (pools hand out the most recently
+// freed slot first).
+#pragma once
+
+#include "decimate/quadric.hpp"
+
+#include <cstddef>
+#include <algorithm>
+#include <cstdint>
+#include <memory>
+
+namespace meshstream::decimate {
+
+inline constexpr uint32_t kNoIndex = 0xFFFFFFFFu;
+inline constexpr uint32_t kOpenEdge = 0xFFFFFFFFu;
+inline constexpr uint32_t kWrittenEdge = 0xFFFFFFFEu;
+inline constexpr uint32_t kNonManifoldEdge = 0xFFFFFFFDu;
+// True when `twin` names a real half-edge rather than one of the markers.
+inline bool is_half_edge(uint32_t twin) { return twin < kNonManifoldEdge; }
+inline uint32_t next_in_face(uint32_t h) { return h % 3 == 2 ? h - 2 : h + 1; }
+inline uint32_t prev_in_face(uint32_t h) { return h % 3 == 0 ? h + 2 : h - 1; }
+
+// Vertex flags.
+inline constexpr uint8_t kInHash = 1;        // open towards unread input: on P_in
+inline constexpr uint8_t kFrozen = 2;        // written (on P_out): position final, id assigned
+inline constexpr uint8_t kNonManifold = 4;   // touches a non-manifold edge: never collapsed
+inline constexpr uint8_t kWeldMerged = 8;    // absorbed another input position (--weld)
+inline constexpr uint8_t kAlive = 16;
+
+struct Vertex {
+    float pos[3];           // input position, moved once when written (§4.4)
+    uint32_t first_corner;  // head of the corner list (kNoIndex when no face)
+    uint32_t face_count;
+    uint32_t open_edges;    // incident half-edges without partner (kOpenEdge), also written ones
+    uint32_t generation;    // bumped at every allocation (stale references detect reuse)
+    uint8_t flags;
+    uint64_t id;            // output vertex id, valid once kFrozen
+};
+
+// A set of face indices with O(1) insert, erase and uniform sampling.
+class FaceSet {
+public:
+    explicit FaceSet(size_t capacity);
+    bool contains(uint32_t f) const { return where_[f] != kNoIndex; }
+    void insert(uint32_t f);
+    void erase(uint32_t f);
+    // Call when slot f is (re)allocated: marks it absent.
+    void reset(uint32_t f) { where_[f] = kNoIndex; }
+    size_t size() const { return size_; }
+    uint32_t at(size_t i) const { return items_[i]; }
+
+private:
+    std::unique_ptr<uint32_t[]> items_, where_;
+    size_t size_ = 0;
+};
+
+class HalfEdgeBuffer {
+public:
+    // `triangle_capacity` ≥ 4. `weld_eps` = 0: weld on exact float position (−0 equals +0);
+    // > 0: weld positions falling into the same cell of a grid of that size.
+    HalfEdgeBuffer(size_t triangle_capacity, double weld_eps);
+
+    size_t face_capacity() const { return face_capacity_; }
+    size_t face_count() const { return live_.size(); }
+    bool full() const { return live_.size() == face_capacity_; }
+    // Free vertex slots; add_triangle needs 3.
+    size_t free_vertex_count() const { return vertex_capacity_ - vertex_used_; }
+
+    struct Added {
+        uint32_t face;     // kNoIndex when degenerate (two corners welded to one vertex)
+        uint32_t vertex[3];
+    };
+    // READ(1) of §4.2: welds the corners, accumulates quadrics, connects the new face to
+    // its in-core neighbours. Preconditions: !full(), free_vertex_count() ≥ 3. A degenerate
+    // triangle is not inserted (its vertices are, so the caller can pass it through).
+    Added add_triangle(const float tri[9]);
+
+    // The vertex leaves P_in (no more input will reach it): removed from the hash table; a
+    // vertex without faces is freed.
+    void finalize_vertex(uint32_t v);
+    // Marks the vertex written (P_out) with output id `id`.
+    void freeze(uint32_t v, uint64_t id);
+    // Removes face f from the vertex lists and sets and frees it. Twins and open-edge counts
+    // are the caller's business. Vertices left without faces are not freed here.
+    void detach_face(uint32_t f);
+    // Re-points every corner of p to q (the vertex part of a half-edge collapse p→q).
+    void move_corners(uint32_t p, uint32_t q);
+    void free_vertex(uint32_t v);
+    // Records that the written face's half-edge a→b had no partner, so that the matching
+    // half-edge b→a arriving later is connected to P_out instead of staying open forever.
+    void add_written_stub(uint32_t a, uint32_t b);
+    // Frees vertices that are open towards input but have no face left (left behind by
+    // forced writes); returns how many.
+    size_t evict_orphans();
+    // End of input: every vertex still on P_in becomes true boundary (finalize_vertex).
+    void finalize_all();
+
+    // Accessors.
+    uint32_t corner_vertex(uint32_t h) const { return corner_vertex_[h]; }
+    uint32_t twin(uint32_t h) const { return twin_[h]; }
+    void set_twin(uint32_t h, uint32_t t) { twin_[h] = t; }
+    uint32_t next_corner(uint32_t c) const { return next_corner_[c]; }
+    Vertex& vertex(uint32_t v) { return vertex_[v]; }
+    const Vertex& vertex(uint32_t v) const { return vertex_[v]; }
+    Quadric& quadric(uint32_t v) { return quadric_[v]; }
+    const Quadric& quadric(uint32_t v) const { return quadric_[v]; }
+    // Position relative to origin() in double (what quadrics are expressed in).
+    void position(uint32_t v, double out[3]) const {
+        for (int i = 0; i < 3; ++i) out[i] = double(vertex_[v].pos[i]) - origin_[i];
+    }
+    void set_position(uint32_t v, const double rel[3]) {
+        for (int i = 0; i < 3; ++i) vertex_[v].pos[i] = float(rel[i] + origin_[i]);
+    }
+    const FaceSet& live_faces() const { return live_; }
+    const FaceSet& interior_faces() const { return interior_; }  // no P_in vertex
+    const FaceSet& frontier_faces() const { return frontier_; }  // interior and touching P_out
+    // A fresh mark value for stamp(): vertices stamped with it are "in the current set".
+    uint32_t new_stamp() {
+        if (++stamp_counter_ == 0) {  // wrapped: old marks could alias
+            std::fill_n(stamp_.get(), vertex_high_, 0u);
+            stamp_counter_ = 1;
+        }
+        return stamp_counter_;
+    }
+    uint32_t& stamp(uint32_t v) { return stamp_[v]; }
+
+    // Running counts for Stats.
+    uint64_t vertices_merged() const { return vertices_merged_; }
+    uint64_t nonmanifold_edges() const { return nonmanifold_edges_; }
+    size_t peak_vertices() const { return vertex_used_peak_; }
+
+private:
+    uint32_t weld(const float p[3]);
+    uint32_t alloc_vertex();
+    uint32_t find_half_edge(uint32_t from, uint32_t to) const;
+    void update_face_sets(uint32_t f);
+    void hash_erase(uint32_t v);
+    size_t hash_slot(const float p[3]) const;
+    bool same_key(const float a[3], const float b[3]) const;
+    bool take_written_stub(uint32_t a, uint32_t b);
+
+    size_t face_capacity_, vertex_capacity_;
+    double weld_eps_;
+    bool origin_set_ = false;
+    double origin_[3] = {0, 0, 0};
+
+    std::unique_ptr<uint32_t[]> corner_vertex_, twin_, next_corner_;
+    std::unique_ptr<uint8_t[]> pin_count_;    // per face: vertices on P_in
+    std::unique_ptr<uint8_t[]> touches_out_;  // per face: has a frozen vertex
+    std::unique_ptr<uint32_t[]> free_faces_;
+    size_t free_face_count_ = 0;
+    uint32_t face_high_ = 0;
+    FaceSet live_, interior_, frontier_;
+
+    std::unique_ptr<Vertex[]> vertex_;
+    std::unique_ptr<Quadric[]> quadric_;
+    std::unique_ptr<uint32_t[]> stamp_;
+    std::unique_ptr<uint32_t[]> free_vertices_;
+    size_t free_vertex_stack_ = 0;
+    uint32_t vertex_high_ = 0;
+    size_t vertex_used_ = 0, vertex_used_peak_ = 0;
+    uint32_t stamp_counter_ = 0;
+
+    std::unique_ptr<uint32_t[]> hash_;  // vertex index or kNoIndex; linear probing
+    size_t hash_mask_;
+
+    struct Stub { uint32_t a, gen_a, b, gen_b; };
+    std::unique_ptr<Stub[]> stubs_;  // a == kNoIndex: empty; linear probing
+    size_t stub_mask_, stub_count_ = 0;
+
+    uint64_t vertices_merged_ = 0, nonmanifold_edges_ = 0;
+};
+
+}  // namespace meshstream::decimate

@@ -1,0 +1,62 @@
+// The READ / DECIMATE / WRITE schedule of Wu & Kobbelt 2003, §4.1, in closed form.
+//
+// Each triangle written statistically stands for 1/p input triangles, so the N_current
+// in-core triangles stand for N_in − N_out/p input triangles and the in-core resolution is
+// R = N_current / (N_in − N_out/p). WRITE is allowed only once R has come down to p, i.e.
+// once N_current ≤ p·N_in − N_out (the "budget"); writing k triangles lowers N_current and
+// the budget alike, so it keeps R. With hysteresis the buffer is only worked on when it is
+// full:
+//   decimate to max(N_max/2, budget), then write down to N_max/2.
+// While the budget is below N_max/2 this is the initialization loop (READ N_max/2,
+// DECIMATE N_max/4, no writes, R falls towards p); afterwards it is the main loop (READ
+// N_max/2, DECIMATE (1−p)·N_max/4, WRITE p·N_max/2). The final loop decimates to
+// round(p·N_in) − N_out and writes everything. None of it needs N_in in advance.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+
+namespace meshstream::decimate {
+
+// Triangles the in-core portion may hold at resolution p: p·N_in − N_out (may be negative
+// when earlier writes were forced).
+inline double resolution_budget(double ratio, uint64_t triangles_in, uint64_t triangles_out) {
+    return ratio * double(triangles_in) - double(triangles_out);
+}
+
+// The in-core resolution level R of §4.1 (infinity before anything stands for input).
+inline double resolution_level(double ratio, size_t current, uint64_t triangles_in,
+                               uint64_t triangles_out) {
+    const double represented = double(triangles_in) - double(triangles_out) / ratio;
+    return represented > 0 ? double(current) / represented : INFINITY;
+}
+
+struct RoomPlan {
+    size_t decimate_to;  // collapse until the buffer holds at most this many triangles
+    size_t write_to;     // then write until it holds at most this many
+};
+
+// What to do when the buffer of `capacity` triangles is full (hysteresis: refill to 100 %,
+// work down to 50 %).
+inline RoomPlan plan_full_buffer(size_t capacity, double ratio, uint64_t triangles_in,
+                                 uint64_t triangles_out) {
+    const size_t half = capacity / 2;
+    const double budget = resolution_budget(ratio, triangles_in, triangles_out);
+    const size_t decimate_to =
+        budget <= double(half) ? half : std::min(capacity, static_cast<size_t>(std::ceil(budget)));
+    return {decimate_to, half};
+}
+
+// The exact output size: round(p·N_in), or the explicit target.
+inline uint64_t final_triangle_count(double ratio, uint64_t triangles_in) {
+    return static_cast<uint64_t>(std::llround(ratio * double(triangles_in)));
+}
+
+// In-core triangles to keep for the final WRITE so that the output totals `target`.
+inline size_t final_budget(uint64_t target, uint64_t triangles_out) {
+    return target > triangles_out ? static_cast<size_t>(target - triangles_out) : 0;
+}
+
+}  // namespace meshstream::decimate

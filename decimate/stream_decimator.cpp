@@ -1,0 +1,168 @@
+// The stream decimator: the schedule of Wu & Kobbelt 2003, §4.1 driven triangle by
+// triangle, with READ (§4.2), DECIMATE (§4.3) and WRITE (§4.4) from their own files, plus
+// the sorted-sweep finalization of hole boundaries and forced writes for stuck buffers.
+#include "decimate/stream_decimator.hpp"
+
+#include "decimate/schedule.hpp"
+
+#include <algorithm>
+#include <cassert>
+
+namespace meshstream::decimate {
+namespace {
+
+// Consecutive DECIMATE(1) attempts without a valid candidate before the buffer counts as
+// stalled (every draw of 8·candidates half-edges found nothing collapsible).
+constexpr int kStallAttempts = 16;
+
+double choose_ratio(const Options& options, std::optional<uint64_t> input_count) {
+    if (!options.target) return options.ratio;
+    assert(input_count.has_value() && "Options::target needs the input triangle count");
+    if (*input_count == 0) return 1.0;
+    return std::min(1.0, double(*options.target) / double(*input_count));
+}
+
+}  // namespace
+
+StreamDecimator::StreamDecimator(const Options& options, std::optional<uint64_t> input_triangle_count)
+    : options_(options),
+      ratio_(choose_ratio(options, input_triangle_count)),
+      buffer_(options.buffer_triangles, options.weld_eps),
+      rng_(options.seed),
+      output_(options.output_chunk_triangles) {
+    assert(ratio_ > 0 && ratio_ <= 1);
+    assert(options.buffer_triangles >= 16);
+    assert(options.candidates >= 1 && options.candidates <= 64);
+    assert(!options.sorted_axis || (*options.sorted_axis >= 0 && *options.sorted_axis <= 2));
+    stats_.buffer_capacity = options.buffer_triangles;
+    if (options.sorted_axis) {
+        sweep_capacity_ = 3 * options.buffer_triangles + 3;
+        sweep_queue_.reset(new SweepEntry[sweep_capacity_]);
+    }
+}
+
+void StreamDecimator::push(const io::TriangleChunk& in, const Emit& out) {
+    assert(!finished_);
+    const std::span<const float> xyz = in.xyz();
+    for (size_t i = 0; i < in.size(); ++i) read_triangle(&xyz[9 * i], out);
+}
+
+void StreamDecimator::read_triangle(const float tri[9], const Emit& out) {
+    if (buffer_.full() || buffer_.free_vertex_count() < 3) make_room(out);
+    if (options_.sorted_axis) {
+        const int axis = *options_.sorted_axis;
+        const float lo = std::min({tri[axis], tri[3 + axis], tri[6 + axis]});
+        const float hi = std::max({tri[axis], tri[3 + axis], tri[6 + axis]});
+        sweep_margin_ = std::max(sweep_margin_, double(hi) - double(lo));
+        sweep_front_ = std::max(sweep_front_, double(lo));
+    }
+    const HalfEdgeBuffer::Added added = buffer_.add_triangle(tri);
+    ++stats_.triangles_in;
+    if (added.face == kNoIndex) {
+        pass_through(buffer_, added.vertex, next_id_, output_, out);
+        ++stats_.degenerate_passed;
+        return;
+    }
+    stats_.peak_buffer_triangles = std::max(stats_.peak_buffer_triangles, buffer_.face_count());
+    if (options_.sorted_axis) {
+        // New P_in vertices join the sweep queue in reading order, which on sorted input is
+        // (nearly) coordinate order.
+        for (uint32_t v : added.vertex) {
+            const Vertex& x = buffer_.vertex(v);
+            if (x.face_count != 1 || (x.flags & kInHash) == 0) continue;
+            if (sweep_size_ == sweep_capacity_) {  // full: drop the oldest entry
+                sweep_head_ = (sweep_head_ + 1) % sweep_capacity_;
+                --sweep_size_;
+            }
+            sweep_queue_[(sweep_head_ + sweep_size_++) % sweep_capacity_] =
+                SweepEntry{x.pos[*options_.sorted_axis], v, x.generation};
+        }
+    }
+}
+
+void StreamDecimator::sweep(double front) {
+    // A future triangle has a sort key ≥ the front (every key lies within its triangle, and
+    // the front is the largest triangle minimum read so far), so it can only reach vertices
+    // within one triangle extent behind the front. Twice the largest extent seen leaves room
+    // for somewhat larger triangles to come. Vertices further behind that are still open are
+    // true boundary (holes): finalizing them lets their triangles be decimated and written.
+    const double threshold = front - 2 * sweep_margin_;
+    while (sweep_size_ > 0) {
+        const SweepEntry& e = sweep_queue_[sweep_head_];
+        if (!(double(e.coordinate) < threshold)) break;
+        const Vertex& x = buffer_.vertex(e.vertex);
+        if ((x.flags & (kAlive | kInHash)) == (kAlive | kInHash) && x.generation == e.generation) {
+            buffer_.finalize_vertex(e.vertex);
+            ++stats_.vertices_finalized_by_sweep;
+        }
+        sweep_head_ = (sweep_head_ + 1) % sweep_capacity_;
+        --sweep_size_;
+    }
+}
+
+void StreamDecimator::write_one(const Emit& out, bool allow_forced) {
+    uint32_t f = pick_write(buffer_, rng_, options_.candidates);
+    if (f == kNoIndex) {
+        // Every in-core triangle touches P_in: the input is not in a streaming-friendly order
+        // (or holes pile up). Write one anyway rather than fail.
+        assert(allow_forced);
+        (void)allow_forced;
+        const FaceSet& live = buffer_.live_faces();
+        f = live.at(static_cast<size_t>(((rng_.next() >> 32) * live.size()) >> 32));
+        ++stats_.forced_writes;
+    }
+    stats_.vertices_moved += write_face(buffer_, f, next_id_, output_, out);
+}
+
+void StreamDecimator::make_room(const Emit& out) {
+    if (options_.sorted_axis) sweep(sweep_front_);
+    const RoomPlan plan = plan_full_buffer(buffer_.face_capacity(), ratio_, stats_.triangles_in,
+                                           output_.triangle_count());
+    int failures = 0;
+    while (buffer_.face_count() > plan.decimate_to) {
+        if (decimate_once(buffer_, rng_, options_.candidates)) {
+            ++stats_.collapses;
+            failures = 0;
+        } else if (++failures >= kStallAttempts) {
+            break;
+        }
+    }
+    while (buffer_.face_count() > plan.write_to) {
+        const double budget =
+            resolution_budget(ratio_, stats_.triangles_in, output_.triangle_count());
+        if (double(buffer_.face_count()) > budget + 0.5) ++stats_.premature_writes;
+        write_one(out, true);
+    }
+    if (buffer_.free_vertex_count() < 3) stats_.orphans_evicted += buffer_.evict_orphans();
+    assert(!buffer_.full() && buffer_.free_vertex_count() >= 3);
+}
+
+void StreamDecimator::finish(const Emit& out) {
+    assert(!finished_);
+    finished_ = true;
+    // No more input: whatever is still open is true boundary.
+    buffer_.finalize_all();
+    const uint64_t target = options_.target ? *options_.target
+                                            : final_triangle_count(ratio_, stats_.triangles_in);
+    stats_.target_triangles = target;
+    const size_t budget = final_budget(target, output_.triangle_count());
+    int failures = 0;
+    while (buffer_.face_count() >= budget + 2) {
+        if (decimate_once(buffer_, rng_, options_.candidates)) {
+            ++stats_.collapses;
+            failures = 0;
+        } else if (++failures >= kStallAttempts) {
+            break;
+        }
+    }
+    // Collapses remove two faces; an odd remainder needs one boundary collapse.
+    if (buffer_.face_count() == budget + 1 && collapse_one_boundary_edge(buffer_)) ++stats_.collapses;
+    while (buffer_.face_count() > 0) write_one(out, false);
+    output_.flush(out);
+    stats_.triangles_out = output_.triangle_count();
+    stats_.peak_vertices = buffer_.peak_vertices();
+    stats_.vertices_merged = buffer_.vertices_merged();
+    stats_.nonmanifold_edges = buffer_.nonmanifold_edges();
+}
+
+}  // namespace meshstream::decimate

@@ -1,0 +1,99 @@
+// meshstream's stream decimator: Wu & Kobbelt, "A Stream Algorithm for the Decimation of
+// Massive Meshes", Graphics Interface 2003. Triangle chunks go in, decimated triangle chunks
+// (with stable vertex ids) come out while the input is still being read; memory is fixed by
+// the buffer capacity, independent of input and output size. No file I/O here.
+//
+// Beyond the paper: non-manifold, duplicate, mis-oriented and degenerate input is frozen and
+// passed through; on input sorted along an axis, hole boundaries the sweep has left behind
+// are finalized so that scans full of holes decimate in a small buffer; when the buffer is
+// full of triangles that can be neither decimated nor written, triangles are force-written
+// and counted instead of failing.
+#pragma once
+
+#include "decimate/collapse.hpp"
+#include "decimate/halfedge_buffer.hpp"
+#include "decimate/random.hpp"
+#include "decimate/writing.hpp"
+#include "io/chunk.hpp"
+
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <optional>
+
+namespace meshstream::decimate {
+
+struct Options {
+    double ratio = 0.1;                 // p in (0, 1]: output = round(p · input)
+    std::optional<uint64_t> target;     // exact output triangle count instead of ratio
+    size_t buffer_triangles = 400000;   // N_max, in-core capacity (≥ 16)
+    int candidates = 8;                 // multiple-choice sample size (1..64)
+    uint64_t seed = 1;
+    double weld_eps = 0;                // 0: exact welding; > 0: grid cell size (absolute)
+    std::optional<int> sorted_axis;     // 0,1,2 when the input is sorted ascending on it
+    size_t output_chunk_triangles = io::TriangleChunk::kDefaultCapacity;
+};
+
+struct Stats {
+    uint64_t triangles_in = 0;
+    uint64_t triangles_out = 0;
+    uint64_t target_triangles = 0;       // round(p·N_in) or --target (known at finish)
+    size_t buffer_capacity = 0;
+    size_t peak_buffer_triangles = 0;
+    size_t peak_vertices = 0;
+    uint64_t collapses = 0;
+    uint64_t forced_writes = 0;          // written while touching P_in (buffer stuck)
+    uint64_t premature_writes = 0;       // written before R reached p (decimation stalled)
+    uint64_t degenerate_passed = 0;      // corners welded together: passed through
+    uint64_t nonmanifold_edges = 0;      // half-edges frozen as non-manifold
+    uint64_t vertices_merged = 0;        // vertices that absorbed other positions (--weld)
+    uint64_t vertices_finalized_by_sweep = 0;
+    uint64_t orphans_evicted = 0;
+    uint64_t vertices_moved = 0;         // moved to their quadric optimum when written
+};
+
+class StreamDecimator {
+public:
+    // `input_triangle_count` is the reader's count when known; Options::target needs it
+    // (asserted). Allocates every buffer once; see halfedge_buffer.hpp for the bound
+    // (about 470 bytes reserved per buffer triangle).
+    StreamDecimator(const Options& options, std::optional<uint64_t> input_triangle_count);
+
+    // Reads every triangle of `in` (positions only; other channels are ignored), decimating
+    // and writing to `out` as the schedule demands.
+    void push(const io::TriangleChunk& in, const Emit& out);
+    // End of input: decimates to the exact target, writes the rest, flushes `out`.
+    // Call once; push() must not follow.
+    void finish(const Emit& out);
+
+    const Stats& stats() const { return stats_; }
+    // The ratio in use (target / input count with Options::target).
+    double ratio() const { return ratio_; }
+
+private:
+    void read_triangle(const float tri[9], const Emit& out);
+    void make_room(const Emit& out);
+    void write_one(const Emit& out, bool allow_forced);
+    void sweep(double front);
+
+    Options options_;
+    double ratio_;
+    HalfEdgeBuffer buffer_;
+    Rng rng_;
+    TriangleOutput output_;
+    uint64_t next_id_ = 0;
+    Stats stats_;
+    bool finished_ = false;
+
+    // Sorted input (--sorted-axis): FIFO of vertices entering P_in with their coordinate.
+    struct SweepEntry {
+        float coordinate;
+        uint32_t vertex, generation;
+    };
+    std::unique_ptr<SweepEntry[]> sweep_queue_;
+    size_t sweep_capacity_ = 0, sweep_head_ = 0, sweep_size_ = 0;
+    double sweep_front_ = -INFINITY, sweep_margin_ = 0;
+};
+
+}  // namespace meshstream::decimate

@@ -1,0 +1,135 @@
+// Multiple-choice writing and write-time vertex placement (Wu & Kobbelt 2003, §4.4).
+#include "decimate/writing.hpp"
+
+#include "decimate/collapse.hpp"
+
+#include <algorithm>
+
+namespace meshstream::decimate {
+
+TriangleOutput::TriangleOutput(size_t chunk_triangles)
+    : chunk_(chunk_triangles, io::Channels{.vertex_id = true}) {}
+
+void TriangleOutput::emit(const float xyz[9], const uint64_t ids[3], const Emit& out) {
+    float* slot = chunk_.push_slot();
+    std::copy(xyz, xyz + 9, slot);
+    uint64_t* id = chunk_.id_at(chunk_.size() - 1);
+    id[0] = ids[0]; id[1] = ids[1]; id[2] = ids[2];
+    ++triangle_count_;
+    if (chunk_.full()) flush(out);
+}
+
+void TriangleOutput::flush(const Emit& out) {
+    if (chunk_.empty()) return;
+    out(chunk_);
+    chunk_.clear();
+}
+
+uint32_t pick_write(const HalfEdgeBuffer& buffer, Rng& rng, int candidates) {
+    // Preferring faces on P_out keeps the number of P_out components from growing (§4.4,
+    // Fig. 3): random interior faces would punch small holes all over the in-core mesh.
+    const FaceSet& set = buffer.frontier_faces().size() > 0 ? buffer.frontier_faces()
+                                                            : buffer.interior_faces();
+    const uint64_t size = set.size();
+    if (size == 0) return kNoIndex;
+    uint32_t best = kNoIndex;
+    double best_error = -1;
+    for (int i = 0; i < std::max(candidates, 1); ++i) {
+        const uint32_t f = set.at(static_cast<size_t>(((rng.next() >> 32) * size) >> 32));
+        Quadric q;
+        double centre[3] = {0, 0, 0};
+        for (int k = 0; k < 3; ++k) {
+            const uint32_t v = buffer.corner_vertex(3 * f + k);
+            q += buffer.quadric(v);
+            double x[3];
+            buffer.position(v, x);
+            for (int j = 0; j < 3; ++j) centre[j] += x[j] / 3;
+        }
+        const double error = q.error(centre);
+        if (error > best_error) {
+            best_error = error;
+            best = f;
+        }
+    }
+    return best;
+}
+
+bool place_vertex(HalfEdgeBuffer& buffer, uint32_t v) {
+    const Vertex& x = buffer.vertex(v);
+    if ((x.flags & (kInHash | kNonManifold | kFrozen)) != 0 || x.open_edges != 0) return false;
+    const Quadric& q = buffer.quadric(v);
+    double old[3], best[3];
+    buffer.position(v, old);
+    if (!q.minimum(best)) return false;
+    double reach2 = 0;
+    for (uint32_t c = x.first_corner; c != kNoIndex; c = buffer.next_corner(c)) {
+        double w[3];
+        buffer.position(buffer.corner_vertex(next_in_face(c)), w);
+        const double d2 = (w[0] - old[0]) * (w[0] - old[0]) + (w[1] - old[1]) * (w[1] - old[1]) +
+                          (w[2] - old[2]) * (w[2] - old[2]);
+        reach2 = std::max(reach2, d2);
+    }
+    const double move2 = (best[0] - old[0]) * (best[0] - old[0]) +
+                         (best[1] - old[1]) * (best[1] - old[1]) +
+                         (best[2] - old[2]) * (best[2] - old[2]);
+    if (move2 > reach2) return false;
+    if (!(q.error(best) <= q.error(old))) return false;
+    if (!moves_keep_faces_valid(buffer, v, old, best, kNoIndex, kNoIndex)) return false;
+    buffer.set_position(v, best);
+    return true;
+}
+
+int write_face(HalfEdgeBuffer& buffer, uint32_t f, uint64_t& next_id, TriangleOutput& output,
+                const Emit& out) {
+    float xyz[9];
+    uint64_t ids[3];
+    uint32_t v[3];
+    int moved = 0;
+    for (int k = 0; k < 3; ++k) {
+        v[k] = buffer.corner_vertex(3 * f + k);
+        if ((buffer.vertex(v[k]).flags & kFrozen) == 0) {
+            moved += place_vertex(buffer, v[k]) ? 1 : 0;
+            buffer.freeze(v[k], next_id++);
+        }
+    }
+    for (int k = 0; k < 3; ++k) {
+        const Vertex& x = buffer.vertex(v[k]);
+        xyz[3 * k] = x.pos[0]; xyz[3 * k + 1] = x.pos[1]; xyz[3 * k + 2] = x.pos[2];
+        ids[k] = x.id;
+    }
+    output.emit(xyz, ids, out);
+    for (int k = 0; k < 3; ++k) {
+        const uint32_t h = 3 * f + k;
+        const uint32_t t = buffer.twin(h);
+        if (is_half_edge(t)) {
+            buffer.set_twin(t, kWrittenEdge);  // the neighbour now borders P_out
+        } else if (t == kOpenEdge &&
+                   ((buffer.vertex(v[k]).flags | buffer.vertex(v[(k + 1) % 3]).flags) & kInHash)) {
+            // A forced write of a face still open towards the input: remember the edge so the
+            // partner arriving later closes it against P_out.
+            buffer.add_written_stub(v[k], v[(k + 1) % 3]);
+        }
+    }
+    buffer.detach_face(f);
+    for (int k = 0; k < 3; ++k) {
+        const Vertex& x = buffer.vertex(v[k]);
+        if ((x.flags & kAlive) && x.face_count == 0 && (x.flags & kInHash) == 0)
+            buffer.free_vertex(v[k]);
+    }
+    return moved;
+}
+
+void pass_through(HalfEdgeBuffer& buffer, const uint32_t vertex[3], uint64_t& next_id,
+                  TriangleOutput& output, const Emit& out) {
+    float xyz[9];
+    uint64_t ids[3];
+    for (int k = 0; k < 3; ++k) {
+        const Vertex& x = buffer.vertex(vertex[k]);
+        if ((x.flags & kFrozen) == 0) buffer.freeze(vertex[k], next_id++);
+        xyz[3 * k] = x.pos[0]; xyz[3 * k + 1] = x.pos[1]; xyz[3 * k + 2] = x.pos[2];
+        ids[k] = x.id;
+    }
+    output.emit(xyz, ids, out);
+}
+
+}  // namespace meshstream::decimate

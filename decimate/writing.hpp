@@ -1,0 +1,57 @@
+// WRITE by multiple-choice selection (Wu & Kobbelt 2003, §4.4): candidates are the in-core
+// triangles adjacent to P_out and not to P_in (all faces without a P_in vertex when none
+// qualify); the one with the largest error, (Q_a + Q_b + Q_c) at its centre, is written.
+// At write time each vertex not yet written moves once to the minimum of its quadric and is
+// then frozen, with a stable output id, so neighbouring triangles written later share it.
+#pragma once
+
+#include "decimate/halfedge_buffer.hpp"
+#include "decimate/random.hpp"
+#include "io/chunk.hpp"
+
+#include <cstdint>
+#include <functional>
+
+namespace meshstream::decimate {
+
+// Receives each full chunk of output triangles (positions + vertex_id channel); the chunk is
+// reused after the call returns.
+using Emit = std::function<void(const io::TriangleChunk&)>;
+
+// Collects written triangles into a fixed chunk and hands it to an Emit when full.
+class TriangleOutput {
+public:
+    explicit TriangleOutput(size_t chunk_triangles);
+    void emit(const float xyz[9], const uint64_t ids[3], const Emit& out);
+    // Hands over the partial chunk, if any.
+    void flush(const Emit& out);
+    uint64_t triangle_count() const { return triangle_count_; }
+
+private:
+    io::TriangleChunk chunk_;
+    uint64_t triangle_count_ = 0;
+};
+
+// The face to write next, or kNoIndex when every in-core face touches P_in (the caller must
+// then force a write or read no further).
+uint32_t pick_write(const HalfEdgeBuffer& buffer, Rng& rng, int candidates);
+
+// Moves vertex v to its quadric minimum when its quadric is complete (not on P_in, manifold,
+// no open edge), the 3×3 system is well conditioned, the move stays within the longest
+// incident edge and no incident face flips or degenerates; otherwise it keeps its position
+// (the fallback: v is either an input position or a collapse target, both on the surface).
+// Returns true when it moved.
+bool place_vertex(HalfEdgeBuffer& buffer, uint32_t v);
+
+// Writes face f: places and freezes its vertices (ids from `next_id`), emits it, marks its
+// neighbours' edges as P_out and removes it from the buffer. Returns how many of its
+// vertices moved to their quadric minimum.
+int write_face(HalfEdgeBuffer& buffer, uint32_t f, uint64_t& next_id, TriangleOutput& output,
+                const Emit& out);
+
+// Passes a triangle whose corners welded together (degenerate) straight through: its
+// vertices are frozen where they are (they are on P_in) and it is emitted as read.
+void pass_through(HalfEdgeBuffer& buffer, const uint32_t vertex[3], uint64_t& next_id,
+                  TriangleOutput& output, const Emit& out);
+
+}  // namespace meshstream::decimate
