@@ -1,0 +1,339 @@
+// External merge sort of triangle records (see external_sort.hpp for the contract). Runs live
+// as consecutive segments of one temporary file; a merge pass reads them through per-run
+// buffers that share the budget, picks the smallest (key, run number) with a binary heap, and
+// either fills output chunks (final pass) or appends to the next temporary file.
+#include "sort/external_sort.hpp"
+
+#include "io/error.hpp"
+#include "sort/radix.hpp"
+
+#include <fcntl.h>
+
+#include <algorithm>
+#include <cassert>
+#include <cstring>
+
+namespace meshstream::sort {
+namespace {
+
+constexpr size_t kStagingBytes = size_t{1} << 20;      // >= TempFile's buffer: writes bypass it
+constexpr uint64_t kMinReadBytes = uint64_t{64} << 10;  // smallest per-run read buffer
+constexpr uint64_t kMaxReadBytes = uint64_t{16} << 20;  // larger reads gain nothing
+constexpr uint64_t kMinRunTriangles = 1024;
+
+}  // namespace
+
+// One run being merged: a window of its records in a read buffer.
+struct ExternalSorter::Cursor {
+    uint64_t next_offset = 0;  // first unread byte of the run in the file
+    uint64_t end_offset = 0;   // end of the run in the file
+    std::byte* buf = nullptr;
+    size_t capacity = 0;  // bytes, a multiple of the record size
+    size_t pos = 0, len = 0;
+    uint64_t block_offset = 0;  // file range of the buffered block, released once consumed
+    uint32_t key = 0;
+    uint32_t run = 0;  // position among the merged runs: breaks key ties (stability)
+};
+
+class ExternalSorter::Merger {
+public:
+    Merger(ExternalSorter& owner, io::TempFile& file, std::span<const Segment> segments, uint64_t buffer_budget)
+        : owner_(owner), file_(file) {
+        const size_t rb = owner.record_bytes_;
+        uint64_t per_run = std::min(kMaxReadBytes, buffer_budget / std::max<size_t>(1, segments.size()));
+        size_t capacity = std::max<size_t>(1, per_run / rb) * rb;
+        storage_.reset(new std::byte[capacity * segments.size()]);
+        cursors_.resize(segments.size());
+        for (size_t i = 0; i < segments.size(); ++i) {
+            Cursor& c = cursors_[i];
+            c.next_offset = segments[i].offset;
+            c.end_offset = segments[i].offset + segments[i].count * rb;
+            c.buf = storage_.get() + i * capacity;
+            c.capacity = capacity;
+            c.run = static_cast<uint32_t>(i);
+            if (refill(c)) heap_.push_back(static_cast<uint32_t>(i));
+        }
+        std::make_heap(heap_.begin(), heap_.end(), Greater{this});
+    }
+
+    // The smallest remaining record (owner's record size), or null when all runs are consumed.
+    const std::byte* top() const {
+        if (heap_.empty()) return nullptr;
+        const Cursor& c = cursors_[heap_.front()];
+        return c.buf + c.pos;
+    }
+
+    // Consumes top().
+    void pop() {
+        std::pop_heap(heap_.begin(), heap_.end(), Greater{this});
+        Cursor& c = cursors_[heap_.back()];
+        c.pos += owner_.record_bytes_;
+        if (c.pos < c.len || refill(c)) {
+            c.key = key_at(c);
+            std::push_heap(heap_.begin(), heap_.end(), Greater{this});
+        } else {
+            heap_.pop_back();
+        }
+    }
+
+private:
+    struct Greater {
+        const Merger* m;
+        bool operator()(uint32_t a, uint32_t b) const {
+            const Cursor& x = m->cursors_[a];
+            const Cursor& y = m->cursors_[b];
+            return x.key != y.key ? x.key > y.key : x.run > y.run;
+        }
+    };
+
+    uint32_t key_at(const Cursor& c) const {
+        float xyz[9];
+        std::memcpy(xyz, c.buf + c.pos, sizeof xyz);  // records are not float-aligned with colours
+        return triangle_key(xyz, owner_.options_.axis);
+    }
+
+    // Reads the cursor's next block; false when its run is exhausted. Releases the consumed one.
+    bool refill(Cursor& c) {
+        if (c.len > 0) owner_.release_temp_range(file_, c.block_offset, c.len);
+        c.pos = c.len = 0;
+        if (c.next_offset >= c.end_offset) return false;
+        size_t n = static_cast<size_t>(std::min<uint64_t>(c.capacity, c.end_offset - c.next_offset));
+        file_.read_at(c.next_offset, c.buf, n);
+        c.block_offset = c.next_offset;
+        c.next_offset += n;
+        c.len = n;
+        c.key = key_at(c);
+        return true;
+    }
+
+    ExternalSorter& owner_;
+    io::TempFile& file_;
+    std::unique_ptr<std::byte[]> storage_;
+    std::vector<Cursor> cursors_;
+    std::vector<uint32_t> heap_;  // cursor indices; front = smallest (key, run)
+};
+
+size_t ExternalSorter::record_bytes_for(const io::Channels& channels) {
+    return 9 * sizeof(float) + (channels.color ? 9 : 0) + (channels.normal ? 9 * sizeof(float) : 0) +
+           (channels.vertex_id ? 3 * sizeof(uint64_t) : 0);
+}
+
+uint64_t ExternalSorter::run_capacity_for(uint64_t memory_budget_bytes, size_t record_bytes) {
+    // Per triangle: its record plus two 8-byte (key, position) items for the radix sort.
+    uint64_t n = memory_budget_bytes / (record_bytes + 2 * sizeof(uint64_t));
+    return std::clamp<uint64_t>(n, kMinRunTriangles, uint64_t{0xFFFFFFFF});
+}
+
+ExternalSorter::ExternalSorter(SorterOptions options)
+    : options_(std::move(options)), record_bytes_(record_bytes_for(options_.channels)) {
+    assert(options_.axis >= 0 && options_.axis <= 2);
+    stats_.record_bytes = record_bytes_;
+    stats_.run_capacity = run_capacity_for(options_.memory_budget_bytes, record_bytes_);
+}
+
+ExternalSorter::~ExternalSorter() = default;
+
+void ExternalSorter::encode(const io::TriangleChunk& chunk, size_t i, std::byte* dst) const {
+    std::memcpy(dst, &chunk.xyz()[9 * i], 9 * sizeof(float));
+    dst += 9 * sizeof(float);
+    if (options_.channels.color) {
+        std::memcpy(dst, &chunk.rgb()[9 * i], 9);
+        dst += 9;
+    }
+    if (options_.channels.normal) {
+        std::memcpy(dst, &chunk.normals()[9 * i], 9 * sizeof(float));
+        dst += 9 * sizeof(float);
+    }
+    if (options_.channels.vertex_id) std::memcpy(dst, &chunk.vertex_ids()[3 * i], 3 * sizeof(uint64_t));
+}
+
+void ExternalSorter::decode(const std::byte* src, io::TriangleChunk& chunk) const {
+    std::memcpy(chunk.push_slot(), src, 9 * sizeof(float));
+    size_t i = chunk.size() - 1;
+    src += 9 * sizeof(float);
+    if (options_.channels.color) {
+        std::memcpy(chunk.rgb_at(i), src, 9);
+        src += 9;
+    }
+    if (options_.channels.normal) {
+        std::memcpy(chunk.normal_at(i), src, 9 * sizeof(float));
+        src += 9 * sizeof(float);
+    }
+    if (options_.channels.vertex_id) std::memcpy(chunk.id_at(i), src, 3 * sizeof(uint64_t));
+}
+
+void ExternalSorter::add(const io::TriangleChunk& chunk) {
+    assert(!input_done_);
+    assert(chunk.channels() == options_.channels);
+    const uint64_t capacity = stats_.run_capacity;
+    if (!records_) {
+        // Uninitialised: pages are touched (and count toward RSS) only as the run fills.
+        records_.reset(new std::byte[capacity * record_bytes_]);
+        items_.reset(new uint64_t[capacity]);
+    }
+    auto xyz = chunk.xyz();
+    for (size_t i = 0; i < chunk.size(); ++i) {
+        if (run_size_ == capacity) spill_run();
+        encode(chunk, i, records_.get() + run_size_ * record_bytes_);
+        items_[run_size_] = uint64_t{triangle_key(&xyz[9 * i], options_.axis)} << 32 | run_size_;
+        ++run_size_;
+    }
+    stats_.triangles += chunk.size();
+}
+
+void ExternalSorter::sort_run() {
+    if (run_size_ == 0) {
+        sorted_ = {};
+        return;
+    }
+    if (!scratch_) scratch_.reset(new uint64_t[stats_.run_capacity]);
+    sorted_ = radix_sort_by_key({items_.get(), run_size_}, {scratch_.get(), run_size_});
+}
+
+void ExternalSorter::write_temp(io::TempFile& file, const void* data, size_t n) {
+    try {
+        file.write(data, n);
+    } catch (const io::Error& e) {
+        throw io::Error(e.file(), e.byte_offset(), 0,
+                        e.message() + " (temporary file of meshstream sort; --tmpdir picks another directory)");
+    }
+    stats_.temp_bytes_written += n;
+    live_temp_bytes_ += n;
+    stats_.peak_temp_bytes = std::max(stats_.peak_temp_bytes, live_temp_bytes_);
+}
+
+void ExternalSorter::release_temp_range(io::TempFile& file, uint64_t offset, uint64_t n) {
+#ifdef FALLOC_FL_PUNCH_HOLE
+    // Consumed run data is never read again: give its blocks back so a merge pass needs about
+    // one copy of the data on disk, not two. File systems without hole punching just keep it.
+    if (::fallocate(file.fd(), FALLOC_FL_PUNCH_HOLE | FALLOC_FL_KEEP_SIZE, static_cast<off_t>(offset),
+                    static_cast<off_t>(n)) == 0)
+        live_temp_bytes_ -= std::min(live_temp_bytes_, n);
+#else
+    (void)file, (void)offset, (void)n;
+#endif
+}
+
+void ExternalSorter::spill_run() {
+    sort_run();
+    if (!runs_file_) runs_file_ = std::make_unique<io::TempFile>(options_.tmpdir, "meshstream-sort");
+    if (staging_.empty()) staging_.resize(kStagingBytes);
+    const uint64_t start = runs_file_->size();
+    size_t fill = 0;
+    for (uint64_t item : sorted_) {
+        if (fill + record_bytes_ > staging_.size()) {
+            write_temp(*runs_file_, staging_.data(), fill);
+            fill = 0;
+        }
+        std::memcpy(staging_.data() + fill, records_.get() + (item & 0xFFFFFFFFu) * record_bytes_, record_bytes_);
+        fill += record_bytes_;
+    }
+    if (fill) write_temp(*runs_file_, staging_.data(), fill);
+    segments_.push_back({start, run_size_});
+    ++stats_.runs;
+    run_size_ = 0;
+}
+
+void ExternalSorter::finish_input() {
+    assert(!input_done_);
+    input_done_ = true;
+    if (segments_.empty()) {
+        sort_run();  // everything fits in one run: no disk
+        return;
+    }
+    if (run_size_ > 0) spill_run();
+    records_.reset();
+    items_.reset();
+    scratch_.reset();
+    sorted_ = {};
+
+    const uint64_t budget = options_.memory_budget_bytes;
+    const size_t fan_in = static_cast<size_t>(std::max<uint64_t>(2, budget / kMinReadBytes));
+    int pass_count = 1;
+    for (size_t r = segments_.size(); r > fan_in; r = (r + fan_in - 1) / fan_in) ++pass_count;
+    for (int pass = 1; pass < pass_count; ++pass) merge_pass(pass, pass_count, fan_in);
+    stats_.merge_passes = pass_count;
+    start_final_merge();
+}
+
+void ExternalSorter::merge_pass(int pass, int pass_count, size_t fan_in) {
+    auto out = std::make_unique<io::TempFile>(options_.tmpdir, "meshstream-sort");
+    std::vector<Segment> merged;
+    // Spread the runs evenly over the groups, consecutive runs together (stability).
+    const size_t groups = (segments_.size() + fan_in - 1) / fan_in;
+    const size_t base = segments_.size() / groups, extra = segments_.size() % groups;
+    size_t first = 0;
+    uint64_t done = 0;
+    for (size_t g = 0; g < groups; ++g) {
+        size_t count = base + (g < extra ? 1 : 0);
+        std::span<const Segment> group(segments_.data() + first, count);
+        first += count;
+        Merger merger(*this, *runs_file_, group, options_.memory_budget_bytes);
+        const uint64_t start = out->size();
+        uint64_t triangles = 0;
+        size_t fill = 0;
+        while (const std::byte* rec = merger.top()) {
+            if (fill + record_bytes_ > staging_.size()) {
+                write_temp(*out, staging_.data(), fill);
+                fill = 0;
+                if (options_.on_merge_progress) options_.on_merge_progress(pass, pass_count, done + triangles);
+            }
+            std::memcpy(staging_.data() + fill, rec, record_bytes_);
+            fill += record_bytes_;
+            ++triangles;
+            merger.pop();
+        }
+        if (fill) write_temp(*out, staging_.data(), fill);
+        merged.push_back({start, triangles});
+        done += triangles;
+    }
+    // The old file's unreleased bytes go away with it.
+    uint64_t old_live = live_temp_bytes_ - out->size();
+    live_temp_bytes_ -= std::min(live_temp_bytes_, old_live);
+    runs_file_ = std::move(out);
+    segments_ = std::move(merged);
+    if (options_.on_merge_progress) options_.on_merge_progress(pass, pass_count, done);
+}
+
+void ExternalSorter::start_final_merge() {
+    final_ = std::make_unique<Merger>(*this, *runs_file_, segments_, options_.memory_budget_bytes);
+}
+
+bool ExternalSorter::next(io::TriangleChunk& chunk) {
+    assert(input_done_);
+    assert(chunk.channels() == options_.channels);
+    chunk.clear();
+    if (!final_) {
+        // In-memory result.
+        while (!chunk.full() && emit_pos_ < sorted_.size()) {
+            uint64_t item = sorted_[emit_pos_++];
+            decode(records_.get() + (item & 0xFFFFFFFFu) * record_bytes_, chunk);
+        }
+        if (emit_pos_ == sorted_.size() && records_ && chunk.empty()) {
+            records_.reset();
+            items_.reset();
+            scratch_.reset();
+            sorted_ = {};
+        }
+        return !chunk.empty();
+    }
+    while (!chunk.full()) {
+        const std::byte* rec = final_->top();
+        if (!rec) break;
+        decode(rec, chunk);
+        final_->pop();
+    }
+    if (chunk.empty()) {
+        final_.reset();
+        runs_file_.reset();  // removes the file as soon as the output is complete
+        live_temp_bytes_ = 0;
+        segments_.clear();
+        final_ = nullptr;
+        emit_pos_ = 0;
+        sorted_ = {};
+        return false;
+    }
+    return true;
+}
+
+}  // namespace meshstream::sort
