@@ -64,8 +64,8 @@ HalfEdgeBuffer::HalfEdgeBuffer(size_t triangle_capacity, double weld_eps)
       live_(triangle_capacity),
       interior_(triangle_capacity),
       frontier_(triangle_capacity),
-      vertex_(new Vertex[vertex_capacity_]),
-      quadric_(new Quadric[vertex_capacity_]),
+      vertex_(raw_array<Vertex>(vertex_capacity_)),
+      quadric_(raw_array<Quadric>(vertex_capacity_)),
       stamp_(new uint32_t[vertex_capacity_]),
       free_vertices_(new uint32_t[vertex_capacity_]) {
     assert(triangle_capacity >= 4 && triangle_capacity < (size_t{1} << 30));
@@ -74,7 +74,7 @@ HalfEdgeBuffer::HalfEdgeBuffer(size_t triangle_capacity, double weld_eps)
     std::fill_n(hash_.get(), slots, kNoIndex);
     hash_mask_ = slots - 1;
     const size_t stub_slots = pow2_at_least(triangle_capacity / 8);
-    stubs_.reset(new Stub[stub_slots]);
+    stubs_ = raw_array<Stub>(stub_slots);
     for (size_t i = 0; i < stub_slots; ++i) stubs_[i].a = kNoIndex;
     stub_mask_ = stub_slots - 1;
 }

@@ -28,7 +28,9 @@
 #include <cstddef>
 #include <algorithm>
 #include <cstdint>
+#include <cstdlib>
 #include <memory>
+#include <new>
 
 namespace meshstream::decimate {
 
@@ -74,6 +76,18 @@ private:
     std::unique_ptr<uint32_t[]> items_, where_;
     size_t size_ = 0;
 };
+
+// An array of an implicit-lifetime type left uninitialized, so that pages nobody touches
+// never become resident (new T[n] would value-initialize types with member initializers).
+struct FreeDeleter {
+    void operator()(void* p) const { std::free(p); }
+};
+template <class T> using RawArray = std::unique_ptr<T[], FreeDeleter>;
+template <class T> RawArray<T> raw_array(size_t n) {
+    void* p = std::malloc(n * sizeof(T));
+    if (!p) throw std::bad_alloc();
+    return RawArray<T>(static_cast<T*>(p));
+}
 
 class HalfEdgeBuffer {
 public:
@@ -173,8 +187,8 @@ private:
     uint32_t face_high_ = 0;
     FaceSet live_, interior_, frontier_;
 
-    std::unique_ptr<Vertex[]> vertex_;
-    std::unique_ptr<Quadric[]> quadric_;
+    RawArray<Vertex> vertex_;
+    RawArray<Quadric> quadric_;
     std::unique_ptr<uint32_t[]> stamp_;
     std::unique_ptr<uint32_t[]> free_vertices_;
     size_t free_vertex_stack_ = 0;
@@ -186,7 +200,7 @@ private:
     size_t hash_mask_;
 
     struct Stub { uint32_t a, gen_a, b, gen_b; };
-    std::unique_ptr<Stub[]> stubs_;  // a == kNoIndex: empty; linear probing
+    RawArray<Stub> stubs_;  // a == kNoIndex: empty; linear probing
     size_t stub_mask_, stub_count_ = 0;
 
     uint64_t vertices_merged_ = 0, nonmanifold_edges_ = 0;
