@@ -3,6 +3,12 @@
 #include "io/error.hpp"
 #include "io/format.hpp"
 #include "io/stl.hpp"
+#if MESHSTREAM_WITH_DRACO
+#include "io/draco.hpp"
+#endif
+#if MESHSTREAM_WITH_GLTF
+#include "io/gltf.hpp"
+#endif
 
 #include <algorithm>
 #include <cctype>
@@ -11,6 +17,13 @@ namespace meshstream::io {
 namespace {
 
 constexpr const Format* kFormats[] = {
+#if MESHSTREAM_WITH_DRACO
+    &kDracoFormat,
+#endif
+#if MESHSTREAM_WITH_GLTF
+    &kGlbFormat,
+    &kGltfFormat,
+#endif
     &kStlFormat,
     &kStlAsciiFormat,
 };

@@ -59,6 +59,19 @@ void add_write_flags(CLI::App* cmd, WriteFlags& flags) {
     cmd->add_option("--to", flags.to, "Output format, overriding the extension (e.g. stl, stl-ascii)");
     cmd->add_option("--gzip-level", flags.gzip_level, "zlib level 0-9 for outputs ending in .gz (default 6)")
         ->check(CLI::Range(0, 9));
+    // Draco (.drc) and glTF (.glb/.gltf) hold the whole mesh in memory (docs/formats.md).
+    auto* web = cmd->add_option_group("Draco / glTF output",
+                                      ".drc, .glb and .gltf are written from the whole mesh in memory; past --memory "
+                                      "they stop with an error asking for a larger --memory");
+    web->add_flag_callback("--no-draco", [&flags] { flags.draco = false; },
+                           "glTF: plain accessors instead of KHR_draco_mesh_compression (Draco is the default)");
+    web->add_flag("--normals", flags.normals, "Draco/glTF: write area-weighted smooth vertex normals");
+    web->add_option("--draco-qp", flags.draco_qp, "Draco position quantization bits, 1-30 (default 14)")
+        ->check(CLI::Range(1, 30));
+    web->add_option("--draco-qn", flags.draco_qn, "Draco normal quantization bits, 1-30 (default 10)")
+        ->check(CLI::Range(1, 30));
+    web->add_option("--draco-cl", flags.draco_cl, "Draco compression level 0-10 (default 7; 10 = smallest, slowest)")
+        ->check(CLI::Range(0, 10));
 }
 
 Global& global() {

@@ -1,0 +1,877 @@
+// glTF 2.0 reader and writer on tinygltf (document model, JSON parsing and serialisation) and
+// Draco (KHR_draco_mesh_compression). The writer lets tinygltf serialise the document with an
+// empty placeholder buffer, then sets buffers[0] itself and frames the GLB container, so the
+// (possibly large) binary payload is written straight to the sink and never base64-encoded or
+// copied into tinygltf's model. See gltf.hpp for the contract.
+#include "io/gltf.hpp"
+
+#include "io/error.hpp"
+#include "io/mesh_index.hpp"
+#if MESHSTREAM_WITH_DRACO
+#include "io/draco.hpp"
+#endif
+
+#include <nlohmann/json.hpp>
+#include <tiny_gltf.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <map>
+#include <memory>
+#include <sstream>
+
+#ifndef MESHSTREAM_VERSION
+#define MESHSTREAM_VERSION "unknown"
+#endif
+
+namespace meshstream::io {
+namespace {
+
+constexpr char kGlbMagic[4] = {'g', 'l', 'T', 'F'};
+constexpr uint32_t kChunkJson = 0x4E4F534A;  // "JSON"
+constexpr uint32_t kChunkBin = 0x004E4942;   // "BIN\0"
+constexpr const char* kDracoExtension = "KHR_draco_mesh_compression";
+constexpr const char* kQuantizationExtension = "KHR_mesh_quantization";
+
+std::string mib(uint64_t bytes) { return std::to_string((bytes + (1u << 20) - 1) >> 20) + " MiB"; }
+
+void put_u32(std::string& out, uint32_t v) {
+    for (int i = 0; i < 4; ++i) out.push_back(static_cast<char>((v >> (8 * i)) & 0xFF));
+}
+
+uint32_t get_u32(const unsigned char* p) {
+    return uint32_t{p[0]} | uint32_t{p[1]} << 8 | uint32_t{p[2]} << 16 | uint32_t{p[3]} << 24;
+}
+
+std::string base64(const unsigned char* data, size_t n) {
+    static const char* kAlphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    std::string out;
+    out.reserve((n + 2) / 3 * 4);
+    for (size_t i = 0; i < n; i += 3) {
+        uint32_t v = uint32_t{data[i]} << 16;
+        if (i + 1 < n) v |= uint32_t{data[i + 1]} << 8;
+        if (i + 2 < n) v |= data[i + 2];
+        out.push_back(kAlphabet[(v >> 18) & 63]);
+        out.push_back(kAlphabet[(v >> 12) & 63]);
+        out.push_back(i + 1 < n ? kAlphabet[(v >> 6) & 63] : '=');
+        out.push_back(i + 2 < n ? kAlphabet[v & 63] : '=');
+    }
+    return out;
+}
+
+// RFC 3986: everything but unreserved characters is percent-encoded in a relative URI.
+std::string uri_encode(const std::string& name) {
+    std::string out;
+    for (unsigned char c : name) {
+        if (std::isalnum(c) || c == '-' || c == '.' || c == '_' || c == '~') {
+            out.push_back(static_cast<char>(c));
+        } else {
+            char buf[4];
+            std::snprintf(buf, sizeof buf, "%%%02X", c);
+            out += buf;
+        }
+    }
+    return out;
+}
+
+// "dir/scene.gltf(.gz)" -> "dir/scene.bin".
+std::string bin_path_for(std::string path) {
+    if (path.size() > 3 && path.ends_with(".gz")) path.resize(path.size() - 3);
+    size_t slash = path.find_last_of('/');
+    size_t dot = path.find_last_of('.');
+    if (dot != std::string::npos && (slash == std::string::npos || dot > slash)) path.resize(dot);
+    return path + ".bin";
+}
+
+std::string base_name(const std::string& path) {
+    size_t slash = path.find_last_of('/');
+    return slash == std::string::npos ? path : path.substr(slash + 1);
+}
+
+// Smallest glTF index component type whose range holds indices 0..vertex_count-1 without the
+// primitive-restart value (all ones), which glTF forbids in index data.
+int index_component_type(uint64_t vertex_count, size_t* size) {
+    if (vertex_count <= 0xFF) return *size = 1, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE;
+    if (vertex_count <= 0xFFFF) return *size = 2, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT;
+    return *size = 4, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
+}
+
+// ---------------------------------------------------------------- writer
+
+class GltfWriter final : public Writer {
+public:
+    GltfWriter(ByteSink& sink, const WriteOptions& options, bool binary)
+        : sink_(sink), options_(options), binary_(binary), indexer_(sink.name()) {
+#if !MESHSTREAM_WITH_DRACO
+        options_.draco = false;
+#endif
+        if (options_.draco_position_bits < 1 || options_.draco_position_bits > 30)
+            throw Error(sink.name(), "--draco-qp must be 1-30, got " + std::to_string(options_.draco_position_bits));
+        if (options_.draco_normal_bits < 1 || options_.draco_normal_bits > 30)
+            throw Error(sink.name(), "--draco-qn must be 1-30, got " + std::to_string(options_.draco_normal_bits));
+        if (options_.draco_level < 0 || options_.draco_level > 10)
+            throw Error(sink.name(), "--draco-cl must be 0-10, got " + std::to_string(options_.draco_level));
+    }
+
+    void write(const TriangleChunk& chunk) override {
+        indexer_.add(chunk);
+        uint64_t v = indexer_.vertex_count(), f = indexer_.triangle_count();
+        uint64_t need;
+#if MESHSTREAM_WITH_DRACO
+        if (options_.draco) need = draco_encode_estimate_bytes(v, f, options_.normals);
+        else
+#endif
+            // Index tables, plus the output buffer (positions, optional normals, indices).
+            need = indexer_.memory_bytes() + v * (12 + (options_.normals ? 24 : 0)) + f * 12;
+        if (need > options_.memory_budget_bytes)
+            throw Error(sink_.name(), "glTF is written from the whole mesh in memory: " +
+                                          std::to_string(indexer_.input_triangle_count()) + " triangles so far need about " +
+                                          mib(need) + ", over the memory budget of " + mib(options_.memory_budget_bytes) +
+                                          "; raise --memory");
+    }
+
+    void finish() override;
+
+private:
+    std::string document_json(tinygltf::Model& model, uint64_t buffer_bytes, const std::string& buffer_uri);
+
+    ByteSink& sink_;
+    WriteOptions options_;
+    bool binary_;
+    MeshIndexer indexer_;
+};
+
+void append_bytes(std::vector<unsigned char>& bin, const void* data, size_t n) {
+    const auto* p = static_cast<const unsigned char*>(data);
+    bin.insert(bin.end(), p, p + n);
+}
+
+void pad4(std::vector<unsigned char>& bin) {
+    while (bin.size() % 4) bin.push_back(0);
+}
+
+void GltfWriter::finish() {
+    IndexedMesh mesh = indexer_.take();
+    std::vector<float> normals;
+    if (options_.normals && mesh.triangle_count() > 0) normals = mesh.smooth_normals();
+
+    tinygltf::Model model;
+    model.asset.version = "2.0";
+    model.asset.generator = std::string("meshstream ") + MESHSTREAM_VERSION;
+    model.defaultScene = 0;
+    model.scenes.emplace_back();
+    std::vector<unsigned char> bin;
+
+    if (mesh.triangle_count() > 0) {
+        tinygltf::Primitive prim;
+        prim.mode = TINYGLTF_MODE_TRIANGLES;
+        tinygltf::Accessor indices, positions, normal_acc;
+        indices.type = TINYGLTF_TYPE_SCALAR;
+        positions.type = TINYGLTF_TYPE_VEC3;
+        positions.componentType = TINYGLTF_COMPONENT_TYPE_FLOAT;
+        normal_acc.type = TINYGLTF_TYPE_VEC3;
+        normal_acc.componentType = TINYGLTF_COMPONENT_TYPE_FLOAT;
+        size_t index_size = 0;
+        Bounds bounds;
+#if MESHSTREAM_WITH_DRACO
+        if (options_.draco) {
+            DracoEncoded enc = encode_draco(mesh, options_.normals ? &normals : nullptr, options_, sink_.name());
+            append_bytes(bin, enc.bytes.data(), enc.bytes.size());
+            tinygltf::BufferView view;
+            view.buffer = 0;
+            view.byteOffset = 0;
+            view.byteLength = enc.bytes.size();
+            model.bufferViews.push_back(view);
+            indices.componentType = index_component_type(enc.point_count, &index_size);
+            indices.count = 3 * enc.face_count;
+            positions.count = enc.point_count;
+            normal_acc.count = enc.point_count;
+            bounds = enc.decoded_bounds;
+            tinygltf::Value::Object attrs;
+            attrs["POSITION"] = tinygltf::Value(enc.position_id);
+            if (options_.normals) attrs["NORMAL"] = tinygltf::Value(enc.normal_id);
+            tinygltf::Value::Object ext;
+            ext["bufferView"] = tinygltf::Value(0);
+            ext["attributes"] = tinygltf::Value(attrs);
+            prim.extensions[kDracoExtension] = tinygltf::Value(ext);
+            model.extensionsUsed.push_back(kDracoExtension);
+            model.extensionsRequired.push_back(kDracoExtension);
+        } else
+#endif
+        {
+            // Layout: indices, then positions, then normals; each view 4-byte aligned.
+            indices.componentType = index_component_type(mesh.vertex_count(), &index_size);
+            indices.count = mesh.indices.size();
+            positions.count = mesh.vertex_count();
+            normal_acc.count = mesh.vertex_count();
+            bounds = mesh.bounds();
+            bin.reserve(mesh.indices.size() * index_size + 4 + mesh.positions.size() * 4 + normals.size() * 4);
+            for (uint32_t i : mesh.indices) {
+                uint8_t le[4] = {uint8_t(i), uint8_t(i >> 8), uint8_t(i >> 16), uint8_t(i >> 24)};
+                append_bytes(bin, le, index_size);
+            }
+            tinygltf::BufferView iv;
+            iv.buffer = 0;
+            iv.byteOffset = 0;
+            iv.byteLength = bin.size();
+            iv.target = TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER;
+            model.bufferViews.push_back(iv);
+            pad4(bin);
+            tinygltf::BufferView pv;
+            pv.buffer = 0;
+            pv.byteOffset = bin.size();
+            pv.byteLength = mesh.positions.size() * sizeof(float);
+            pv.target = TINYGLTF_TARGET_ARRAY_BUFFER;
+            append_bytes(bin, mesh.positions.data(), pv.byteLength);  // little-endian host (x86/ARM)
+            model.bufferViews.push_back(pv);
+            indices.bufferView = 0;
+            positions.bufferView = 1;
+            if (options_.normals) {
+                tinygltf::BufferView nv = pv;
+                nv.byteOffset = bin.size();
+                append_bytes(bin, normals.data(), nv.byteLength);
+                model.bufferViews.push_back(nv);
+                normal_acc.bufferView = 2;
+            }
+        }
+        positions.minValues = {bounds.min[0], bounds.min[1], bounds.min[2]};
+        positions.maxValues = {bounds.max[0], bounds.max[1], bounds.max[2]};
+        model.accessors.push_back(indices);
+        model.accessors.push_back(positions);
+        prim.indices = 0;
+        prim.attributes["POSITION"] = 1;
+        if (options_.normals) {
+            model.accessors.push_back(normal_acc);
+            prim.attributes["NORMAL"] = 2;
+        }
+        tinygltf::Mesh m;
+        m.primitives.push_back(prim);
+        model.meshes.push_back(m);
+        tinygltf::Node node;
+        node.mesh = 0;
+        model.nodes.push_back(node);
+        model.scenes[0].nodes.push_back(0);
+        model.buffers.emplace_back();  // placeholder: set by document_json
+    }
+    mesh = IndexedMesh{};
+
+    const bool to_stdout = sink_.name() == "<stdout>";
+    if (binary_) {
+        std::string json = document_json(model, bin.size(), {});
+        while (json.size() % 4) json.push_back(' ');
+        pad4(bin);
+        uint64_t total = 12 + 8 + json.size() + (bin.empty() ? 0 : 8 + bin.size());
+        if (total > 0xFFFFFFFFull)
+            throw Error(sink_.name(), "the GLB would be " + std::to_string(total) +
+                                          " bytes, over GLB's 4 GiB limit; write .gltf (+ .bin) instead");
+        std::string head;
+        head.append(kGlbMagic, 4);
+        put_u32(head, 2);
+        put_u32(head, static_cast<uint32_t>(total));
+        put_u32(head, static_cast<uint32_t>(json.size()));
+        put_u32(head, kChunkJson);
+        sink_.write(head);
+        sink_.write(json);
+        if (!bin.empty()) {
+            std::string chunk;
+            put_u32(chunk, static_cast<uint32_t>(bin.size()));
+            put_u32(chunk, kChunkBin);
+            sink_.write(chunk);
+            sink_.write(bin.data(), bin.size());
+        }
+    } else if (bin.empty()) {
+        sink_.write(document_json(model, 0, {}));
+    } else if (to_stdout) {
+        std::string uri = "data:application/octet-stream;base64," + base64(bin.data(), bin.size());
+        sink_.write(document_json(model, bin.size(), uri));
+    } else {
+        std::string bin_path = bin_path_for(sink_.name());
+        std::string json = document_json(model, bin.size(), uri_encode(base_name(bin_path)));
+        // The side file goes through its own ByteSink: it appears only when complete, and the
+        // .gltf (committed by the caller right after) never points at a half-written .bin.
+        std::unique_ptr<ByteSink> side = ByteSink::open(bin_path);
+        side->write(bin.data(), bin.size());
+        side->commit();
+        sink_.write(json);
+    }
+}
+
+std::string GltfWriter::document_json(tinygltf::Model& model, uint64_t buffer_bytes, const std::string& buffer_uri) {
+    std::ostringstream stream;
+    tinygltf::TinyGLTF gltf;
+    if (!gltf.WriteGltfSceneToStream(&model, stream, !binary_, false))
+        throw Error(sink_.name(), "tinygltf could not serialise the document");
+    nlohmann::ordered_json doc = nlohmann::ordered_json::parse(stream.str());
+    if (buffer_bytes > 0) {
+        nlohmann::ordered_json buffer;
+        buffer["byteLength"] = buffer_bytes;
+        if (!buffer_uri.empty()) buffer["uri"] = buffer_uri;
+        doc["buffers"] = nlohmann::ordered_json::array({buffer});
+    } else {
+        doc.erase("buffers");
+    }
+    return doc.dump(binary_ ? -1 : 2) + (binary_ ? "" : "\n");
+}
+
+std::unique_ptr<Writer> open_glb_writer(ByteSink& sink, const WriteOptions& options) {
+    return std::make_unique<GltfWriter>(sink, options, true);
+}
+
+std::unique_ptr<Writer> open_gltf_writer(ByteSink& sink, const WriteOptions& options) {
+    return std::make_unique<GltfWriter>(sink, options, false);
+}
+
+// ---------------------------------------------------------------- reader
+
+bool skip_image(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int, void*) {
+    return true;  // geometry only: images are never decoded
+}
+
+// Required extensions that do not change geometry, or that this reader implements.
+bool extension_supported(const std::string& ext) {
+#if MESHSTREAM_WITH_DRACO
+    if (ext == kDracoExtension) return true;
+#endif
+    if (ext == kQuantizationExtension) return true;
+    return ext.starts_with("KHR_materials_") || ext.starts_with("KHR_texture_") || ext.starts_with("EXT_texture_") ||
+           ext == "KHR_lights_punctual";
+}
+
+size_t component_size(int type) {
+    switch (type) {
+        case TINYGLTF_COMPONENT_TYPE_BYTE:
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return 1;
+        case TINYGLTF_COMPONENT_TYPE_SHORT:
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return 2;
+        case TINYGLTF_COMPONENT_TYPE_INT:
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
+        case TINYGLTF_COMPONENT_TYPE_FLOAT: return 4;
+        default: return 0;
+    }
+}
+
+int component_count(int type) {
+    switch (type) {
+        case TINYGLTF_TYPE_SCALAR: return 1;
+        case TINYGLTF_TYPE_VEC2: return 2;
+        case TINYGLTF_TYPE_VEC3: return 3;
+        case TINYGLTF_TYPE_VEC4: return 4;
+        default: return 0;
+    }
+}
+
+// A bounds-checked window onto one accessor's elements.
+struct AccessorView {
+    const unsigned char* base = nullptr;  // null: no bufferView, all zeros (glTF 2.0 §3.6.2.4)
+    size_t stride = 0, count = 0;
+    int component_type = 0, components = 0;
+    bool normalized = false;
+
+    double get(size_t i, int c) const {
+        if (!base) return 0.0;
+        const unsigned char* p = base + i * stride + c * component_size(component_type);
+        switch (component_type) {
+            case TINYGLTF_COMPONENT_TYPE_FLOAT: {
+                float f;
+                std::memcpy(&f, p, 4);
+                return f;
+            }
+            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: return get_u32(p);
+            case TINYGLTF_COMPONENT_TYPE_INT: return static_cast<int32_t>(get_u32(p));
+            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+                double v = uint16_t(p[0] | p[1] << 8);
+                return normalized ? v / 65535.0 : v;
+            }
+            case TINYGLTF_COMPONENT_TYPE_SHORT: {
+                double v = int16_t(uint16_t(p[0] | p[1] << 8));
+                return normalized ? std::max(v / 32767.0, -1.0) : v;
+            }
+            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return normalized ? p[0] / 255.0 : p[0];
+            case TINYGLTF_COMPONENT_TYPE_BYTE: {
+                double v = static_cast<int8_t>(p[0]);
+                return normalized ? std::max(v / 127.0, -1.0) : v;
+            }
+            default: return 0.0;
+        }
+    }
+};
+
+// A primitive in its local space: positions and triangles (strips and fans already unrolled).
+struct PrimitiveGeometry {
+    std::vector<float> positions;
+    std::vector<uint32_t> triangles;
+};
+
+struct Instance {
+    double matrix[16];  // column-major world transform
+    int mesh;
+};
+
+void mat_mul(const double* a, const double* b, double* out) {
+    double r[16];
+    for (int c = 0; c < 4; ++c)
+        for (int row = 0; row < 4; ++row) {
+            double s = 0;
+            for (int k = 0; k < 4; ++k) s += a[k * 4 + row] * b[c * 4 + k];
+            r[c * 4 + row] = s;
+        }
+    std::memcpy(out, r, sizeof r);
+}
+
+void local_matrix(const tinygltf::Node& node, double* m) {
+    if (node.matrix.size() == 16) {
+        for (int i = 0; i < 16; ++i) m[i] = node.matrix[i];
+        return;
+    }
+    double t[3] = {0, 0, 0}, q[4] = {0, 0, 0, 1}, s[3] = {1, 1, 1};
+    if (node.translation.size() == 3)
+        for (int i = 0; i < 3; ++i) t[i] = node.translation[i];
+    if (node.rotation.size() == 4)
+        for (int i = 0; i < 4; ++i) q[i] = node.rotation[i];
+    if (node.scale.size() == 3)
+        for (int i = 0; i < 3; ++i) s[i] = node.scale[i];
+    const double x = q[0], y = q[1], z = q[2], w = q[3];
+    // Rotation matrix of the unit quaternion (x, y, z, w), columns scaled: M = T · R · S.
+    const double r[9] = {1 - 2 * (y * y + z * z), 2 * (x * y + z * w), 2 * (x * z - y * w),
+                         2 * (x * y - z * w), 1 - 2 * (x * x + z * z), 2 * (y * z + x * w),
+                         2 * (x * z + y * w), 2 * (y * z - x * w), 1 - 2 * (x * x + y * y)};
+    for (int c = 0; c < 3; ++c) {
+        for (int row = 0; row < 3; ++row) m[c * 4 + row] = r[c * 3 + row] * s[c];
+        m[c * 4 + 3] = 0;
+    }
+    m[12] = t[0];
+    m[13] = t[1];
+    m[14] = t[2];
+    m[15] = 1;
+}
+
+double det3(const double* m) {
+    return m[0] * (m[5] * m[10] - m[9] * m[6]) - m[4] * (m[1] * m[10] - m[9] * m[2]) + m[8] * (m[1] * m[6] - m[5] * m[2]);
+}
+
+// Required extensions listed in the raw JSON, for a clear refusal when tinygltf itself fails
+// on data only the extension explains (EXT_meshopt_compression's fallback buffers).
+std::vector<std::string> required_extensions_in(const std::string& json) {
+    std::vector<std::string> out;
+    auto doc = nlohmann::json::parse(json, nullptr, false);
+    if (doc.is_discarded() || !doc.is_object() || !doc.contains("extensionsRequired")) return out;
+    for (const auto& e : doc["extensionsRequired"])
+        if (e.is_string()) out.push_back(e.get<std::string>());
+    return out;
+}
+
+class GltfReader final : public Reader {
+public:
+    GltfReader(ByteSource& source, const ReadOptions& options) : name_(source.name()) {
+        std::vector<unsigned char> bytes;
+        unsigned char buf[1 << 16];
+        while (size_t n = source.read(buf, sizeof buf)) {
+            bytes.insert(bytes.end(), buf, buf + n);
+            if (bytes.size() > options.memory_budget_bytes)
+                throw Error(name_, "glTF documents are read whole into memory and this one is over the memory budget of " +
+                                       mib(options.memory_budget_bytes) + "; raise --memory");
+        }
+        const bool glb = bytes.size() >= 4 && std::memcmp(bytes.data(), kGlbMagic, 4) == 0;
+        if (!glb && bytes.size() > 0xFFFFFFFFull) throw Error(name_, "glTF JSON over 4 GiB is not supported");
+        header_.variant = glb ? "binary (GLB)" : "JSON";
+
+        hide_draco_indices(bytes, glb);
+
+        tinygltf::TinyGLTF gltf;
+        gltf.SetImageLoader(&skip_image, nullptr);
+        std::string err, warn;
+        std::string base_dir = parent_dir(source.name());
+        bool ok = glb ? gltf.LoadBinaryFromMemory(&model_, &err, &warn, bytes.data(), static_cast<unsigned>(bytes.size()), base_dir)
+                      : gltf.LoadASCIIFromString(&model_, &err, &warn, reinterpret_cast<const char*>(bytes.data()),
+                                                 static_cast<unsigned>(bytes.size()), base_dir);
+        if (!ok) {
+            std::string json;
+            if (glb && bytes.size() >= 20) {
+                size_t len = std::min<size_t>(get_u32(&bytes[12]), bytes.size() - 20);
+                json.assign(reinterpret_cast<const char*>(&bytes[20]), len);
+            } else if (!glb) {
+                json.assign(bytes.begin(), bytes.end());
+            }
+            for (const std::string& ext : required_extensions_in(json))
+                if (!extension_supported(ext)) throw_unsupported_extension(ext);
+            while (!err.empty() && (err.back() == '\n' || err.back() == ' ')) err.pop_back();
+            throw Error(name_, "invalid glTF: " + (err.empty() ? std::string("tinygltf failed to parse it") : err));
+        }
+        bytes = {};
+        for (const std::string& ext : model_.extensionsRequired)
+            if (!extension_supported(ext)) throw_unsupported_extension(ext);
+
+        collect_instances();
+        uint64_t triangles = 0;
+        for (const Instance& inst : instances_)
+            for (size_t p = 0; p < model_.meshes[inst.mesh].primitives.size(); ++p)
+                triangles += primitive_triangle_count(inst.mesh, static_cast<int>(p));
+        header_.triangle_count = triangles;
+        header_.notes.emplace_back("instances", std::to_string(instances_.size()) + " mesh instance(s) of " +
+                                                    std::to_string(model_.meshes.size()) + " mesh(es)");
+        if (!model_.asset.generator.empty()) header_.notes.emplace_back("generator", model_.asset.generator);
+        std::string used;
+        for (const std::string& e : model_.extensionsUsed) used += (used.empty() ? "" : ", ") + e;
+        if (!used.empty()) header_.notes.emplace_back("extensions", used);
+    }
+
+    bool next(TriangleChunk& chunk) override;
+
+private:
+    void hide_draco_indices(std::vector<unsigned char>& bytes, bool glb);
+    [[noreturn]] void throw_unsupported_extension(const std::string& ext) const {
+#if !MESHSTREAM_WITH_DRACO
+        if (ext == kDracoExtension)
+            throw Error(name_, "requires extension KHR_draco_mesh_compression, but this meshstream was built without Draco");
+#endif
+        throw Error(name_, "requires extension " + ext + ", which meshstream does not support");
+    }
+    std::string where(int mesh, int prim) const {
+        std::string s = "mesh " + std::to_string(mesh);
+        if (!model_.meshes[mesh].name.empty()) s += " '" + model_.meshes[mesh].name + "'";
+        return s + " primitive " + std::to_string(prim);
+    }
+    void collect_instances();
+    void visit(int node, const double* parent, int depth);
+    bool is_draco(const tinygltf::Primitive& p) const {
+#if MESHSTREAM_WITH_DRACO
+        return p.extensions.count(kDracoExtension) > 0;
+#else
+        (void)p;
+        return false;
+#endif
+    }
+    int mode_of(int mesh, int prim) const;
+    uint64_t primitive_triangle_count(int mesh, int prim) const;
+    AccessorView view(int accessor, const std::string& what) const;
+    std::shared_ptr<const PrimitiveGeometry> geometry(int mesh, int prim);
+    void load_current();
+
+    std::string name_;
+    tinygltf::Model model_;
+    std::vector<Instance> instances_;
+    std::map<std::pair<int, int>, std::shared_ptr<const PrimitiveGeometry>> draco_cache_;
+    std::map<std::pair<int, int>, int> draco_indices_;  // (mesh, primitive) -> hidden indices accessor
+    // Streaming position: instance, primitive, triangle; world-space positions of the current one.
+    size_t inst_ = 0, prim_ = 0, tri_ = 0;
+    bool loaded_ = false;
+    bool flip_ = false;
+    std::shared_ptr<const PrimitiveGeometry> current_;
+    std::vector<float> world_;
+};
+
+// tinygltf 2.7 rejects an index accessor without a bufferView ("accessor[0] invalid
+// bufferView"), which is exactly what KHR_draco_mesh_compression primitives have: the indices
+// live in the Draco blob. So the "indices" of Draco primitives are taken out of the JSON before
+// tinygltf parses it and remembered here (they only state the triangle count).
+void GltfReader::hide_draco_indices(std::vector<unsigned char>& bytes, bool glb) {
+    size_t json_begin = 0, json_size = bytes.size();
+    if (glb) {
+        if (bytes.size() < 20 || get_u32(&bytes[16]) != kChunkJson) return;  // tinygltf reports it
+        json_begin = 20;
+        json_size = get_u32(&bytes[12]);
+        if (json_size > bytes.size() - 20) return;
+    }
+    std::string_view json(reinterpret_cast<const char*>(bytes.data()) + json_begin, json_size);
+    if (json.find(kDracoExtension) == std::string_view::npos) return;
+    auto doc = nlohmann::ordered_json::parse(json, nullptr, false);
+    if (doc.is_discarded() || !doc.is_object() || !doc.contains("meshes") || !doc["meshes"].is_array()) return;
+    bool changed = false;
+    for (size_t m = 0; m < doc["meshes"].size(); ++m) {
+        auto& mesh = doc["meshes"][m];
+        if (!mesh.is_object() || !mesh.contains("primitives") || !mesh["primitives"].is_array()) continue;
+        for (size_t p = 0; p < mesh["primitives"].size(); ++p) {
+            auto& prim = mesh["primitives"][p];
+            if (!prim.is_object() || !prim.contains("extensions") || !prim["extensions"].is_object() ||
+                !prim["extensions"].contains(kDracoExtension) || !prim.contains("indices") ||
+                !prim["indices"].is_number_integer())
+                continue;
+            draco_indices_[{int(m), int(p)}] = prim["indices"].get<int>();
+            prim.erase("indices");
+            changed = true;
+        }
+    }
+    if (!changed) return;
+    std::string text = doc.dump();
+    if (!glb) {
+        bytes.assign(text.begin(), text.end());
+        return;
+    }
+    while (text.size() % 4) text.push_back(' ');
+    std::string head;
+    head.append(kGlbMagic, 4);
+    put_u32(head, 2);
+    const size_t rest = bytes.size() - 20 - json_size;  // the BIN chunk and anything after
+    put_u32(head, static_cast<uint32_t>(20 + text.size() + rest));
+    put_u32(head, static_cast<uint32_t>(text.size()));
+    put_u32(head, kChunkJson);
+    std::vector<unsigned char> out;
+    out.reserve(head.size() + text.size() + rest);
+    out.insert(out.end(), head.begin(), head.end());
+    out.insert(out.end(), text.begin(), text.end());
+    out.insert(out.end(), bytes.begin() + 20 + json_size, bytes.end());
+    bytes.swap(out);
+}
+
+void GltfReader::collect_instances() {
+    const double identity[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+    if (model_.scenes.empty()) {
+        // No scene: nothing says how meshes are placed; take each mesh once, untransformed.
+        for (size_t m = 0; m < model_.meshes.size(); ++m) {
+            Instance inst;
+            std::memcpy(inst.matrix, identity, sizeof identity);
+            inst.mesh = static_cast<int>(m);
+            instances_.push_back(inst);
+        }
+        return;
+    }
+    int scene = model_.defaultScene >= 0 ? model_.defaultScene : 0;
+    if (scene >= static_cast<int>(model_.scenes.size()))
+        throw Error(name_, "default scene " + std::to_string(scene) + " does not exist");
+    for (int node : model_.scenes[scene].nodes) visit(node, identity, 0);
+}
+
+void GltfReader::visit(int node, const double* parent, int depth) {
+    if (node < 0 || node >= static_cast<int>(model_.nodes.size()))
+        throw Error(name_, "scene refers to node " + std::to_string(node) + ", which does not exist");
+    if (depth > static_cast<int>(model_.nodes.size())) throw Error(name_, "node hierarchy has a cycle at node " + std::to_string(node));
+    const tinygltf::Node& n = model_.nodes[node];
+    double local[16], world[16];
+    local_matrix(n, local);
+    mat_mul(parent, local, world);
+    if (n.mesh >= 0) {
+        if (n.mesh >= static_cast<int>(model_.meshes.size()))
+            throw Error(name_, "node " + std::to_string(node) + " refers to mesh " + std::to_string(n.mesh) + ", which does not exist");
+        Instance inst;
+        std::memcpy(inst.matrix, world, sizeof world);
+        inst.mesh = n.mesh;
+        instances_.push_back(inst);
+    }
+    for (int child : n.children) visit(child, world, depth + 1);
+}
+
+int GltfReader::mode_of(int mesh, int prim) const {
+    int mode = model_.meshes[mesh].primitives[prim].mode;
+    if (mode == -1) mode = TINYGLTF_MODE_TRIANGLES;  // the default when absent
+    static const char* kNames[] = {"POINTS", "LINES", "LINE_LOOP", "LINE_STRIP"};
+    if (mode >= 0 && mode <= 3)
+        throw Error(name_, where(mesh, prim) + " has mode " + kNames[mode] + " (" + std::to_string(mode) +
+                               "); only TRIANGLES, TRIANGLE_STRIP and TRIANGLE_FAN are supported");
+    if (mode > 6) throw Error(name_, where(mesh, prim) + " has unknown mode " + std::to_string(mode));
+    if (is_draco(model_.meshes[mesh].primitives[prim]) && mode != TINYGLTF_MODE_TRIANGLES)
+        throw Error(name_, where(mesh, prim) + ": KHR_draco_mesh_compression with mode " + std::to_string(mode) +
+                               " is not supported (only TRIANGLES)");
+    return mode;
+}
+
+uint64_t GltfReader::primitive_triangle_count(int mesh, int prim) const {
+    const tinygltf::Primitive& p = model_.meshes[mesh].primitives[prim];
+    int mode = mode_of(mesh, prim);
+    auto pos = p.attributes.find("POSITION");
+    if (pos == p.attributes.end()) throw Error(name_, where(mesh, prim) + " has no POSITION attribute");
+    int acc = p.indices >= 0 ? p.indices : pos->second;
+    if (auto hidden = draco_indices_.find({mesh, prim}); hidden != draco_indices_.end()) acc = hidden->second;
+    if (acc < 0 || acc >= static_cast<int>(model_.accessors.size()))
+        throw Error(name_, where(mesh, prim) + " refers to accessor " + std::to_string(acc) + ", which does not exist");
+    uint64_t n = model_.accessors[acc].count;
+    if (mode == TINYGLTF_MODE_TRIANGLES) {
+        if (n % 3) throw Error(name_, where(mesh, prim) + ": TRIANGLES with " + std::to_string(n) + " vertices, not a multiple of 3");
+        return n / 3;
+    }
+    return n >= 3 ? n - 2 : 0;
+}
+
+AccessorView GltfReader::view(int accessor, const std::string& what) const {
+    if (accessor < 0 || accessor >= static_cast<int>(model_.accessors.size()))
+        throw Error(name_, what + " refers to accessor " + std::to_string(accessor) + ", which does not exist");
+    const tinygltf::Accessor& a = model_.accessors[accessor];
+    std::string where_acc = what + " (accessor " + std::to_string(accessor) + ")";
+    if (a.sparse.isSparse) throw Error(name_, where_acc + " is sparse; sparse accessors are not supported");
+    AccessorView v;
+    v.count = a.count;
+    v.component_type = a.componentType;
+    v.components = component_count(a.type);
+    v.normalized = a.normalized;
+    size_t csize = component_size(a.componentType);
+    if (csize == 0 || v.components == 0)
+        throw Error(name_, where_acc + " has unsupported component type " + std::to_string(a.componentType) + " / type " +
+                               std::to_string(a.type));
+    if (a.bufferView < 0) return v;  // all zeros
+    if (a.bufferView >= static_cast<int>(model_.bufferViews.size()))
+        throw Error(name_, where_acc + " refers to bufferView " + std::to_string(a.bufferView) + ", which does not exist");
+    const tinygltf::BufferView& bv = model_.bufferViews[a.bufferView];
+    if (bv.buffer < 0 || bv.buffer >= static_cast<int>(model_.buffers.size()))
+        throw Error(name_, where_acc + ": bufferView refers to a missing buffer");
+    const std::vector<unsigned char>& data = model_.buffers[bv.buffer].data;
+    const size_t elem = csize * v.components;
+    v.stride = bv.byteStride ? bv.byteStride : elem;
+    uint64_t end = uint64_t{bv.byteOffset} + a.byteOffset + (a.count ? (a.count - 1) * uint64_t{v.stride} + elem : 0);
+    if (bv.byteOffset + bv.byteLength > data.size() || end > bv.byteOffset + bv.byteLength)
+        throw Error(name_, where_acc + " reaches byte " + std::to_string(end) + " of a buffer view ending at " +
+                               std::to_string(std::min<uint64_t>(bv.byteOffset + bv.byteLength, data.size())));
+    v.base = data.data() + bv.byteOffset + a.byteOffset;
+    return v;
+}
+
+std::shared_ptr<const PrimitiveGeometry> GltfReader::geometry(int mesh, int prim) {
+    const tinygltf::Primitive& p = model_.meshes[mesh].primitives[prim];
+    const int mode = mode_of(mesh, prim);
+    const std::string at = where(mesh, prim);
+    auto geo = std::make_shared<PrimitiveGeometry>();
+#if MESHSTREAM_WITH_DRACO
+    if (is_draco(p)) {
+        auto cached = draco_cache_.find({mesh, prim});
+        if (cached != draco_cache_.end()) return cached->second;
+        const tinygltf::Value& ext = p.extensions.at(kDracoExtension);
+        const tinygltf::Value& bvv = ext.Get("bufferView");
+        const tinygltf::Value& attrs = ext.Get("attributes");
+        if (!bvv.IsInt() || !attrs.IsObject() || !attrs.Get("POSITION").IsInt())
+            throw Error(name_, at + ": KHR_draco_mesh_compression needs an integer bufferView and attributes.POSITION");
+        int bvi = bvv.Get<int>();
+        if (bvi < 0 || bvi >= static_cast<int>(model_.bufferViews.size()))
+            throw Error(name_, at + ": KHR_draco_mesh_compression refers to bufferView " + std::to_string(bvi) + ", which does not exist");
+        const tinygltf::BufferView& bv = model_.bufferViews[bvi];
+        if (bv.buffer < 0 || bv.buffer >= static_cast<int>(model_.buffers.size()) ||
+            bv.byteOffset + bv.byteLength > model_.buffers[bv.buffer].data.size())
+            throw Error(name_, at + ": KHR_draco_mesh_compression bufferView " + std::to_string(bvi) + " lies outside its buffer");
+        const auto* start = reinterpret_cast<const std::byte*>(model_.buffers[bv.buffer].data.data() + bv.byteOffset);
+        DracoDecoded d;
+        try {
+            d = decode_draco({start, bv.byteLength}, name_, 0, attrs.Get("POSITION").Get<int>());
+        } catch (const Error& e) {
+            throw Error(name_, at + " (KHR_draco_mesh_compression): " + e.message());
+        }
+        uint64_t stated = primitive_triangle_count(mesh, prim);
+        if (d.indices.size() / 3 != stated)
+            throw Error(name_, at + ": accessors state " + std::to_string(stated) + " triangles, the Draco data holds " +
+                                   std::to_string(d.indices.size() / 3));
+        geo->positions = std::move(d.positions);
+        geo->triangles = std::move(d.indices);
+        draco_cache_[{mesh, prim}] = geo;
+        return geo;
+    }
+#endif
+    AccessorView pos = view(p.attributes.at("POSITION"), at + " POSITION");
+    if (pos.components != 3) throw Error(name_, at + " POSITION is not VEC3");
+    if (pos.component_type != TINYGLTF_COMPONENT_TYPE_FLOAT) {
+        bool quantized = std::find(model_.extensionsUsed.begin(), model_.extensionsUsed.end(), kQuantizationExtension) !=
+                         model_.extensionsUsed.end();
+        bool integer = pos.component_type != TINYGLTF_COMPONENT_TYPE_INT && pos.component_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
+        if (!quantized || !integer)
+            throw Error(name_, at + " POSITION has component type " + std::to_string(pos.component_type) +
+                                   " (allowed: FLOAT, or 8/16-bit integers with KHR_mesh_quantization)");
+    }
+    geo->positions.resize(pos.count * 3);
+    for (size_t i = 0; i < pos.count; ++i)
+        for (int c = 0; c < 3; ++c) geo->positions[3 * i + c] = static_cast<float>(pos.get(i, c));
+
+    std::vector<uint32_t> order;  // the vertex sequence the mode walks
+    if (p.indices >= 0) {
+        AccessorView idx = view(p.indices, at + " indices");
+        if (idx.components != 1 || (idx.component_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
+                                    idx.component_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+                                    idx.component_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT))
+            throw Error(name_, at + " indices must be unsigned byte/short/int scalars");
+        order.resize(idx.count);
+        for (size_t i = 0; i < idx.count; ++i) {
+            double v = idx.get(i, 0);
+            if (v >= static_cast<double>(pos.count))
+                throw Error(name_, at + " index " + std::to_string(i) + " is " + std::to_string(uint64_t(v)) + ", but POSITION has " +
+                                       std::to_string(pos.count) + " vertices");
+            order[i] = static_cast<uint32_t>(v);
+        }
+    } else {
+        order.resize(pos.count);
+        for (size_t i = 0; i < pos.count; ++i) order[i] = static_cast<uint32_t>(i);
+    }
+    const size_t n = order.size();
+    if (mode == TINYGLTF_MODE_TRIANGLES) {
+        geo->triangles = std::move(order);
+    } else if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
+        // glTF 2.0 §3.7.2.1: triangle i is (v_i, v_{i+1+i%2}, v_{i+2-i%2}), keeping one winding.
+        for (size_t i = 0; i + 2 < n; ++i) {
+            uint32_t t[3] = {order[i], order[i + 1 + i % 2], order[i + 2 - i % 2]};
+            geo->triangles.insert(geo->triangles.end(), t, t + 3);
+        }
+    } else {  // TRIANGLE_FAN: (v_{i+1}, v_{i+2}, v_0)
+        for (size_t i = 0; i + 2 < n; ++i) {
+            uint32_t t[3] = {order[i + 1], order[i + 2], order[0]};
+            geo->triangles.insert(geo->triangles.end(), t, t + 3);
+        }
+    }
+    return geo;
+}
+
+void GltfReader::load_current() {
+    const Instance& inst = instances_[inst_];
+    current_ = geometry(inst.mesh, static_cast<int>(prim_));
+    const double* m = inst.matrix;
+    // A mirroring transform reverses the winding (glTF 2.0 §3.7.4); swap two corners back.
+    flip_ = det3(m) < 0;
+    const auto& src = current_->positions;
+    world_.resize(src.size());
+    for (size_t i = 0; i < src.size(); i += 3) {
+        double x = src[i], y = src[i + 1], z = src[i + 2];
+        for (int r = 0; r < 3; ++r) world_[i + r] = static_cast<float>(m[r] * x + m[4 + r] * y + m[8 + r] * z + m[12 + r]);
+    }
+    tri_ = 0;
+    loaded_ = true;
+}
+
+bool GltfReader::next(TriangleChunk& chunk) {
+    chunk.clear();
+    while (!chunk.full() && inst_ < instances_.size()) {
+        const tinygltf::Mesh& mesh = model_.meshes[instances_[inst_].mesh];
+        if (prim_ >= mesh.primitives.size()) {
+            ++inst_;
+            prim_ = 0;
+            loaded_ = false;
+            continue;
+        }
+        if (!loaded_) load_current();
+        const std::vector<uint32_t>& t = current_->triangles;
+        const size_t count = t.size() / 3;
+        while (tri_ < count && !chunk.full()) {
+            float* dst = chunk.push_slot();
+            uint32_t v[3] = {t[3 * tri_], t[3 * tri_ + 1], t[3 * tri_ + 2]};
+            if (flip_) std::swap(v[1], v[2]);
+            for (int k = 0; k < 3; ++k) std::memcpy(dst + 3 * k, &world_[3 * size_t{v[k]}], 3 * sizeof(float));
+            ++tri_;
+        }
+        if (tri_ == count) {
+            ++prim_;
+            loaded_ = false;
+        }
+    }
+    return !chunk.empty();
+}
+
+std::unique_ptr<Reader> open_gltf_reader(ByteSource& source, const ReadOptions& options) {
+    return std::make_unique<GltfReader>(source, options);
+}
+
+}  // namespace
+
+const Format kGlbFormat = {
+    "glb", "glb", "binary glTF 2.0 (Draco by default; whole mesh in memory)", &probe_glb, &open_gltf_reader,
+    &open_glb_writer,
+};
+
+const Format kGltfFormat = {
+    "gltf", "gltf", "glTF 2.0 JSON + .bin (Draco by default; whole mesh in memory)", &probe_gltf_json, &open_gltf_reader,
+    &open_gltf_writer,
+};
+
+bool probe_glb(std::span<const std::byte> head, std::optional<uint64_t>) {
+    return head.size() >= 12 && std::memcmp(head.data(), kGlbMagic, 4) == 0;
+}
+
+bool probe_gltf_json(std::span<const std::byte> head, std::optional<uint64_t>) {
+    std::string_view text(reinterpret_cast<const char*>(head.data()), head.size());
+    size_t first = text.find_first_not_of(" \t\r\n");
+    if (first == std::string_view::npos || text[first] != '{') return false;
+    return text.find("\"asset\"") != std::string_view::npos;
+}
+
+}  // namespace meshstream::io

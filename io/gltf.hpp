@@ -1,0 +1,41 @@
+// glTF 2.0: binary `.glb` and JSON `.gltf` (+ `.bin` side file), through tinygltf (Debian
+// libtinygltf-dev, the compiled library) and, for KHR_draco_mesh_compression, Draco.
+// Memory class: whole document. The writer indexes the soup in memory (io/mesh_index.hpp) and
+// serialises at finish(); it refuses cleanly once its estimate passes --memory. The reader
+// reads the whole document (and its external buffers) into memory, because tinygltf parses
+// from memory, and refuses documents larger than --memory.
+//
+// Writer: one mesh, one TRIANGLES primitive on one node of the default scene; POSITION with
+// exact min/max, optional NORMAL (--normals: area-weighted smooth normals), indices of the
+// smallest component type that fits (restart values excluded), asset.generator
+// "meshstream <version>". With Draco (the default; --no-draco off) the primitive carries
+// KHR_draco_mesh_compression, listed in extensionsUsed and extensionsRequired, and its
+// accessors have no bufferView but the decoded count, min and max. `.gltf` writes its buffer
+// to `<stem>.bin` beside it (committed atomically with it); to stdout the buffer is embedded
+// as a base64 data URI. An empty mesh becomes a valid document with an empty scene.
+//
+// Reader: the default scene's node tree (or, without scenes, every mesh once) with node
+// transforms applied, so the soup is in world space; winding is flipped under mirroring
+// transforms. TRIANGLES, TRIANGLE_STRIP and TRIANGLE_FAN are read (with or without indices,
+// Draco or plain accessors, KHR_mesh_quantization's integer positions); points and lines,
+// sparse accessors and other required extensions (e.g. EXT_meshopt_compression) are refused
+// with an io::Error naming the file and the mesh, primitive or extension.
+#pragma once
+
+#include "io/format.hpp"
+
+#include <cstdint>
+#include <optional>
+#include <span>
+
+namespace meshstream::io {
+
+extern const Format kGlbFormat;   // "glb": binary glTF
+extern const Format kGltfFormat;  // "gltf": JSON glTF with a .bin side file
+
+// True for the GLB magic "glTF".
+bool probe_glb(std::span<const std::byte> head, std::optional<uint64_t> file_size);
+// True when the head is a JSON object that mentions "asset" (a glTF document's required key).
+bool probe_gltf_json(std::span<const std::byte> head, std::optional<uint64_t> file_size);
+
+}  // namespace meshstream::io
