@@ -2,6 +2,8 @@
 // Order is probe priority: formats with unambiguous magic first, STL (which has none) last.
 #include "io/error.hpp"
 #include "io/format.hpp"
+#include "io/obj.hpp"
+#include "io/ply.hpp"
 #include "io/stl.hpp"
 #if MESHSTREAM_WITH_DRACO
 #include "io/draco.hpp"
@@ -24,6 +26,9 @@ constexpr const Format* kFormats[] = {
     &kGlbFormat,
     &kGltfFormat,
 #endif
+    &kPlyFormat,
+    &kPlyAsciiFormat,
+    &kObjFormat,
     &kStlFormat,
     &kStlAsciiFormat,
 };

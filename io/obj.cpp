@@ -1,0 +1,282 @@
+// OBJ reader and writer: line-based parsing from the ByteSource window (lines up to 1 MiB,
+// `\` continuations joined in a scratch string), numbers with std::from_chars, as fast_obj
+// does with its 64 KiB refill loop; the writer spools through io::Welder.
+#include "io/obj.hpp"
+
+#include "io/error.hpp"
+#include "io/vertex_table.hpp"
+#include "io/weld.hpp"
+
+#include <charconv>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+#include <vector>
+
+namespace meshstream::io {
+namespace {
+
+constexpr std::string_view kSortMarker = "meshstream sorted-axis=";
+
+bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
+
+// Splits off the next blank-separated word of `rest`.
+std::string_view next_word(std::string_view& rest) {
+    size_t i = 0;
+    while (i < rest.size() && is_space(rest[i])) ++i;
+    size_t j = i;
+    while (j < rest.size() && !is_space(rest[j])) ++j;
+    std::string_view w = rest.substr(i, j - i);
+    rest.remove_prefix(j);
+    return w;
+}
+
+class ObjReader : public Reader {
+public:
+    ObjReader(ByteSource& source, const ReadOptions& options)
+        : src_(source), options_(options), table_(options.memory_budget_bytes, options.tmpdir, false) {
+        header_.channels.vertex_id = true;
+    }
+
+    bool next(TriangleChunk& chunk) override {
+        chunk.clear();
+        for (;;) {
+            if (fan_next_ + 1 < polygon_.size() && !emit_fan(table_, polygon_, &fan_next_, chunk)) return true;
+            if (chunk.full()) return true;
+            if (!next_statement()) return !chunk.empty();
+        }
+    }
+
+private:
+    [[noreturn]] void fail(const std::string& message) const {
+        throw Error(src_.name(), line_offset_, line_no_, message);
+    }
+
+    // Reads the next logical line into line_; false at the end of the input.
+    bool next_line() {
+        scratch_.clear();
+        bool joined = false;
+        for (;;) {
+            auto w = src_.window();
+            if (w.empty()) {
+                if (!joined) return false;
+                line_ = scratch_;
+                return true;
+            }
+            const char* p = reinterpret_cast<const char*>(w.data());
+            const void* nl = std::memchr(p, '\n', w.size());
+            if (!nl && w.size() < ByteSource::kBufferBytes) {
+                w = src_.peek(ByteSource::kBufferBytes);
+                p = reinterpret_cast<const char*>(w.data());
+                nl = std::memchr(p, '\n', w.size());
+            }
+            if (!joined) {
+                line_offset_ = src_.offset();
+                line_no_ = physical_lines_ + 1;
+            }
+            if (!nl && w.size() >= ByteSource::kBufferBytes) {
+                line_no_ = physical_lines_ + 1;
+                fail("line longer than 1 MiB");
+            }
+            size_t len = nl ? static_cast<size_t>(static_cast<const char*>(nl) - p) : w.size();
+            std::string_view view(p, len);
+            src_.consume(nl ? len + 1 : len);
+            ++physical_lines_;
+            while (!view.empty() && is_space(view.back())) view.remove_suffix(1);
+            if (!view.empty() && view.back() == '\\') {  // continuation: join with the next line
+                view.remove_suffix(1);
+                scratch_.append(view);
+                scratch_ += ' ';
+                joined = true;
+                continue;
+            }
+            if (joined) {
+                scratch_.append(view);
+                line_ = scratch_;
+            } else {
+                line_ = view;
+            }
+            return true;
+        }
+    }
+
+    // Handles one statement; a face leaves its polygon in polygon_. False at the end.
+    bool next_statement() {
+        for (;;) {
+            if (!next_line()) return false;
+            std::string_view rest = line_;
+            std::string_view key = next_word(rest);
+            if (key.empty()) continue;
+            if (key[0] == '#') {
+                size_t at = line_.find(kSortMarker);
+                if (at != std::string_view::npos && at + kSortMarker.size() < line_.size()) {
+                    char axis = line_[at + kSortMarker.size()];
+                    if (axis >= 'x' && axis <= 'z') header_.sorted_axis = axis - 'x';
+                }
+                continue;
+            }
+            if (key == "v") {
+                float xyz[3];
+                for (int a = 0; a < 3; ++a) xyz[a] = parse_float(next_word(rest), a);
+                table_.append(xyz, nullptr);
+                continue;
+            }
+            if (key == "f") {
+                read_face(rest);
+                return true;
+            }
+            // vt vn vp g o s usemtl mtllib l p and anything else: not geometry we keep.
+        }
+    }
+
+    float parse_float(std::string_view tok, int axis) const {
+        if (tok.empty()) fail("'v' needs 3 coordinates, found " + std::to_string(axis));
+        const char* b = tok.data();
+        const char* e = b + tok.size();
+        if (*b == '+') ++b;
+        float v = 0;
+        auto [p, ec] = std::from_chars(b, e, v);
+        if (ec == std::errc::result_out_of_range) v = std::strtof(std::string(tok).c_str(), nullptr);
+        else if (ec != std::errc() || p != e) fail("expected a coordinate, found " + quote_token(tok));
+        return v;
+    }
+
+    void read_face(std::string_view rest) {
+        polygon_.clear();
+        fan_next_ = 1;
+        const uint64_t defined = table_.size();
+        for (;;) {
+            std::string_view tok = next_word(rest);
+            if (tok.empty()) break;
+            // "i", "i/t", "i//n", "i/t/n": the position index comes first.
+            std::string_view num = tok.substr(0, tok.find('/'));
+            const char* b = num.data();
+            const char* e = b + num.size();
+            if (b != e && *b == '+') ++b;
+            int64_t index = 0;
+            auto [p, ec] = std::from_chars(b, e, index);
+            if (ec != std::errc() || p != e) fail("expected a vertex index, found " + quote_token(tok));
+            if (index == 0) fail("vertex index 0 is invalid (OBJ indices start at 1)");
+            int64_t zero_based = index > 0 ? index - 1 : static_cast<int64_t>(defined) + index;
+            if (zero_based < 0 || static_cast<uint64_t>(zero_based) >= defined)
+                fail("vertex index " + std::to_string(index) + " refers past the " + std::to_string(defined) +
+                     " vertices defined so far");
+            polygon_.push_back(static_cast<uint64_t>(zero_based));
+        }
+        if (polygon_.size() < 3 && options_.strict)
+            fail("face with " + std::to_string(polygon_.size()) + " vertices (--strict)");
+    }
+
+    ByteSource& src_;
+    ReadOptions options_;
+    VertexTable table_;
+    std::string scratch_;
+    std::string_view line_;
+    uint64_t line_no_ = 0, physical_lines_ = 0, line_offset_ = 0;
+    std::vector<uint64_t> polygon_;
+    size_t fan_next_ = 1;
+};
+
+class ObjWriter : public Writer {
+public:
+    ObjWriter(ByteSink& sink, const WriteOptions& options)
+        : sink_(sink), options_(options), welder_(options.memory_budget_bytes, options.tmpdir, sink.name()) {}
+
+    void write(const TriangleChunk& chunk) override { welder_.add(chunk); }
+
+    void finish() override {
+        welder_.finish();
+        std::string out = "# generated by meshstream\n";
+        if (options_.sorted_axis) out += "# " + std::string(kSortMarker) + char('x' + *options_.sorted_axis) + "\n";
+        std::string_view text = options_.comment;
+        while (!text.empty()) {
+            size_t nl = text.find('\n');
+            out += "# " + std::string(text.substr(0, nl)) + "\n";
+            if (nl == std::string_view::npos) break;
+            text.remove_prefix(nl + 1);
+        }
+        std::vector<WeldedVertex> vs(8192);
+        while (size_t n = welder_.next_vertices(vs)) {
+            for (size_t i = 0; i < n; ++i) {
+                out += 'v';
+                for (int a = 0; a < 3; ++a) {
+                    out += ' ';
+                    append_number(out, vs[i].xyz[a]);
+                }
+                out += '\n';
+            }
+            flush(out);
+        }
+        std::vector<uint32_t> idx(3 * 8192);
+        while (size_t n = welder_.next_indices(idx)) {
+            for (size_t t = 0; t + 2 < n; t += 3) {
+                out += 'f';
+                for (int k = 0; k < 3; ++k) {
+                    out += ' ';
+                    append_number(out, uint64_t{idx[t + k]} + 1);
+                }
+                out += '\n';
+            }
+            flush(out);
+        }
+        flush(out);
+    }
+
+private:
+    template <class N>
+    static void append_number(std::string& out, N v) {
+        char buf[32];
+        out.append(buf, std::to_chars(buf, buf + sizeof buf, v).ptr);  // shortest round-trip form
+    }
+    void flush(std::string& out) {
+        sink_.write(out);
+        out.clear();
+    }
+
+    ByteSink& sink_;
+    WriteOptions options_;
+    Welder welder_;
+};
+
+std::unique_ptr<Reader> open_obj_reader(ByteSource& source, const ReadOptions& options) {
+    return std::make_unique<ObjReader>(source, options);
+}
+
+std::unique_ptr<Writer> open_obj_writer(ByteSink& sink, const WriteOptions& options) {
+    return std::make_unique<ObjWriter>(sink, options);
+}
+
+}  // namespace
+
+bool probe_obj(std::span<const std::byte> head, std::optional<uint64_t>) {
+    if (head.empty()) return false;
+    for (std::byte b : head) {
+        unsigned char c = static_cast<unsigned char>(b);
+        if (c < 0x20 && c != '\t' && c != '\n' && c != '\r' && c != '\v' && c != '\f') return false;  // binary
+    }
+    std::string_view text(reinterpret_cast<const char*>(head.data()), head.size());
+    static constexpr std::string_view kKeywords[] = {"v", "vt", "vn", "vp", "f", "o", "g", "s", "usemtl", "mtllib", "l", "p"};
+    while (!text.empty()) {
+        size_t nl = text.find('\n');
+        std::string_view line = text.substr(0, nl);
+        text = nl == std::string_view::npos ? std::string_view() : text.substr(nl + 1);
+        std::string_view rest = line;
+        std::string_view key = next_word(rest);
+        if (key.empty() || key[0] == '#') continue;
+        for (std::string_view k : kKeywords)
+            if (key == k) return true;
+        return false;
+    }
+    return true;  // only comments and blank lines
+}
+
+const Format kObjFormat = {
+    "obj",
+    "obj",
+    "Wavefront OBJ (geometry: v and f)",
+    &probe_obj,
+    &open_obj_reader,
+    &open_obj_writer,
+};
+
+}  // namespace meshstream::io

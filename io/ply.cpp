@@ -1,0 +1,701 @@
+// PLY reader and writer. The header is parsed line by line (CRLF and trailing blanks allowed);
+// the body is decoded from the ByteSource's window with explicit byte-order helpers (binary) or
+// whitespace-separated tokens parsed with std::from_chars (ascii), the way miniply walks its
+// refill buffer. Based on Greg Turk's PLY description and the quirks seen in PDAL's PlyReader
+// and happly: type aliases (float32, uint8, ...), `vertex_index` as well as `vertex_indices`,
+// elements in any order around vertex and face.
+#include "io/ply.hpp"
+
+#include "io/error.hpp"
+#include "io/vertex_table.hpp"
+#include "io/weld.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace meshstream::io {
+namespace {
+
+constexpr std::string_view kSortMarker = "meshstream sorted-axis=";
+constexpr size_t kMaxTokenBytes = 4096;
+
+enum class PlyType : uint8_t { kInt8, kUint8, kInt16, kUint16, kInt32, kUint32, kFloat32, kFloat64 };
+
+size_t type_size(PlyType t) {
+    switch (t) {
+        case PlyType::kInt8: case PlyType::kUint8: return 1;
+        case PlyType::kInt16: case PlyType::kUint16: return 2;
+        case PlyType::kInt32: case PlyType::kUint32: case PlyType::kFloat32: return 4;
+        case PlyType::kFloat64: return 8;
+    }
+    return 0;
+}
+
+bool is_float_type(PlyType t) { return t == PlyType::kFloat32 || t == PlyType::kFloat64; }
+
+std::optional<PlyType> type_from_name(std::string_view s) {
+    if (s == "char" || s == "int8") return PlyType::kInt8;
+    if (s == "uchar" || s == "uint8") return PlyType::kUint8;
+    if (s == "short" || s == "int16") return PlyType::kInt16;
+    if (s == "ushort" || s == "uint16") return PlyType::kUint16;
+    if (s == "int" || s == "int32") return PlyType::kInt32;
+    if (s == "uint" || s == "uint32") return PlyType::kUint32;
+    if (s == "float" || s == "float32") return PlyType::kFloat32;
+    if (s == "double" || s == "float64") return PlyType::kFloat64;
+    return std::nullopt;
+}
+
+enum class Encoding { kAscii, kBinaryLittle, kBinaryBig };
+
+struct Property {
+    std::string name;
+    PlyType type = PlyType::kFloat32;
+    bool is_list = false;
+    PlyType count_type = PlyType::kUint8;
+};
+
+struct Element {
+    std::string name;
+    uint64_t count = 0;
+    std::vector<Property> props;
+    // Bytes per item in binary when no property is a list, else 0.
+    size_t fixed_bytes() const {
+        size_t n = 0;
+        for (const Property& p : props) {
+            if (p.is_list) return 0;
+            n += type_size(p.type);
+        }
+        return n;
+    }
+};
+
+bool is_blank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\v' || c == '\f'; }
+
+std::vector<std::string_view> split_words(std::string_view line) {
+    std::vector<std::string_view> words;
+    size_t i = 0;
+    while (i < line.size()) {
+        while (i < line.size() && is_blank(line[i])) ++i;
+        size_t start = i;
+        while (i < line.size() && !is_blank(line[i])) ++i;
+        if (i > start) words.push_back(line.substr(start, i - start));
+    }
+    return words;
+}
+
+uint8_t to_color(double v, PlyType t) {
+    if (is_float_type(t)) v = std::round(std::clamp(v, 0.0, 1.0) * 255.0);
+    else if (t == PlyType::kUint16 || t == PlyType::kInt16) v = std::round(v / 257.0);
+    if (!(v >= 0)) return 0;
+    return static_cast<uint8_t>(std::min(v, 255.0));
+}
+
+// ---------------- reader ----------------
+
+class PlyReader : public Reader {
+public:
+    PlyReader(ByteSource& source, const ReadOptions& options) : src_(source), options_(options) {
+        parse_header();
+        read_up_to_faces();
+    }
+
+    bool next(TriangleChunk& chunk) override {
+        chunk.clear();
+        for (;;) {
+            if (fan_next_ + 1 < polygon_.size()) {
+                if (!emit_fan(*table_, polygon_, &fan_next_, chunk)) return true;
+            }
+            if (chunk.full()) return true;
+            // Elements after the faces carry nothing we use and are not read: real files get
+            // them wrong (CGAL's colored_tetra.ply promises 3 properties per 'edge', writes 2).
+            if (face_ < 0 || item_ == elements_[static_cast<size_t>(face_)].count) return !chunk.empty();
+            read_face();
+        }
+    }
+
+private:
+    // ---- header ----
+    std::string header_line() {
+        for (;;) {
+            auto w = src_.window();
+            const char* p = reinterpret_cast<const char*>(w.data());
+            const void* nl = std::memchr(p, '\n', w.size());
+            if (!nl && w.size() < ByteSource::kBufferBytes) {
+                w = src_.peek(ByteSource::kBufferBytes);
+                p = reinterpret_cast<const char*>(w.data());
+                nl = std::memchr(p, '\n', w.size());
+            }
+            if (!nl) {
+                if (w.size() >= ByteSource::kBufferBytes) header_fail("header line longer than 1 MiB");
+                header_fail("file ends inside the header (no end_header line)");
+            }
+            size_t len = static_cast<size_t>(static_cast<const char*>(nl) - p);
+            std::string line(p, len);
+            src_.consume(len + 1);
+            ++line_;
+            while (!line.empty() && is_blank(line.back())) line.pop_back();
+            return line;
+        }
+    }
+
+    [[noreturn]] void header_fail(const std::string& message) const {
+        throw Error(src_.name(), Error::kNoOffset, line_ + 1, message);
+    }
+
+    void parse_header() {
+        std::string magic = header_line();
+        if (magic != "ply") throw Error(src_.name(), 0, 0, "not a PLY file (first line is " + quote_token(magic) + ")");
+        bool have_format = false;
+        for (;;) {
+            uint64_t line_start = src_.offset();
+            std::string line = header_line();
+            auto words = split_words(line);
+            if (words.empty()) continue;
+            std::string_view key = words[0];
+            auto bad = [&](const std::string& what) {
+                throw Error(src_.name(), line_start, line_, what + " in header line " + quote_token(line));
+            };
+            if (key == "end_header") break;
+            if (key == "comment" || key == "obj_info") {
+                size_t at = line.find(kSortMarker);
+                if (at != std::string::npos && at + kSortMarker.size() < line.size()) {
+                    char axis = line[at + kSortMarker.size()];
+                    if (axis >= 'x' && axis <= 'z') header_.sorted_axis = axis - 'x';
+                }
+                continue;
+            }
+            if (key == "format") {
+                if (words.size() < 2) bad("missing encoding");
+                if (words[1] == "ascii") encoding_ = Encoding::kAscii;
+                else if (words[1] == "binary_little_endian") encoding_ = Encoding::kBinaryLittle;
+                else if (words[1] == "binary_big_endian") encoding_ = Encoding::kBinaryBig;
+                else bad("unknown format " + quote_token(words[1]));
+                header_.variant = std::string(words[1]);
+                have_format = true;
+            } else if (key == "element") {
+                if (words.size() != 3) bad("expected 'element <name> <count>'");
+                Element e;
+                e.name = std::string(words[1]);
+                auto [p, ec] = std::from_chars(words[2].data(), words[2].data() + words[2].size(), e.count);
+                if (ec != std::errc() || p != words[2].data() + words[2].size()) bad("bad element count");
+                elements_.push_back(std::move(e));
+            } else if (key == "property") {
+                if (elements_.empty()) bad("property before any element");
+                Property prop;
+                if (words.size() == 5 && words[1] == "list") {
+                    auto ct = type_from_name(words[2]);
+                    auto it = type_from_name(words[3]);
+                    if (!ct || !it || is_float_type(*ct)) bad("bad list types");
+                    prop.is_list = true;
+                    prop.count_type = *ct;
+                    prop.type = *it;
+                    prop.name = std::string(words[4]);
+                } else if (words.size() == 3) {
+                    auto t = type_from_name(words[1]);
+                    if (!t) bad("unknown property type " + quote_token(words[1]));
+                    prop.type = *t;
+                    prop.name = std::string(words[2]);
+                } else {
+                    bad("expected 'property <type> <name>' or 'property list <count type> <type> <name>'");
+                }
+                elements_.back().props.push_back(std::move(prop));
+            } else {
+                bad("unknown keyword " + quote_token(key));
+            }
+        }
+        if (!have_format) throw Error(src_.name(), Error::kNoOffset, line_, "PLY header has no 'format' line");
+        swap_ = (encoding_ == Encoding::kBinaryBig) == (std::endian::native == std::endian::little);
+
+        for (size_t i = 0; i < elements_.size(); ++i) {
+            if (elements_[i].name == "vertex" && vertex_ < 0) vertex_ = static_cast<int>(i);
+            if (elements_[i].name == "face" && face_ < 0) face_ = static_cast<int>(i);
+        }
+        if (face_ >= 0) {
+            const Element& f = elements_[static_cast<size_t>(face_)];
+            for (size_t p = 0; p < f.props.size(); ++p)
+                if (f.props[p].is_list && (f.props[p].name == "vertex_indices" || f.props[p].name == "vertex_index"))
+                    index_prop_ = static_cast<int>(p);
+            if (index_prop_ < 0 && f.count > 0)
+                throw Error(src_.name(), Error::kNoOffset, line_,
+                            "face element has no list property 'vertex_indices' or 'vertex_index'");
+            if (f.count > 0 && vertex_ < 0)
+                throw Error(src_.name(), Error::kNoOffset, line_, "faces but no vertex element");
+            if (f.count > 0 && face_ < vertex_)
+                throw Error(src_.name(), Error::kNoOffset, line_,
+                            "face element before the vertex element is not supported");
+        }
+        if (vertex_ >= 0) {
+            const Element& v = elements_[static_cast<size_t>(vertex_)];
+            for (size_t p = 0; p < v.props.size(); ++p) {
+                const std::string& n = v.props[p].name;
+                int slot = n == "x" ? 0 : n == "y" ? 1 : n == "z" ? 2 : n == "red" ? 3 : n == "green" ? 4 : n == "blue" ? 5 : -1;
+                if (slot >= 0 && !v.props[p].is_list) vertex_props_[slot] = static_cast<int>(p);
+            }
+            for (int a = 0; a < 3; ++a)
+                if (vertex_props_[a] < 0)
+                    throw Error(src_.name(), Error::kNoOffset, line_,
+                                std::string("vertex element has no property '") + char('x' + a) + "'");
+            header_.vertex_count = v.count;
+        }
+        has_color_ = vertex_props_[3] >= 0 && vertex_props_[4] >= 0 && vertex_props_[5] >= 0;
+        header_.channels.vertex_id = true;
+        header_.channels.color = has_color_;
+        uint64_t faces = face_ >= 0 ? elements_[static_cast<size_t>(face_)].count : 0;
+        if (faces == 0) header_.triangle_count = 0;
+        header_.notes.emplace_back("faces", std::to_string(faces));
+    }
+
+    // ---- body primitives ----
+    [[noreturn]] void item_fail(uint64_t offset, const std::string& message) const {
+        const Element& e = elements_[element_];
+        throw Error(src_.name(), offset, encoding_ == Encoding::kAscii ? line_ + 1 : 0,
+                    "element '" + e.name + "' item " + std::to_string(item_) + ": " + message);
+    }
+
+    [[noreturn]] void truncated() const {
+        const Element& e = elements_[element_];
+        item_fail(src_.offset(), "file ends early (header promises " + std::to_string(e.count) + " " + e.name +
+                                     " items)");
+    }
+
+    const std::byte* need(size_t n) {
+        auto s = src_.peek(n);
+        if (s.size() < n) truncated();
+        return s.data();
+    }
+
+    template <class U>
+    U load(const std::byte* p) const {
+        U v;
+        std::memcpy(&v, p, sizeof v);
+        if (swap_) {
+            if constexpr (sizeof(U) == 2) v = std::bit_cast<U>(__builtin_bswap16(std::bit_cast<uint16_t>(v)));
+            if constexpr (sizeof(U) == 4) v = std::bit_cast<U>(__builtin_bswap32(std::bit_cast<uint32_t>(v)));
+            if constexpr (sizeof(U) == 8) v = std::bit_cast<U>(__builtin_bswap64(std::bit_cast<uint64_t>(v)));
+        }
+        return v;
+    }
+
+    double decode(const std::byte* p, PlyType t) const {
+        switch (t) {
+            case PlyType::kInt8: return load<int8_t>(p);
+            case PlyType::kUint8: return load<uint8_t>(p);
+            case PlyType::kInt16: return load<int16_t>(p);
+            case PlyType::kUint16: return load<uint16_t>(p);
+            case PlyType::kInt32: return load<int32_t>(p);
+            case PlyType::kUint32: return load<uint32_t>(p);
+            case PlyType::kFloat32: return load<float>(p);
+            case PlyType::kFloat64: return load<double>(p);
+        }
+        return 0;
+    }
+
+    int64_t decode_int(const std::byte* p, PlyType t) const {
+        switch (t) {
+            case PlyType::kInt8: return load<int8_t>(p);
+            case PlyType::kUint8: return load<uint8_t>(p);
+            case PlyType::kInt16: return load<int16_t>(p);
+            case PlyType::kUint16: return load<uint16_t>(p);
+            case PlyType::kInt32: return load<int32_t>(p);
+            case PlyType::kUint32: return load<uint32_t>(p);
+            case PlyType::kFloat32: return static_cast<int64_t>(load<float>(p));
+            case PlyType::kFloat64: return static_cast<int64_t>(load<double>(p));
+        }
+        return 0;
+    }
+
+    // Next whitespace-separated ascii token (its offset in token_offset_).
+    std::string_view token() {
+        for (;;) {
+            auto w = src_.window();
+            if (w.empty()) truncated();
+            const char* p = reinterpret_cast<const char*>(w.data());
+            size_t i = 0;
+            while (i < w.size() && is_blank(p[i])) {
+                if (p[i] == '\n') ++line_;
+                ++i;
+            }
+            src_.consume(i);
+            if (i < w.size()) break;
+        }
+        auto w = src_.window();
+        const char* p = reinterpret_cast<const char*>(w.data());
+        size_t j = 0;
+        while (j < w.size() && !is_blank(p[j])) ++j;
+        if (j == w.size()) {  // the token may continue past the buffered bytes
+            w = src_.peek(kMaxTokenBytes);
+            p = reinterpret_cast<const char*>(w.data());
+            j = 0;
+            while (j < w.size() && !is_blank(p[j])) ++j;
+            if (j == kMaxTokenBytes) item_fail(src_.offset(), "token longer than 4 KiB");
+        }
+        token_offset_ = src_.offset();
+        src_.consume(j);
+        return {p, j};
+    }
+
+    double parse_number(std::string_view tok) const {
+        const char* b = tok.data();
+        const char* e = b + tok.size();
+        if (b != e && *b == '+') ++b;
+        double v = 0;
+        auto [p, ec] = std::from_chars(b, e, v);
+        if (ec == std::errc::result_out_of_range) {
+            // Subnormal or huge: keep strtod's value (from_chars leaves v unchanged here).
+            v = std::strtod(std::string(tok).c_str(), nullptr);
+        } else if (ec != std::errc() || p != e) {
+            item_fail(token_offset_, "expected a number, found " + quote_token(tok));
+        }
+        return v;
+    }
+
+    float parse_float(std::string_view tok) const {
+        const char* b = tok.data();
+        const char* e = b + tok.size();
+        if (b != e && *b == '+') ++b;
+        float v = 0;
+        auto [p, ec] = std::from_chars(b, e, v);
+        if (ec == std::errc::result_out_of_range) v = std::strtof(std::string(tok).c_str(), nullptr);
+        else if (ec != std::errc() || p != e) item_fail(token_offset_, "expected a number, found " + quote_token(tok));
+        return v;
+    }
+
+    int64_t parse_integer(std::string_view tok) const {
+        const char* b = tok.data();
+        const char* e = b + tok.size();
+        if (b != e && *b == '+') ++b;
+        int64_t v = 0;
+        auto [p, ec] = std::from_chars(b, e, v);
+        if (ec == std::errc() && p == e) return v;
+        double d = parse_number(tok);
+        if (d != std::floor(d) || !(std::fabs(d) < 9e18)) item_fail(token_offset_, "expected an integer, found " + quote_token(tok));
+        return static_cast<int64_t>(d);
+    }
+
+    double read_scalar(PlyType t) {
+        if (encoding_ == Encoding::kAscii) return parse_number(token());
+        size_t n = type_size(t);
+        double v = decode(need(n), t);
+        src_.consume(n);
+        return v;
+    }
+
+    int64_t read_integer(PlyType t) {
+        if (encoding_ == Encoding::kAscii) return parse_integer(token());
+        size_t n = type_size(t);
+        token_offset_ = src_.offset();
+        int64_t v = decode_int(need(n), t);
+        src_.consume(n);
+        return v;
+    }
+
+    int64_t read_count(const Property& p) {
+        int64_t n = read_integer(p.count_type);
+        if (n < 0) item_fail(token_offset_, "negative list length " + std::to_string(n) + " in '" + p.name + "'");
+        return n;
+    }
+
+    void skip_property(const Property& p) {
+        if (!p.is_list) {
+            read_scalar(p.type);
+            return;
+        }
+        int64_t n = read_count(p);
+        if (encoding_ == Encoding::kAscii) {
+            for (int64_t i = 0; i < n; ++i) parse_number(token());
+        } else {
+            uint64_t bytes = uint64_t(n) * type_size(p.type);
+            if (src_.skip(bytes) != bytes) truncated();
+        }
+    }
+
+    void skip_element(size_t index) {
+        element_ = index;
+        const Element& e = elements_[index];
+        size_t fixed = e.fixed_bytes();
+        if (encoding_ != Encoding::kAscii && fixed > 0) {
+            uint64_t bytes = e.count * fixed;
+            uint64_t got = src_.skip(bytes);
+            if (got != bytes) {
+                item_ = got / fixed;
+                truncated();
+            }
+            return;
+        }
+        for (item_ = 0; item_ < e.count; ++item_)
+            for (const Property& p : e.props) skip_property(p);
+    }
+
+    // ---- vertices ----
+    // Reads (or skips) the elements before the faces; the faces then stream from next().
+    void read_up_to_faces() {
+        for (size_t i = 0; i < elements_.size(); ++i) {
+            element_ = i;
+            item_ = 0;
+            if (static_cast<int>(i) == face_) return;
+            if (static_cast<int>(i) == vertex_) {
+                read_vertices(i);
+                if (face_ < 0) return;  // a point cloud: nothing more to read
+            } else {
+                skip_element(i);
+            }
+        }
+    }
+
+    void read_vertices(size_t index) {
+        element_ = index;
+        const Element& e = elements_[index];
+        size_t fixed = e.fixed_bytes();
+        const uint64_t budget = options_.memory_budget_bytes;
+        // A plain file in host byte order with float x, y, z (and uchar colour) is mapped as is.
+        bool direct = encoding_ != Encoding::kAscii && !swap_ && fixed > 0 && !src_.regular_file_path().empty();
+        size_t offsets[6] = {};
+        for (int s = 0; s < 6; ++s) {
+            if (vertex_props_[s] < 0) continue;
+            for (int p = 0; p < vertex_props_[s]; ++p) offsets[s] += type_size(e.props[static_cast<size_t>(p)].type);
+            PlyType t = e.props[static_cast<size_t>(vertex_props_[s])].type;
+            if (s < 3 && t != PlyType::kFloat32) direct = false;
+            if (s >= 3 && has_color_ && t != PlyType::kUint8) direct = false;
+        }
+        if (direct) {
+            uint64_t start = src_.offset();
+            uint64_t bytes = e.count * fixed;
+            uint64_t got = src_.skip(bytes);  // also proves the block is all there
+            if (got != bytes) {
+                item_ = got / fixed;
+                truncated();
+            }
+            const size_t xyz[3] = {offsets[0], offsets[1], offsets[2]};
+            table_ = VertexTable::map_input_file(src_.regular_file_path(), start, e.count, fixed, xyz,
+                                                 has_color_ ? offsets + 3 : nullptr, budget);
+            header_.notes.emplace_back("vertex table", "input file, mapped");
+            return;
+        }
+        table_ = std::make_unique<VertexTable>(budget, options_.tmpdir, has_color_);
+        double values[6] = {0, 0, 0, 0, 0, 0};
+        float xyz[3];
+        uint8_t rgb[3];
+        for (item_ = 0; item_ < e.count; ++item_) {
+            if (fixed > 0 && encoding_ != Encoding::kAscii) {
+                const std::byte* rec = need(fixed);
+                for (int s = 0; s < 6; ++s)
+                    if (vertex_props_[s] >= 0)
+                        values[s] = decode(rec + offsets[s], e.props[static_cast<size_t>(vertex_props_[s])].type);
+                src_.consume(fixed);
+            } else {
+                for (size_t p = 0; p < e.props.size(); ++p) {
+                    const Property& prop = e.props[p];
+                    int slot = -1;
+                    for (int s = 0; s < 6; ++s)
+                        if (vertex_props_[s] == static_cast<int>(p)) slot = s;
+                    if (slot >= 0 && slot < 3 && encoding_ == Encoding::kAscii)
+                        values[slot] = parse_float(token());  // decimal -> float directly: no double rounding
+                    else if (slot >= 0)
+                        values[slot] = read_scalar(prop.type);
+                    else skip_property(prop);
+                }
+            }
+            for (int a = 0; a < 3; ++a) xyz[a] = static_cast<float>(values[a]);
+            if (has_color_)
+                for (int a = 0; a < 3; ++a)
+                    rgb[a] = to_color(values[3 + a], e.props[static_cast<size_t>(vertex_props_[3 + a])].type);
+            table_->append(xyz, has_color_ ? rgb : nullptr);
+        }
+        header_.notes.emplace_back("vertex table", table_->storage() == VertexTable::Storage::kMemory
+                                                       ? "in memory"
+                                                       : "temporary file, mapped");
+    }
+
+    // ---- faces ----
+    void read_face() {
+        const Element& e = elements_[static_cast<size_t>(face_)];
+        polygon_.clear();
+        fan_next_ = 1;
+        for (size_t p = 0; p < e.props.size(); ++p) {
+            const Property& prop = e.props[p];
+            if (static_cast<int>(p) != index_prop_) {
+                skip_property(prop);
+                continue;
+            }
+            int64_t n = read_count(prop);
+            const uint64_t vertices = table_->size();
+            for (int64_t k = 0; k < n; ++k) {
+                int64_t index = read_integer(prop.type);
+                if (index < 0 || static_cast<uint64_t>(index) >= vertices)
+                    item_fail(token_offset_, "vertex index " + std::to_string(index) + " out of range (" +
+                                                 std::to_string(vertices) + " vertices)");
+                polygon_.push_back(static_cast<uint64_t>(index));
+            }
+            if (n < 3 && options_.strict)
+                item_fail(token_offset_, "face with " + std::to_string(n) + " vertices (--strict)");
+        }
+        ++item_;
+    }
+
+
+    ByteSource& src_;
+    ReadOptions options_;
+    Encoding encoding_ = Encoding::kAscii;
+    bool swap_ = false;
+    uint64_t line_ = 0;  // lines consumed (header; ascii body)
+    std::vector<Element> elements_;
+    int vertex_ = -1, face_ = -1, index_prop_ = -1;
+    int vertex_props_[6] = {-1, -1, -1, -1, -1, -1};  // x y z red green blue
+    bool has_color_ = false;
+    size_t element_ = 0;  // element being read (for messages)
+    uint64_t item_ = 0;   // item number within it
+    uint64_t token_offset_ = 0;
+    std::unique_ptr<VertexTable> table_;
+    std::vector<uint64_t> polygon_;
+    size_t fan_next_ = 1;
+};
+
+// ---------------- writer ----------------
+
+class PlyWriter : public Writer {
+public:
+    PlyWriter(ByteSink& sink, const WriteOptions& options, bool ascii)
+        : sink_(sink), options_(options), ascii_(ascii),
+          welder_(options.memory_budget_bytes, options.tmpdir, sink.name()) {}
+
+    void write(const TriangleChunk& chunk) override { welder_.add(chunk); }
+
+    void finish() override {
+        welder_.finish();
+        const uint64_t vertices = welder_.vertex_count();
+        if (vertices > 0x7fffffffULL)
+            throw Error(sink_.name(), "PLY int indices hold at most 2^31 - 1 vertices, the mesh has " +
+                                          std::to_string(vertices));
+        const bool color = welder_.color();
+        std::string h = "ply\nformat ";
+        h += ascii_ ? "ascii 1.0\n" : "binary_little_endian 1.0\n";
+        h += "comment generated by meshstream\n";
+        if (options_.sorted_axis) h += "comment " + std::string(kSortMarker) + char('x' + *options_.sorted_axis) + "\n";
+        std::string_view text = options_.comment;
+        while (!text.empty()) {
+            size_t nl = text.find('\n');
+            h += "comment " + std::string(text.substr(0, nl)) + "\n";
+            if (nl == std::string_view::npos) break;
+            text.remove_prefix(nl + 1);
+        }
+        h += "element vertex " + std::to_string(vertices) + "\n";
+        h += "property float x\nproperty float y\nproperty float z\n";
+        if (color) h += "property uchar red\nproperty uchar green\nproperty uchar blue\n";
+        h += "element face " + std::to_string(welder_.triangle_count()) + "\n";
+        h += "property list uchar int vertex_indices\nend_header\n";
+        sink_.write(h);
+
+        std::vector<WeldedVertex> vs(8192);
+        std::string out;
+        out.reserve(size_t{1} << 20);
+        while (size_t n = welder_.next_vertices(vs)) {
+            for (size_t i = 0; i < n; ++i) {
+                const WeldedVertex& v = vs[i];
+                if (ascii_) {
+                    for (int a = 0; a < 3; ++a) {
+                        if (a) out += ' ';
+                        append_number(out, v.xyz[a]);
+                    }
+                    if (color)
+                        for (int a = 0; a < 3; ++a) {
+                            out += ' ';
+                            append_number(out, unsigned{v.rgb[a]});
+                        }
+                    out += '\n';
+                } else {
+                    char buf[15];
+                    for (int a = 0; a < 3; ++a) store_le(buf + 4 * a, std::bit_cast<uint32_t>(v.xyz[a]));
+                    std::memcpy(buf + 12, v.rgb, 3);
+                    out.append(buf, color ? 15 : 12);
+                }
+            }
+            flush(out);
+        }
+        std::vector<uint32_t> idx(3 * 8192);
+        while (size_t n = welder_.next_indices(idx)) {
+            for (size_t t = 0; t + 2 < n; t += 3) {
+                if (ascii_) {
+                    out += '3';
+                    for (int k = 0; k < 3; ++k) {
+                        out += ' ';
+                        append_number(out, idx[t + k]);
+                    }
+                    out += '\n';
+                } else {
+                    char buf[13];
+                    buf[0] = 3;
+                    for (int k = 0; k < 3; ++k) store_le(buf + 1 + 4 * k, idx[t + k]);
+                    out.append(buf, 13);
+                }
+            }
+            flush(out);
+        }
+        flush(out);
+    }
+
+private:
+    template <class N>
+    static void append_number(std::string& out, N v) {
+        char buf[32];
+        out.append(buf, std::to_chars(buf, buf + sizeof buf, v).ptr);  // shortest round-trip form
+    }
+    static void store_le(char* p, uint32_t v) {
+        for (int i = 0; i < 4; ++i) p[i] = static_cast<char>((v >> (8 * i)) & 0xff);
+    }
+    void flush(std::string& out) {
+        sink_.write(out);
+        out.clear();
+    }
+
+    ByteSink& sink_;
+    WriteOptions options_;
+    bool ascii_;
+    Welder welder_;
+};
+
+std::unique_ptr<Reader> open_ply_reader(ByteSource& source, const ReadOptions& options) {
+    return std::make_unique<PlyReader>(source, options);
+}
+
+std::unique_ptr<Writer> open_ply_writer(ByteSink& sink, const WriteOptions& options) {
+    return std::make_unique<PlyWriter>(sink, options, false);
+}
+
+std::unique_ptr<Writer> open_ply_ascii_writer(ByteSink& sink, const WriteOptions& options) {
+    return std::make_unique<PlyWriter>(sink, options, true);
+}
+
+}  // namespace
+
+bool probe_ply(std::span<const std::byte> head, std::optional<uint64_t>) {
+    auto starts = [&](std::string_view magic) {
+        return head.size() >= magic.size() && std::memcmp(head.data(), magic.data(), magic.size()) == 0;
+    };
+    return starts("ply\n") || starts("ply\r\n");
+}
+
+const Format kPlyFormat = {
+    "ply",
+    "ply",
+    "PLY, binary little endian (reads ascii, binary little and big endian)",
+    &probe_ply,
+    &open_ply_reader,
+    &open_ply_writer,
+};
+
+const Format kPlyAsciiFormat = {
+    "ply-ascii",
+    "",
+    "PLY, ascii (write with --to ply-ascii)",
+    nullptr,
+    &open_ply_reader,
+    &open_ply_ascii_writer,
+};
+
+}  // namespace meshstream::io

@@ -1,0 +1,187 @@
+// The spillable vertex table: memory blocks, then a temp file or the input read through mmap
+// with resident-page accounting (see vertex_table.hpp).
+#include "io/vertex_table.hpp"
+
+#include "io/error.hpp"
+
+#include <algorithm>
+#include <cerrno>
+#include <cstring>
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <unistd.h>
+
+namespace meshstream::io {
+namespace {
+
+constexpr size_t kPageBytes = 4096;
+constexpr size_t kTailBytes = size_t{1} << 20;
+
+}  // namespace
+
+VertexTable::VertexTable(uint64_t budget_bytes, std::string tmpdir, bool color)
+    : budget_bytes_(budget_bytes), tmpdir_(std::move(tmpdir)), color_(color) {
+    stride_ = color ? 16 : 12;  // xyz, then rgb + 1 pad byte
+}
+
+std::unique_ptr<VertexTable> VertexTable::map_input_file(const std::string& path, uint64_t offset, uint64_t count,
+                                                         size_t stride, const size_t (&xyz_offsets)[3],
+                                                         const size_t* rgb_offsets, uint64_t budget_bytes) {
+    std::unique_ptr<VertexTable> t(new VertexTable());
+    t->storage_ = Storage::kInputFile;
+    t->budget_bytes_ = budget_bytes;
+    t->stride_ = stride;
+    t->size_ = count;
+    t->mapped_records_ = count;
+    std::copy(std::begin(xyz_offsets), std::end(xyz_offsets), t->xyz_offsets_);
+    if (rgb_offsets) {
+        t->color_ = true;
+        std::copy(rgb_offsets, rgb_offsets + 3, t->rgb_offsets_);
+    }
+    if (count == 0) return t;
+    t->input_fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (t->input_fd_ < 0) throw Error(path, "cannot open for mapping: " + std::string(std::strerror(errno)));
+    uint64_t aligned = offset / kPageBytes * kPageBytes;
+    t->map_bytes_ = static_cast<size_t>(offset - aligned + count * stride);
+    t->map_ = ::mmap(nullptr, t->map_bytes_, PROT_READ, MAP_SHARED, t->input_fd_, static_cast<off_t>(aligned));
+    if (t->map_ == MAP_FAILED) {
+        t->map_ = nullptr;
+        throw Error(path, offset, 0, "cannot map the vertex block: " + std::string(std::strerror(errno)));
+    }
+    t->base_ = static_cast<const std::byte*>(t->map_) + (offset - aligned);
+    if (t->map_bytes_ > budget_bytes) {
+        t->touched_bits_.assign(t->map_bytes_ / kPageBytes / 64 + 2, 0);
+        t->page_limit_ = std::max<uint64_t>(budget_bytes / kPageBytes, 16);
+    }
+    return t;
+}
+
+VertexTable::~VertexTable() {
+    if (map_) ::munmap(map_, map_bytes_);
+    if (input_fd_ >= 0) ::close(input_fd_);
+}
+
+void VertexTable::append(const float* xyz, const uint8_t* rgb) {
+    std::byte rec[16] = {};
+    std::memcpy(rec, xyz, 12);
+    if (color_ && rgb) std::memcpy(rec + 12, rgb, 3);
+    if (storage_ == Storage::kMemory) {
+        if ((size_ + 1) * stride_ > budget_bytes_) {
+            spill();
+        } else {
+            size_t in_block = static_cast<size_t>(size_ & ((uint64_t{1} << kBlockRecordsLog2) - 1));
+            if (in_block == 0)
+                blocks_.push_back(std::make_unique<std::byte[]>(stride_ << kBlockRecordsLog2));
+            std::memcpy(blocks_.back().get() + in_block * stride_, rec, stride_);
+            ++size_;
+            return;
+        }
+    }
+    // kTempFile: append to the tail, flushing it (and extending the mapping) when full.
+    if (tail_.size() + stride_ > kTailBytes) flush_tail();
+    tail_.insert(tail_.end(), rec, rec + stride_);
+    ++size_;
+}
+
+void VertexTable::spill() {
+    temp_ = std::make_unique<TempFile>(tmpdir_, "meshstream-vertices");
+    for (uint64_t done = 0; done < size_;) {
+        size_t n = static_cast<size_t>(std::min<uint64_t>(size_ - done, uint64_t{1} << kBlockRecordsLog2));
+        temp_->write(blocks_[done >> kBlockRecordsLog2].get(), n * stride_);
+        done += n;
+    }
+    temp_->flush();
+    std::vector<std::unique_ptr<std::byte[]>>().swap(blocks_);
+    storage_ = Storage::kTempFile;
+    tail_.reserve(kTailBytes);
+    map_temp(size_ * stride_);
+    mapped_records_ = size_;
+}
+
+void VertexTable::flush_tail() {
+    if (tail_.empty()) return;
+    temp_->write(tail_.data(), tail_.size());
+    temp_->flush();
+    uint64_t records = tail_.size() / stride_;
+    tail_.clear();
+    uint64_t bytes = (mapped_records_ + records) * stride_;
+    if (bytes > map_bytes_) map_temp(bytes);
+    mapped_records_ += records;
+    touched_bits_.resize(map_bytes_ / kPageBytes / 64 + 2, 0);
+}
+
+// Maps the temp file with room to grow: a shared mapping longer than the file is valid, and
+// the pages become readable as write() extends the file (one page cache).
+void VertexTable::map_temp(uint64_t min_bytes) {
+    if (map_) ::munmap(map_, map_bytes_);
+    map_ = nullptr;
+    uint64_t want = std::max<uint64_t>({min_bytes * 2, uint64_t{1} << 30});
+    map_bytes_ = static_cast<size_t>(want);
+    map_ = ::mmap(nullptr, map_bytes_, PROT_READ, MAP_SHARED, temp_->fd(), 0);
+    if (map_ == MAP_FAILED) {
+        map_ = nullptr;
+        throw Error(temp_->path(), "cannot map the vertex table: " + std::string(std::strerror(errno)));
+    }
+    base_ = static_cast<const std::byte*>(map_);
+    page_limit_ = std::max<uint64_t>(budget_bytes_ / kPageBytes, 16);
+    touched_bits_.assign(map_bytes_ / kPageBytes / 64 + 2, 0);
+    touched_pages_ = 0;
+}
+
+const std::byte* VertexTable::record_in_map(uint64_t byte_offset) {
+    if (!touched_bits_.empty()) {
+        // Page index relative to the mapping start (base_ may sit inside the first page).
+        uint64_t page = (static_cast<uint64_t>(base_ - static_cast<const std::byte*>(map_)) + byte_offset) / kPageBytes;
+        uint64_t& word = touched_bits_[page >> 6];
+        uint64_t bit = uint64_t{1} << (page & 63);
+        if (!(word & bit)) {
+            // A record can straddle two pages; count the first, the second is at most one more.
+            word |= bit;
+            if (++touched_pages_ > page_limit_) {
+                uint64_t used = mapped_records_ * stride_ + static_cast<uint64_t>(base_ - static_cast<const std::byte*>(map_));
+                ::madvise(map_, static_cast<size_t>(std::min<uint64_t>(used + kPageBytes, map_bytes_)) / kPageBytes * kPageBytes,
+                          MADV_DONTNEED);
+                std::fill(touched_bits_.begin(), touched_bits_.end(), 0);
+                touched_pages_ = 0;
+            }
+        }
+    }
+    return base_ + byte_offset;
+}
+
+void VertexTable::get(uint64_t i, float* xyz, uint8_t* rgb) {
+    const std::byte* rec;
+    if (storage_ == Storage::kMemory) {
+        rec = blocks_[i >> kBlockRecordsLog2].get() + (i & ((uint64_t{1} << kBlockRecordsLog2) - 1)) * stride_;
+    } else if (i < mapped_records_) {
+        rec = record_in_map(i * stride_);
+    } else {
+        rec = tail_.data() + (i - mapped_records_) * stride_;
+    }
+    for (int a = 0; a < 3; ++a) std::memcpy(&xyz[a], rec + xyz_offsets_[a], 4);
+    if (rgb) {
+        if (color_)
+            for (int a = 0; a < 3; ++a) rgb[a] = static_cast<uint8_t>(rec[rgb_offsets_[a]]);
+        else
+            rgb[0] = rgb[1] = rgb[2] = 0;
+    }
+}
+
+bool emit_fan(VertexTable& table, const std::vector<uint64_t>& polygon, size_t* next, TriangleChunk& chunk) {
+    while (*next + 1 < polygon.size()) {
+        if (chunk.full()) return false;
+        size_t i = chunk.size();
+        float* xyz = chunk.push_slot();
+        uint8_t* rgb = chunk.rgb_at(i);
+        uint64_t* ids = chunk.id_at(i);
+        const uint64_t corner[3] = {polygon[0], polygon[*next], polygon[*next + 1]};
+        for (int k = 0; k < 3; ++k) {
+            table.get(corner[k], xyz + 3 * k, rgb ? rgb + 3 * k : nullptr);
+            if (ids) ids[k] = corner[k];
+        }
+        ++*next;
+    }
+    return true;
+}
+
+}  // namespace meshstream::io

@@ -1,0 +1,93 @@
+// The vertex table of the indexed readers (PLY, OBJ): faces refer to vertices at random, so
+// the reader keeps every vertex, in bounded memory. Up to the budget the records live in
+// memory (64 Ki-record blocks, no reallocation copies); past it they go to an io::TempFile that
+// is read through a shared read-only mmap (the OS page cache does the caching). A seekable
+// binary PLY whose x, y, z are float32 in host byte order is not copied at all: its own vertex
+// block is mapped (map_input_file).
+//
+// Memory: mapped pages count towards RSS once touched, so reads through a mapping larger than
+// the budget track the pages they touch in a bitmap (1 bit per 4 KiB page) and drop them all
+// with madvise(MADV_DONTNEED) when they pass the budget. Resident memory is therefore at most
+// budget + bitmap (1/32768 of the table) + one 1 MiB append buffer, whatever the input size.
+#pragma once
+
+#include "io/byte_stream.hpp"
+#include "io/chunk.hpp"
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace meshstream::io {
+
+class VertexTable {
+public:
+    enum class Storage { kMemory, kTempFile, kInputFile };
+
+    // An owned, growable table. `color`: records carry RGB8. Throws io::Error when a temp file
+    // cannot be created or written.
+    VertexTable(uint64_t budget_bytes, std::string tmpdir, bool color);
+    // A read-only view of `count` records of `stride` bytes starting at byte `offset` of the
+    // regular file `path`: float32 x, y, z (host byte order) at xyz_offsets, and when
+    // `rgb_offsets` is non-null uint8 red, green, blue there. Throws io::Error when the file
+    // cannot be opened or mapped.
+    static std::unique_ptr<VertexTable> map_input_file(const std::string& path, uint64_t offset, uint64_t count,
+                                                       size_t stride, const size_t (&xyz_offsets)[3],
+                                                       const size_t* rgb_offsets, uint64_t budget_bytes);
+    ~VertexTable();
+    VertexTable(const VertexTable&) = delete;
+    VertexTable& operator=(const VertexTable&) = delete;
+
+    // Appends a vertex (owned tables only). `rgb` may be null (black).
+    void append(const float* xyz, const uint8_t* rgb);
+    uint64_t size() const { return size_; }
+    bool color() const { return color_; }
+    Storage storage() const { return storage_; }
+    // Copies vertex i (< size()) into xyz[3] and, when rgb is non-null, rgb[3] (zeros when the
+    // table has no colour). Not const: it accounts the pages it touches.
+    void get(uint64_t i, float* xyz, uint8_t* rgb);
+
+private:
+    VertexTable() = default;
+    void spill();
+    void flush_tail();
+    void map_temp(uint64_t min_bytes);
+    const std::byte* record_in_map(uint64_t byte_offset);
+
+    uint64_t budget_bytes_ = 0;
+    std::string tmpdir_;
+    bool color_ = false;
+    Storage storage_ = Storage::kMemory;
+    uint64_t size_ = 0;
+    size_t stride_ = 12;
+    size_t xyz_offsets_[3] = {0, 4, 8};
+    size_t rgb_offsets_[3] = {12, 13, 14};
+
+    // kMemory: fixed-size blocks of records.
+    static constexpr size_t kBlockRecordsLog2 = 16;
+    std::vector<std::unique_ptr<std::byte[]>> blocks_;
+
+    // kTempFile / kInputFile: a mapping; records [0, mapped_records_) are readable through it,
+    // later ones (temp file only) sit in tail_ until flushed.
+    std::unique_ptr<TempFile> temp_;
+    int input_fd_ = -1;
+    void* map_ = nullptr;
+    size_t map_bytes_ = 0;
+    const std::byte* base_ = nullptr;  // first record (map_ plus the page-alignment delta)
+    uint64_t mapped_records_ = 0;
+    std::vector<std::byte> tail_;
+    // Resident-page accounting for mappings larger than the budget.
+    std::vector<uint64_t> touched_bits_;
+    uint64_t touched_pages_ = 0;
+    uint64_t page_limit_ = 0;
+};
+
+// Emits the fan triangulation (p0, pk, pk+1) of `polygon`, starting at fan position `*next`
+// (1 for a fresh polygon), into `chunk` until it is full or the fan is done. Sets the chunk's
+// vertex ids (the polygon's indices) and colours when the chunk has those channels. Returns
+// true when the polygon is finished. Indices must be < table.size().
+bool emit_fan(VertexTable& table, const std::vector<uint64_t>& polygon, size_t* next, TriangleChunk& chunk);
+
+}  // namespace meshstream::io
