@@ -297,7 +297,7 @@ private:
             if (text.empty()) {
                 if (state_ == State::kSolid && solids_ > 0) return;
                 switch (state_) {
-                    case State::kSolid: expected("'solid'", "end of file");
+                    case State::kSolid: fail("expected 'solid', found end of file");
                     case State::kFacetOrEnd: fail("expected 'facet' or 'endsolid', found end of file");
                     case State::kNormal: fail("expected 'outer', found end of file");
                     case State::kLoop: fail("expected 'loop', found end of file");

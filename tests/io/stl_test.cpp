@@ -1,0 +1,576 @@
+// STL reader/writer tests: exact counts on real fixtures, round trips over both encodings and
+// gzip with bit-exact floats, chunk-boundary runs, truncation at every byte, and bad input as
+// small inline strings asserting file, line or byte and the message.
+#include "io/stl.hpp"
+
+#include "io/error.hpp"
+#include "io/format.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iterator>
+#include <limits>
+
+namespace io = meshstream::io;
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string fixture(const std::string& name) { return std::string(MESHSTREAM_FIXTURES_DIR) + "/" + name; }
+
+std::string slurp(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    EXPECT_TRUE(in.good()) << path;
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// Bytes in memory as a RawInput: with or without a known size (a file vs. stdin), handing out at
+// most `piece` bytes per read to exercise refills.
+class MemoryInput : public io::RawInput {
+public:
+    MemoryInput(std::string bytes, bool sized, size_t piece) : bytes_(std::move(bytes)), sized_(sized), piece_(piece) {}
+    size_t read(void* dst, size_t n) override {
+        size_t take = std::min({n, piece_, bytes_.size() - pos_});
+        std::memcpy(dst, bytes_.data() + pos_, take);
+        pos_ += take;
+        return take;
+    }
+    std::optional<uint64_t> size() const override {
+        return sized_ ? std::optional<uint64_t>(bytes_.size()) : std::nullopt;
+    }
+
+private:
+    std::string bytes_;
+    bool sized_;
+    size_t piece_;
+    size_t pos_ = 0;
+};
+
+std::unique_ptr<io::ByteSource> memory_source(std::string bytes, const std::string& name, bool sized,
+                                              size_t piece = std::numeric_limits<size_t>::max()) {
+    return std::make_unique<io::ByteSource>(std::make_unique<MemoryInput>(std::move(bytes), sized, piece), name);
+}
+
+struct Mesh {
+    std::vector<float> xyz;
+    io::MeshHeader header;
+    std::string format;
+    size_t chunks = 0;
+};
+
+// Reads every chunk, checking that all but the last are full.
+Mesh drain(io::Reader& reader, size_t capacity) {
+    Mesh mesh;
+    mesh.header = reader.header();
+    io::TriangleChunk chunk(capacity);
+    bool short_seen = false;
+    while (reader.next(chunk)) {
+        EXPECT_FALSE(short_seen) << "a short chunk was followed by more triangles";
+        short_seen = !chunk.full();
+        mesh.xyz.insert(mesh.xyz.end(), chunk.xyz().begin(), chunk.xyz().end());
+        ++mesh.chunks;
+    }
+    EXPECT_TRUE(chunk.empty());
+    return mesh;
+}
+
+Mesh read_path(const std::string& path, size_t capacity = io::TriangleChunk::kDefaultCapacity,
+               std::string_view from = {}) {
+    io::Input in = io::open_input(path, from);
+    Mesh mesh = drain(*in.reader, capacity);
+    mesh.format = in.format->name;
+    return mesh;
+}
+
+// Reads from memory through the "stl" format's reader (auto-detecting binary/ASCII).
+Mesh read_memory(std::string bytes, const std::string& name, bool sized, size_t capacity = 4096,
+                 size_t piece = std::numeric_limits<size_t>::max()) {
+    auto source = memory_source(std::move(bytes), name, sized, piece);
+    auto reader = io::kStlFormat.open_reader(*source, {});
+    return drain(*reader, capacity);
+}
+
+void write_path(const std::string& path, const std::vector<float>& xyz, std::string_view to,
+                io::WriteOptions options = {}, size_t capacity = 1000) {
+    io::Output out = io::open_output(path, to, options);
+    io::TriangleChunk chunk(capacity);
+    for (size_t t = 0; t < xyz.size() / 9; ++t) {
+        float tri[9];
+        std::memcpy(tri, &xyz[9 * t], sizeof tri);
+        chunk.push(tri);
+        if (chunk.full()) {
+            out.write(chunk);
+            chunk.clear();
+        }
+    }
+    if (!chunk.empty()) out.write(chunk);
+    out.finish();
+}
+
+bool same_bits(const std::vector<float>& a, const std::vector<float>& b) {
+    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0;
+}
+
+// Runs f and returns the io::Error it throws (fails the test when it throws nothing).
+io::Error error_of(const std::function<void()>& f) {
+    try {
+        f();
+    } catch (const io::Error& e) {
+        return e;
+    }
+    ADD_FAILURE() << "no io::Error thrown";
+    return io::Error("", "none");
+}
+
+// A binary STL in memory: `header` padded with NULs (or the given pad byte) to 80 bytes.
+std::string binary_stl(std::string header, const std::vector<float>& xyz, uint32_t count_field, char pad = '\0') {
+    header.resize(80, pad);
+    std::string out = header;
+    for (int i = 0; i < 4; ++i) out += static_cast<char>(count_field >> (8 * i));
+    for (size_t t = 0; t < xyz.size() / 9; ++t) {
+        float facet[12] = {0, 0, 1};
+        std::memcpy(facet + 3, &xyz[9 * t], 9 * sizeof(float));
+        out.append(reinterpret_cast<const char*>(facet), sizeof facet);  // little-endian host
+        out += std::string("\x07\x00", 2);                              // attribute bytes, ignored
+    }
+    return out;
+}
+
+class StlTest : public ::testing::Test {
+protected:
+    void SetUp() override {
+        std::string pattern = (fs::temp_directory_path() / "stl_test-XXXXXX").string();
+        ASSERT_NE(::mkdtemp(pattern.data()), nullptr);
+        dir_ = pattern;
+    }
+    void TearDown() override { fs::remove_all(dir_); }
+    std::string path(const std::string& name) const { return (dir_ / name).string(); }
+
+    fs::path dir_;
+};
+
+const std::vector<float> kTwoTriangles = {0, 0, 0, 1, 0, 0, 0, 1, 0,  //
+                                          -0.0f, 1.5f, -2.25e-7f, 3e30f, -0.0f, 1, 1e-40f, 2, 3};
+
+TEST(StlReader, ExactCountsOnFixtures) {
+    struct Case {
+        const char* file;
+        uint64_t triangles;
+        const char* variant;
+    };
+    const Case cases[] = {
+        {"bunny_from_draco.bin.stl", 69451, "binary"},  {"cube.bin.stl", 12, "binary"},
+        {"cube_crlf.ascii.stl", 12, "ascii"},           {"faceless.ascii.stl", 0, "ascii"},
+        {"gearwheel.ascii.stl", 2444, "ascii"},         {"gearwheel.bin.stl", 2444, "binary"},
+        {"Spider_binary.stl", 1368, "binary"},          {"cgal_sphere_attrbytes.bin.stl", 320, "binary"},
+        {"missingNormal.ascii.stl", 4, "ascii"},        {"notANumberNormal.ascii.stl", 4, "ascii"},
+        {"multiWordName.ascii.stl", 4, "ascii"},        {"tetrahedronMinusZero.bin.stl", 4, "binary"},
+        {"tetrahedron.ascii.stl", 4, "ascii"},          {"sphereWithHole.stl", 285, "ascii"},
+        {"wrongHeader.bin.stl", 12, "binary"},          {"triangle_with_two_solids.stl", 2, "ascii"},
+        {"cube.bin.stl.gz", 12, "binary"},              {"gearwheel.ascii.stl.gz", 2444, "ascii"},
+    };
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.file);
+        Mesh mesh = read_path(fixture(c.file));
+        EXPECT_EQ(mesh.xyz.size(), 9 * c.triangles);
+        EXPECT_EQ(mesh.header.variant, c.variant);
+        if (std::string_view(c.variant) == "binary") {
+            EXPECT_EQ(mesh.format, "stl");
+            EXPECT_EQ(mesh.header.triangle_count, c.triangles);
+        } else {
+            EXPECT_EQ(mesh.format, "stl-ascii");
+            EXPECT_FALSE(mesh.header.triangle_count.has_value());
+        }
+        EXPECT_FALSE(mesh.header.sorted_axis.has_value());
+    }
+}
+
+TEST(StlReader, ReportsHeaderTextAndSolidName) {
+    auto note = [](const std::string& file) {
+        io::Input in = io::open_input(fixture(file));
+        return in.reader->header().notes.at(0);
+    };
+    EXPECT_EQ(note("bunny_from_draco.bin.stl"),
+              std::make_pair(std::string("header"), std::string("Stanford bunny, 69451 triangles, from Draco test data")));
+    EXPECT_EQ(note("Spider_binary.stl").second, "Generated by Caligari's trueSpace");
+    EXPECT_EQ(note("cgal_sphere_attrbytes.bin.stl").second, "FileType: Binary");
+    EXPECT_EQ(note("multiWordName.ascii.stl"),
+              std::make_pair(std::string("solid"), std::string("Model with a multi word name")));
+    EXPECT_EQ(note("faceless.ascii.stl").second, "empty");
+}
+
+TEST(StlReader, AsciiAndBinaryFixturesOfTheSameMeshAgree) {
+    // stl-models ships the cube and tetrahedron in both encodings with identical coordinates.
+    EXPECT_TRUE(same_bits(read_path(fixture("cube_crlf.ascii.stl")).xyz, read_path(fixture("cube.bin.stl")).xyz));
+    EXPECT_TRUE(same_bits(read_path(fixture("tetrahedron.ascii.stl")).xyz,
+                          read_path(fixture("tetrahedronMinusZero.bin.stl")).xyz));
+    // The gzip fixtures decode to their plain twins.
+    EXPECT_TRUE(same_bits(read_path(fixture("cube.bin.stl.gz")).xyz, read_path(fixture("cube.bin.stl")).xyz));
+    EXPECT_TRUE(
+        same_bits(read_path(fixture("gearwheel.ascii.stl.gz")).xyz, read_path(fixture("gearwheel.ascii.stl")).xyz));
+}
+
+TEST(StlReader, AttributeBytesAndNormalsAreIgnored) {
+    Mesh mesh = read_memory(binary_stl("attr", kTwoTriangles, 2), "attr.stl", true);
+    EXPECT_TRUE(same_bits(mesh.xyz, kTwoTriangles));
+}
+
+TEST(StlReader, SolidHeaderBinaryIsBinary) {
+    // wrongHeader.bin.stl: a real binary STL whose header is "solid" + NULs.
+    std::string bytes = slurp(fixture("wrongHeader.bin.stl"));
+    ASSERT_EQ(bytes.substr(0, 5), "solid");
+    for (bool sized : {true, false}) {
+        SCOPED_TRACE(sized);
+        Mesh mesh = read_memory(bytes, "wrongHeader.bin.stl", sized);
+        EXPECT_EQ(mesh.header.variant, "binary");
+        EXPECT_EQ(mesh.xyz.size(), 9u * 12);
+    }
+    // Worse: a header that is all text, "solid ..." padded with spaces; only the count and the
+    // floats are not text.
+    std::string made = binary_stl("solid written by a careless exporter", kTwoTriangles, 2, ' ');
+    for (bool sized : {true, false}) {
+        SCOPED_TRACE(sized);
+        Mesh mesh = read_memory(made, "made.stl", sized);
+        EXPECT_EQ(mesh.header.variant, "binary");
+        EXPECT_TRUE(same_bits(mesh.xyz, kTwoTriangles));
+    }
+    EXPECT_TRUE(io::probe_stl_binary(std::as_bytes(std::span(made.data(), made.size())), made.size()));
+    EXPECT_FALSE(io::kStlAsciiFormat.probe(std::as_bytes(std::span(made.data(), made.size())), made.size()));
+    // And its count lying: still read as binary, so the error is about the count.
+    std::string lying = binary_stl("solid written by a careless exporter", kTwoTriangles, 3, ' ');
+    io::Error e = error_of([&] { read_memory(lying, "lying.stl", true); });
+    EXPECT_STREQ(e.what(), "lying.stl: byte 84: header promises 3 triangles, file holds 2");
+}
+
+TEST(StlProbe, DecidesBySizeThenContent) {
+    std::string cube = slurp(fixture("cube.bin.stl"));
+    std::string ascii = slurp(fixture("tetrahedron.ascii.stl"));
+    auto head = [](const std::string& s) { return std::as_bytes(std::span(s.data(), std::min<size_t>(s.size(), 4096))); };
+    EXPECT_TRUE(io::probe_stl_binary(head(cube), 684));
+    EXPECT_FALSE(io::probe_stl_binary(head(cube), 685));
+    EXPECT_TRUE(io::probe_stl_binary(head(cube), std::nullopt));
+    EXPECT_FALSE(io::probe_stl_binary(head(cube).first(83), std::nullopt));
+    EXPECT_FALSE(io::probe_stl_binary(head(ascii), ascii.size()));
+    EXPECT_FALSE(io::probe_stl_binary(head(ascii), std::nullopt));
+    EXPECT_TRUE(io::kStlAsciiFormat.probe(head(ascii), ascii.size()));
+    EXPECT_TRUE(io::kStlAsciiFormat.probe(head(ascii), std::nullopt));
+    EXPECT_FALSE(io::kStlAsciiFormat.probe(head(cube), std::nullopt));
+    // Leading BOM and whitespace before "solid"; "solidus" is not "solid".
+    std::string bom = "\xef\xbb\xbf  \n solid x\nendsolid x\n";
+    EXPECT_TRUE(io::kStlAsciiFormat.probe(head(bom), bom.size()));
+    std::string solidus = "solidus\n";
+    EXPECT_FALSE(io::kStlAsciiFormat.probe(head(solidus), solidus.size()));
+}
+
+TEST_F(StlTest, RoundTripsBothEncodingsPlainAndGzipBitExact) {
+    const std::vector<float> bunny = read_path(fixture("bunny_from_draco.bin.stl")).xyz;
+    ASSERT_EQ(bunny.size(), 9u * 69451);
+    // The whole bunny through binary -> ASCII -> binary.
+    write_path(path("bunny.ascii.stl"), bunny, "stl-ascii");
+    write_path(path("bunny.bin.stl"), read_path(path("bunny.ascii.stl")).xyz, "stl");
+    Mesh whole = read_path(path("bunny.bin.stl"));
+    EXPECT_TRUE(same_bits(whole.xyz, bunny));
+    EXPECT_EQ(whole.header.triangle_count, 69451u);
+    // Each encoding x plain/gzip x count known or not (patched, spooled or written up front),
+    // on the bunny's first 5000 triangles to keep the suite fast.
+    const std::vector<float> part(bunny.begin(), bunny.begin() + 9 * 5000);
+    for (std::string_view to : {"stl", "stl-ascii"}) {
+        for (std::string_view suffix : {".stl", ".stl.gz"}) {
+            for (bool announce : {false, true}) {
+                std::string out = path("rt" + std::string(suffix));
+                SCOPED_TRACE(std::string(to) + " " + out + (announce ? " announced" : ""));
+                io::WriteOptions options;
+                if (announce) options.triangle_count = 5000;
+                write_path(out, part, to, options);
+                std::string bytes = slurp(out);
+                EXPECT_EQ(bytes.substr(0, 2) == "\x1f\x8b", suffix == ".stl.gz");
+                Mesh back = read_path(out);
+                EXPECT_TRUE(same_bits(back.xyz, part));
+                EXPECT_EQ(back.header.variant, to == "stl" ? "binary" : "ascii");
+                if (to == "stl") {
+                    EXPECT_EQ(back.header.triangle_count, 5000u);
+                }
+                if (to == "stl" && suffix == ".stl") {
+                    EXPECT_EQ(bytes.size(), 84u + 50 * 5000);
+                }
+            }
+        }
+    }
+    // ASCII -> binary -> ASCII gives the same ASCII bytes.
+    write_path(path("a.stl"), read_path(fixture("gearwheel.ascii.stl")).xyz, "stl-ascii");
+    write_path(path("b.stl"), read_path(path("a.stl")).xyz, "stl");
+    write_path(path("c.stl"), read_path(path("b.stl")).xyz, "stl-ascii");
+    EXPECT_EQ(slurp(path("a.stl")), slurp(path("c.stl")));
+}
+
+TEST_F(StlTest, AsciiKeepsNegativeZeroTinyAndHugeFloats) {
+    write_path(path("z.stl"), kTwoTriangles, "stl-ascii");
+    std::string text = slurp(path("z.stl"));
+    EXPECT_NE(text.find("vertex -0 1.5 -2.25e-07\n"), std::string::npos) << text;
+    EXPECT_NE(text.find("vertex 3e+30 -0 1\n"), std::string::npos) << text;
+    Mesh back = read_path(path("z.stl"));
+    EXPECT_TRUE(same_bits(back.xyz, kTwoTriangles));
+    EXPECT_TRUE(std::signbit(back.xyz[9]));
+    EXPECT_EQ(text.substr(0, 17), "solid meshstream\n");
+    EXPECT_EQ(text.substr(text.size() - 20), "endsolid meshstream\n");
+}
+
+TEST_F(StlTest, ChunkCapacitiesGiveIdenticalOutput) {
+    for (const char* file : {"bunny_from_draco.bin.stl", "gearwheel.ascii.stl", "gearwheel.ascii.stl.gz"}) {
+        SCOPED_TRACE(file);
+        Mesh whole = read_path(fixture(file));
+        for (size_t capacity : {size_t{1}, size_t{7}}) {
+            Mesh bits = read_path(fixture(file), capacity);
+            EXPECT_TRUE(same_bits(bits.xyz, whole.xyz)) << capacity;
+            EXPECT_EQ(bits.chunks, (whole.xyz.size() / 9 + capacity - 1) / capacity);
+        }
+        // Writers fed chunks of 1 and 7 produce the same bytes as one big chunk.
+        write_path(path("big.stl"), whole.xyz, "stl", {}, 1 << 20);
+        write_path(path("one.stl"), whole.xyz, "stl", {}, 1);
+        write_path(path("seven.stl"), whole.xyz, "stl-ascii", {}, 7);
+        write_path(path("big_ascii.stl"), whole.xyz, "stl-ascii", {}, 1 << 20);
+        EXPECT_EQ(slurp(path("big.stl")), slurp(path("one.stl")));
+        EXPECT_EQ(slurp(path("big_ascii.stl")), slurp(path("seven.stl")));
+    }
+    // A source handing out 3 bytes per read puts facets across every refill boundary.
+    std::string bytes = slurp(fixture("gearwheel.bin.stl"));
+    Mesh trickle = read_memory(bytes, "gearwheel.bin.stl", false, 7, 3);
+    EXPECT_TRUE(same_bits(trickle.xyz, read_path(fixture("gearwheel.bin.stl")).xyz));
+    std::string text = slurp(fixture("sphereWithHole.stl"));
+    Mesh trickle_text = read_memory(text, "sphereWithHole.stl", false, 7, 5);
+    EXPECT_TRUE(same_bits(trickle_text.xyz, read_path(fixture("sphereWithHole.stl")).xyz));
+}
+
+TEST(StlReader, RejectsTruncatedBinaryAtEveryByte) {
+    for (const char* file : {"cube.bin.stl", "wrongHeader.bin.stl"}) {
+        const std::string bytes = slurp(fixture(file));
+        ASSERT_EQ(bytes.size(), 684u);
+        for (size_t length = 0; length < bytes.size(); ++length) {
+            for (bool sized : {true, false}) {
+                SCOPED_TRACE(std::string(file) + " length " + std::to_string(length) + (sized ? " sized" : " stream"));
+                io::Error e = error_of([&] { read_memory(bytes.substr(0, length), "cut.stl", sized); });
+                EXPECT_EQ(e.file(), "cut.stl");
+                // "solid" + NULs cut short of any NUL looks like ASCII STL and fails as such.
+                bool ascii = std::string_view(file) == "wrongHeader.bin.stl" && length == 5;
+                if (ascii) {
+                    EXPECT_EQ(e.line(), 1u) << e.what();
+                } else if (length < 84) {
+                    EXPECT_EQ(e.byte_offset(), length) << e.what();
+                } else if (sized) {
+                    EXPECT_EQ(e.byte_offset(), 84u);
+                    EXPECT_EQ(e.message(), "header promises 12 triangles, file holds " +
+                                               std::to_string((length - 84) / 50) +
+                                               ((length - 84) % 50 ? " and " + std::to_string((length - 84) % 50) +
+                                                                          " stray bytes"
+                                                                   : ""));
+                } else {
+                    EXPECT_EQ(e.byte_offset(), length) << e.what();
+                    EXPECT_NE(e.message().find("file ends inside triangle " + std::to_string((length - 84) / 50 + 1)),
+                              std::string::npos)
+                        << e.what();
+                }
+            }
+        }
+    }
+}
+
+TEST(StlReader, TruncatedAsciiFailsUnlessOnlyTheEndsolidNameIsCut) {
+    const std::string text = slurp(fixture("tetrahedron.ascii.stl"));
+    const size_t endsolid = text.rfind("endsolid");
+    ASSERT_NE(endsolid, std::string::npos);
+    for (size_t length = 0; length < text.size(); ++length) {
+        SCOPED_TRACE(length);
+        std::string cut = text.substr(0, length);
+        if (length >= endsolid + 8) {
+            // Only the name after "endsolid" (or the final newline) is missing: a complete file.
+            EXPECT_EQ(read_memory(cut, "cut.stl", false).xyz.size(), 9u * 4);
+        } else {
+            EXPECT_THROW(read_memory(cut, "cut.stl", false), io::Error);
+        }
+    }
+}
+
+TEST(StlReader, HeaderCountLyingBothWays) {
+    const std::string cube = slurp(fixture("cube.bin.stl"));
+    auto with_count = [&](uint32_t n) {
+        std::string bytes = cube;
+        for (int i = 0; i < 4; ++i) bytes[80 + i] = static_cast<char>(n >> (8 * i));
+        return bytes;
+    };
+    // Size known: checked up front.
+    EXPECT_STREQ(error_of([&] { read_memory(with_count(13), "more.stl", true); }).what(),
+                 "more.stl: byte 84: header promises 13 triangles, file holds 12");
+    EXPECT_STREQ(error_of([&] { read_memory(with_count(11), "fewer.stl", true); }).what(),
+                 "fewer.stl: byte 84: header promises 11 triangles, file holds 12");
+    // Streams (stdin, gzip): detected where the bytes run out, or where extra ones follow.
+    EXPECT_STREQ(error_of([&] { read_memory(with_count(13), "more.stl", false); }).what(),
+                 "more.stl: byte 684: file ends inside triangle 13 (header promises 13 triangles)");
+    EXPECT_STREQ(error_of([&] { read_memory(with_count(11), "fewer.stl", false); }).what(),
+                 "fewer.stl: byte 634: header promises 11 triangles, but more bytes follow");
+    // A huge count, as when a text file is mistaken for binary, does not allocate or hang.
+    EXPECT_EQ(error_of([&] { read_memory(with_count(0xffffffffu), "huge.stl", true); }).message(),
+              "header promises 4294967295 triangles, file holds 12");
+}
+
+TEST(StlReader, AsciiMissingEndloopNamesFileAndLine) {
+    const std::string text =
+        "solid scan\n"
+        "  facet normal 0 0 1\n"
+        "    outer loop\n"
+        "      vertex 0 0 0\n"
+        "      vertex 1 0 0\n"
+        "      vertex 0 1 0\n"
+        "  endfacet\n"  // line 7: endloop missing
+        "endsolid scan\n";
+    io::Error e = error_of([&] { read_memory(text, "scan.stl", true); });
+    EXPECT_STREQ(e.what(), "scan.stl:7: expected 'endloop', found 'endfacet'");
+    EXPECT_EQ(e.line(), 7u);
+}
+
+TEST(StlReader, AsciiBadInputNamesLine) {
+    struct Case {
+        const char* text;
+        const char* what;
+    };
+    const Case cases[] = {
+        // CRLF lines count once each.
+        {"solid x\r\nfacet normal 0 0 1\r\nouter loop\r\nvertex 1 2 zz\r\n", "bad.stl:4: expected a number, found 'zz'"},
+        {"solid x\nfacet normal 0 0 1\nouter loop\nvertex 1 2 3 4\n",
+         "bad.stl:4: expected 'vertex', found '4'"},
+        {"solid x\nfacet normal 0 0 1\nouter loop\nvertex 1 2 3\nvertex 1 2 3\nendloop\n",
+         "bad.stl:6: expected 'vertex', found 'endloop'"},
+        {"solid x\nfacet normal 0 0 1 7 8\nouter loop\n", "bad.stl:2: expected 'outer', found '7'"},
+        {"solid x\nfacet normal 0 0 1\nouter loop\nvertex 1 +-2 3\n", "bad.stl:4: expected a number, found '+-2'"},
+        {"solid x\nfacet normal 0 0 1\nouter loop\nvertex 1 2 1e999\n",
+         "bad.stl:4: expected a number, found '1e999'"},
+        {"solid x\nfacet normal 0 0 1\nouter\n", "bad.stl:4: expected 'loop', found end of file"},
+        // Every facet complete but no endsolid: a cut file, not a shorter mesh.
+        {"solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\n",
+         "bad.stl:9: expected 'facet' or 'endsolid', found end of file"},
+        {"solid x\nendsolid x\ngarbage\n", "bad.stl:3: expected 'solid', found 'garbage'"},
+        {"solid x\nvertex 1 2 3\n", "bad.stl:2: expected 'facet' or 'endsolid', found 'vertex'"},
+        {"", "bad.stl:1: expected 'solid', found end of file"},
+    };
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.text);
+        EXPECT_STREQ(error_of([&] {
+                         auto source = memory_source(c.text, "bad.stl", true);
+                         auto reader = io::kStlAsciiFormat.open_reader(*source, {});
+                         drain(*reader, 16);
+                     }).what(),
+                     c.what);
+    }
+}
+
+TEST(StlReader, AsciiAcceptsCaseWhitespaceSignsAndSeveralSolids) {
+    const std::string good =
+        "\xef\xbb\xbf  SOLID Part One\r\n"
+        "FACET NORMAL nan -inf garbage\r\n"
+        "\tOUTER LOOP\r\n"
+        "\t\tVERTEX +1.5e+2 -0 1E-3\r\n"
+        "\t\tVertex\t.5\v2.\f-3e-2\r\n"
+        "  vertex 1e-50 3.4028235e38 -7\r\n"
+        "ENDLOOP\r\nENDFACET\r\n"
+        "ENDSOLID Part One\r\n"
+        "solid two\n"
+        "facet outer loop vertex 1 2 3 vertex 4 5 6 vertex 7 8 9 endloop endfacet\n"
+        "endsolid";  // no final newline
+    Mesh mesh = read_memory(good, "good.stl", true);
+    const std::vector<float> expected = {150, -0.0f, 1e-3f, 0.5f, 2, -0.03f, 0, 3.4028235e38f, -7,
+                                         1,   2,     3,     4,    5, 6,      7, 8,             9};
+    EXPECT_TRUE(same_bits(mesh.xyz, expected));
+    EXPECT_EQ(mesh.header.variant, "ascii");
+    EXPECT_EQ(mesh.header.notes.at(0).second, "Part One");
+    // A hex-looking token is not a decimal number.
+    EXPECT_THROW(read_memory("solid x\nfacet normal\nouter loop\nvertex 0x1 0 0\n", "hex.stl", true), io::Error);
+}
+
+TEST(StlReader, LineLongerThanTheBufferFailsLoudly) {
+    std::string text = "solid x\nfacet normal " + std::string(3 << 20, '1') + "\n";
+    io::Error e = error_of([&] { read_memory(text, "long.stl", false); });
+    EXPECT_EQ(e.line(), 2u);
+    EXPECT_NE(e.message().find("line longer than 1 MiB"), std::string::npos) << e.what();
+}
+
+TEST(StlReader, EmptyAndTinyFilesAreErrors) {
+    EXPECT_STREQ(error_of([] { read_memory("", "empty.stl", true); }).what(),
+                 "empty.stl: byte 0: file ends inside the 84-byte binary STL header (neither binary nor ASCII STL)");
+    EXPECT_EQ(error_of([] { read_memory("hello", "hello.stl", false); }).byte_offset(), 5u);
+}
+
+TEST_F(StlTest, WriterComputesNormalsAndAHeader) {
+    const std::vector<float> tris = {0, 0, 0, 2, 0, 0, 0, 2, 0,   // normal +z
+                                     0, 0, 0, 0, 0, 3, 0, 3, 0,   // normal -x
+                                     1, 1, 1, 2, 2, 2, 3, 3, 3};  // degenerate: zero normal
+    write_path(path("n.stl"), tris, "stl");
+    std::string bytes = slurp(path("n.stl"));
+    ASSERT_EQ(bytes.size(), 84u + 3 * 50);
+    EXPECT_EQ(bytes.substr(0, 11), "meshstream ");
+    EXPECT_EQ(bytes.substr(80, 4), std::string("\x03\0\0\0", 4));
+    const float normals[3][3] = {{0, 0, 1}, {-1, 0, 0}, {0, 0, 0}};
+    for (int t = 0; t < 3; ++t) {
+        float n[3];
+        std::memcpy(n, bytes.data() + 84 + 50 * t, sizeof n);
+        EXPECT_EQ(n[0], normals[t][0]);
+        EXPECT_EQ(n[1], normals[t][1]);
+        EXPECT_EQ(n[2], normals[t][2]);
+        EXPECT_EQ(bytes.substr(84 + 50 * t + 48, 2), std::string("\0\0", 2));
+    }
+    EXPECT_EQ(read_path(path("n.stl")).header.notes.at(0).second, "meshstream");
+}
+
+TEST_F(StlTest, SortMarkerRoundTrips) {
+    for (std::string_view to : {"stl", "stl-ascii"}) {
+        for (int axis = 0; axis < 3; ++axis) {
+            io::WriteOptions options;
+            options.sorted_axis = axis;
+            write_path(path("s.stl"), kTwoTriangles, to, options);
+            EXPECT_EQ(read_path(path("s.stl")).header.sorted_axis, axis) << to;
+        }
+    }
+    EXPECT_NE(slurp(path("s.stl")).find("solid meshstream sorted-axis=z\n"), std::string::npos);
+    write_path(path("b.stl"), kTwoTriangles, "stl", [] { io::WriteOptions o; o.sorted_axis = 1; return o; }());
+    EXPECT_EQ(slurp(path("b.stl")).substr(0, 24), "meshstream sorted-axis=y");
+}
+
+TEST_F(StlTest, WriterChecksAnnouncedCountAndLeavesNoFileOnFailure) {
+    const std::string out = path("c.stl");
+    io::WriteOptions options;
+    options.triangle_count = 3;
+    io::TriangleChunk two(4);
+    float tri[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    two.push(tri);
+    two.push(tri);
+    {
+        io::Output output = io::open_output(out, "stl", options);
+        output.write(two);
+        EXPECT_STREQ(error_of([&] { output.finish(); }).what(),
+                     (out + ": header promises 3 triangles, 2 were written").c_str());
+    }
+    {
+        io::Output output = io::open_output(out, "stl", options);
+        output.write(two);
+        io::Error e = error_of([&] { output.write(two); });  // 4 > 3, refused before any byte goes out
+        EXPECT_NE(e.message().find("more triangles than the 3 announced"), std::string::npos) << e.what();
+    }
+    EXPECT_TRUE(fs::is_empty(dir_)) << "an unfinished writer left a file behind";
+
+    options.triangle_count = uint64_t{1} << 32;
+    io::Error too_many = error_of([&] { io::open_output(out, "stl", options); });
+    EXPECT_NE(too_many.message().find("at most 4294967295 triangles"), std::string::npos) << too_many.what();
+    EXPECT_TRUE(fs::is_empty(dir_));
+}
+
+TEST_F(StlTest, ForcedAsciiReaderRejectsBinary) {
+    io::Error e = error_of([] { read_path(fixture("cube.bin.stl"), 16, "stl-ascii"); });
+    EXPECT_EQ(e.line(), 1u);
+    EXPECT_NE(e.message().find("expected 'solid'"), std::string::npos) << e.what();
+}
+
+}  // namespace
