@@ -41,6 +41,10 @@ StreamDecimator::StreamDecimator(const Options& options, std::optional<uint64_t>
     }
 }
 
+uint64_t StreamDecimator::expected_output(double ratio, uint64_t input_triangle_count) {
+    return final_triangle_count(ratio, input_triangle_count);
+}
+
 void StreamDecimator::push(const io::TriangleChunk& in, const Emit& out) {
     assert(!finished_);
     const std::span<const float> xyz = in.xyz();

@@ -68,6 +68,8 @@ public:
     void finish(const Emit& out);
 
     const Stats& stats() const { return stats_; }
+    // round(ratio · input_triangle_count): the output size finish() lands on.
+    static uint64_t expected_output(double ratio, uint64_t input_triangle_count);
     // The ratio in use (target / input count with Options::target).
     double ratio() const { return ratio_; }
 

@@ -8,5 +8,6 @@ namespace meshstream::tools {
 
 void add_info(CLI::App& app);
 void add_convert(CLI::App& app);
+void add_decimate(CLI::App& app);
 
 }  // namespace meshstream::tools

@@ -17,6 +17,7 @@ int main(int argc, char** argv) {
     app.require_subcommand(1);
     tools::add_info(app);
     tools::add_convert(app);
+    tools::add_decimate(app);
 
     io::install_cleanup_handlers();
     try {

@@ -1,0 +1,179 @@
+// `meshstream decimate IN OUT --ratio p`: the Wu & Kobbelt stream decimator (decimate/) between
+// any reader and writer of the registry. Memory: the decimator's fixed buffer (--buffer) plus
+// what the two formats need; the output streams while the input is still being read.
+#include "decimate/stream_decimator.hpp"
+#include "io/error.hpp"
+#include "tools/commands.hpp"
+#include "tools/common.hpp"
+#include "tools/metro.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+
+namespace meshstream::tools {
+namespace {
+
+struct DecimateOptions {
+    std::string input, output;
+    std::optional<double> ratio;
+    std::optional<uint64_t> target;
+    size_t buffer = 400000;
+    int candidates = 8;
+    uint64_t seed = 1;
+    std::string weld;  // "" / "0.001" / "0.01%"
+    std::optional<int> sorted_axis;
+    bool report = false;
+    ReadFlags read;
+    WriteFlags write;
+};
+
+// --weld EPS: absolute, or "P%" of the bounding-box diagonal when the reader knows the box.
+double weld_epsilon(const std::string& text, const io::MeshHeader& header, const std::string& input) {
+    if (text.empty()) return 0;
+    const bool percent = text.back() == '%';
+    double value = 0;
+    try {
+        value = std::stod(percent ? text.substr(0, text.size() - 1) : text);
+    } catch (const std::exception&) {
+        throw CLI::ValidationError("--weld", "expected a number or a percentage, found '" + text + "'");
+    }
+    if (!(value >= 0) || !std::isfinite(value))
+        throw CLI::ValidationError("--weld", "must be a non-negative number, found '" + text + "'");
+    if (!percent) return value;
+    if (!header.bounds)
+        throw io::Error(input, "--weld " + text + " needs the bounding box, which this format does not state "
+                               "up front; give an absolute size instead");
+    double diag2 = 0;
+    for (int i = 0; i < 3; ++i) {
+        const double d = double(header.bounds->max[i]) - header.bounds->min[i];
+        diag2 += d * d;
+    }
+    return value / 100 * std::sqrt(diag2);
+}
+
+void run_decimate(const DecimateOptions& opt) {
+    const auto start = std::chrono::steady_clock::now();
+    io::Input in = io::open_input(opt.input, opt.read.from, opt.read.options());
+    const io::MeshHeader& header = in.reader->header();
+
+    decimate::Options options;
+    if (opt.target) {
+        if (!header.triangle_count)
+            throw io::Error(in.source->name(), "--target needs the input triangle count, which this format does "
+                                               "not state up front; use --ratio");
+        options.target = *opt.target;
+    } else {
+        options.ratio = opt.ratio.value_or(0.1);
+    }
+    options.buffer_triangles = opt.buffer;
+    options.candidates = opt.candidates;
+    options.seed = opt.seed;
+    options.weld_eps = weld_epsilon(opt.weld, header, in.source->name());
+    options.sorted_axis = opt.sorted_axis ? opt.sorted_axis : header.sorted_axis;
+    decimate::StreamDecimator decimator(options, header.triangle_count);
+
+    io::WriteOptions wo = opt.write.options(opt.read);
+    if (options.target) wo.triangle_count = options.target;
+    else if (header.triangle_count) wo.triangle_count = decimate::StreamDecimator::expected_output(options.ratio, *header.triangle_count);
+    io::Output out = io::open_output(opt.output, opt.write.to, wo, opt.write.gzip_level);
+
+    const decimate::Emit emit = [&out](const io::TriangleChunk& chunk) { out.write(chunk); };
+    io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, header.channels);
+    uint64_t done = 0;
+    Progress progress("decimating", header.triangle_count);
+    while (in.reader->next(chunk)) {
+        decimator.push(chunk, emit);
+        done += chunk.size();
+        progress.update(done);
+    }
+    if (header.triangle_count && done != *header.triangle_count)
+        throw io::Error(in.source->name(), "header promises " + std::to_string(*header.triangle_count) +
+                                               " triangles, read " + std::to_string(done));
+    progress.phase("finishing", std::nullopt);
+    decimator.finish(emit);
+    progress.done();
+    out.finish();
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+    const decimate::Stats& s = decimator.stats();
+    std::fprintf(stderr, "decimated %s -> %s\n", in.source->name().c_str(), opt.output.c_str());
+    std::fprintf(stderr, "  triangles in %llu, out %llu (target %llu, ratio %.6g)\n",
+                 (unsigned long long)s.triangles_in, (unsigned long long)s.triangles_out,
+                 (unsigned long long)s.target_triangles, decimator.ratio());
+    std::fprintf(stderr, "  time %.3f s, %s input triangles/s, peak RSS %s\n", seconds,
+                 human_count(seconds > 0 ? double(s.triangles_in) / seconds : 0).c_str(),
+                 human_bytes(double(peak_rss_bytes())).c_str());
+    std::fprintf(stderr, "  buffer %zu triangles, peak fill %zu (%.1f %%), collapses %llu, forced writes %llu\n",
+                 s.buffer_capacity, s.peak_buffer_triangles,
+                 100.0 * double(s.peak_buffer_triangles) / double(s.buffer_capacity),
+                 (unsigned long long)s.collapses, (unsigned long long)s.forced_writes);
+    if (options.weld_eps > 0)
+        std::fprintf(stderr, "  weld %.6g: %llu vertices merged\n", options.weld_eps,
+                     (unsigned long long)s.vertices_merged);
+    if (options.sorted_axis)
+        std::fprintf(stderr, "  sorted along %c: %llu hole-boundary vertices finalized by the sweep\n",
+                     "xyz"[*options.sorted_axis], (unsigned long long)s.vertices_finalized_by_sweep);
+
+    Warnings warnings;
+    if (s.forced_writes > 0)
+        warnings.add("buffer full of undecimatable triangles: " + std::to_string(s.forced_writes) +
+                     " triangles force-written at full resolution (" +
+                     std::to_string(s.premature_writes) +
+                     " written before reaching the target resolution); the input is not in streaming order: "
+                     "run `meshstream sort` on it first, or raise --buffer");
+    if (s.nonmanifold_edges > 0)
+        warnings.add("non-manifold, duplicate or mis-oriented edges frozen and passed through", s.nonmanifold_edges);
+    if (s.degenerate_passed > 0)
+        warnings.add("degenerate triangles (welded corners) passed through", s.degenerate_passed);
+    if (s.triangles_out != s.target_triangles)
+        warnings.add("output has " + std::to_string(s.triangles_out) + " triangles instead of the target " +
+                     std::to_string(s.target_triangles) + " (too little left that could be decimated)");
+    warnings.print();
+
+    if (opt.report) {
+        if (opt.input == "-" || opt.output == "-")
+            throw io::Error(opt.input, "--report needs to re-read both files; it does not work with '-'");
+        CompareOptions co;
+        co.memory_budget_bytes = opt.read.options().memory_budget_bytes;
+        co.tmpdir = opt.read.tmpdir;
+        const CompareResult r = compare_meshes(file_source(opt.input, opt.read.from, opt.read.options()),
+                                               file_source(opt.output, {}, opt.read.options()), co);
+        const double diag = r.diagonal > 0 ? r.diagonal : 1;
+        std::fprintf(stderr, "  error vs input (%% of bbox diagonal %.6g): Hausdorff %.6g (%.4f %%), mean %.6g (%.4f %%), "
+                             "rms %.6g (%.4f %%)\n", r.diagonal, r.hausdorff(), 100 * r.hausdorff() / diag,
+                     r.mean(), 100 * r.mean() / diag, r.rms(), 100 * r.rms() / diag);
+    }
+}
+
+}  // namespace
+
+void add_decimate(CLI::App& app) {
+    auto opt = std::make_shared<DecimateOptions>();
+    CLI::App* cmd = app.add_subcommand(
+        "decimate", "Decimate a mesh of any size in one streaming pass (Wu & Kobbelt 2003) with a fixed memory buffer.\n"
+                    "Output size is exactly round(ratio x input), or --target.");
+    cmd->add_option("input", opt->input, "Input mesh ('-' = stdin)")->required();
+    cmd->add_option("output", opt->output, "Output mesh ('-' = stdout, needs --to)")->required();
+    auto* ratio = cmd->add_option("-r,--ratio", opt->ratio, "Fraction of input triangles to keep, in (0, 1] (default 0.1)")
+                      ->check(CLI::Range(1e-9, 1.0));
+    cmd->add_option("--target", opt->target, "Exact output triangle count (needs a format that states the input count)")
+        ->excludes(ratio);
+    cmd->add_option("--buffer", opt->buffer, "In-core buffer capacity in triangles (memory is fixed by it)")
+        ->capture_default_str()->check(CLI::Range(size_t{16}, size_t{1} << 29));
+    cmd->add_option("--candidates", opt->candidates, "Multiple-choice sample size for collapses and writes")
+        ->capture_default_str()->check(CLI::Range(1, 64));
+    cmd->add_option("--seed", opt->seed, "Random seed (same input, options and seed give identical output)")
+        ->capture_default_str();
+    cmd->add_option("--weld", opt->weld, "Weld vertices on a grid of this size (absolute, or N% of the bbox diagonal)");
+    cmd->add_option("--sorted-axis", opt->sorted_axis,
+                    "The input is sorted ascending along this axis (0=x, 1=y, 2=z; read from the file when it says so)")
+        ->check(CLI::Range(0, 2));
+    cmd->add_flag("--report", opt->report, "Compare the output against the input (Hausdorff, mean, RMS) at the end");
+    add_read_flags(cmd, opt->read);
+    add_write_flags(cmd, opt->write);
+    cmd->callback([opt] { run_decimate(*opt); });
+}
+
+}  // namespace meshstream::tools
