@@ -15,6 +15,7 @@
 #include <tiny_gltf.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstring>
 #include <map>
@@ -303,6 +304,10 @@ std::string GltfWriter::document_json(tinygltf::Model& model, uint64_t buffer_by
     if (!gltf.WriteGltfSceneToStream(&model, stream, !binary_, false))
         throw Error(sink_.name(), "tinygltf could not serialise the document");
     nlohmann::ordered_json doc = nlohmann::ordered_json::parse(stream.str());
+    // tinygltf writes a scene without nodes as null; glTF wants an object.
+    if (doc.contains("scenes"))
+        for (auto& scene : doc["scenes"])
+            if (scene.is_null()) scene = nlohmann::ordered_json::object();
     if (buffer_bytes > 0) {
         nlohmann::ordered_json buffer;
         buffer["byteLength"] = buffer_bytes;
@@ -473,6 +478,20 @@ public:
                                        mib(options.memory_budget_bytes) + "; raise --memory");
         }
         const bool glb = bytes.size() >= 4 && std::memcmp(bytes.data(), kGlbMagic, 4) == 0;
+        if (glb) {
+            // tinygltf tolerates a GLB shorter than its header says when the cut falls in
+            // padding; a file that disagrees with its own length is truncated or corrupt.
+            if (bytes.size() < 12) throw Error(name_, bytes.size(), 0, "file ends inside the 12-byte GLB header");
+            uint32_t stated = get_u32(&bytes[8]);
+            if (stated != bytes.size())
+                throw Error(name_, 8, 0, "GLB header states " + std::to_string(stated) + " bytes, the file holds " +
+                                             std::to_string(bytes.size()));
+        } else {
+            size_t first = 0;
+            while (first < bytes.size() && std::isspace(bytes[first])) ++first;
+            if (first == bytes.size() || bytes[first] != '{')
+                throw Error(name_, first, 0, "not glTF: expected the GLB magic 'glTF' or a JSON object");
+        }
         if (!glb && bytes.size() > 0xFFFFFFFFull) throw Error(name_, "glTF JSON over 4 GiB is not supported");
         header_.variant = glb ? "binary (GLB)" : "JSON";
 

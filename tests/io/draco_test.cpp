@@ -1,0 +1,217 @@
+// Draco .drc tests: exact counts and settings on real files (bitstreams 1.1 and 2.2,
+// edgebreaker and sequential), point-cloud refusal, truncation, chunk boundaries, lossy round
+// trips within the quantization bound, Debian's draco_decoder agreeing on every file we write,
+// vertex ids, normals, and the memory budget.
+#include "io/draco.hpp"
+
+#include "io/error.hpp"
+#include "io/format.hpp"
+#include "web_test_util.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <sstream>
+
+using namespace web_test;
+
+namespace {
+
+std::string note(const io::MeshHeader& h, const std::string& key) {
+    for (const auto& [k, v] : h.notes)
+        if (k == key) return v;
+    return "<missing>";
+}
+
+// Runs Debian's draco_decoder on `drc` and returns the (vertex, face) counts of its PLY output.
+std::pair<uint64_t, uint64_t> draco_decoder_counts(const std::string& drc, const std::string& ply) {
+    std::string tool = MESHSTREAM_DRACO_DECODER;
+    EXPECT_TRUE(fs::exists(tool)) << "draco_decoder not found (" << tool << "); install Debian's 'draco' package";
+    std::string out;
+    EXPECT_EQ(run(quote(tool) + " -i " + quote(drc) + " -o " + quote(ply) + " 2>&1", &out), 0) << out;
+    std::istringstream header(slurp(ply));
+    std::string line;
+    uint64_t vertices = 0, faces = 0;
+    while (std::getline(header, line) && line != "end_header") {
+        if (line.rfind("element vertex ", 0) == 0) vertices = std::stoull(line.substr(15));
+        if (line.rfind("element face ", 0) == 0) faces = std::stoull(line.substr(13));
+    }
+    return {vertices, faces};
+}
+
+TEST(DracoReader, ExactCountsAndSettingsOnRealFiles) {
+    struct Case {
+        const char* file;
+        uint64_t triangles;
+        const char* draco;
+        const char* attributes;
+    } cases[] = {
+        {"drc/bunny_v1.1_draco3d-npm.drc", 69451, "bitstream 1.1, edgebreaker connectivity", "position"},
+        {"drc/cactus_vcolor_edgebreaker.drc", 1236, "bitstream 2.2, edgebreaker connectivity", "position, color"},
+        {"drc/cube_quads.drc", 12, "bitstream 2.2, edgebreaker connectivity", "position"},
+        {"drc/elephant_normals_sequential_cl0.drc", 5558, "bitstream 2.2, sequential connectivity", "position, normal"},
+    };
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.file);
+        io::MeshHeader h;
+        Soup s = read_soup(fixture(c.file), io::TriangleChunk::kDefaultCapacity, &h);
+        EXPECT_EQ(s.triangles(), c.triangles);
+        EXPECT_EQ(h.triangle_count, c.triangles);
+        EXPECT_EQ(note(h, "draco"), c.draco);
+        EXPECT_EQ(note(h, "attributes"), c.attributes);
+        EXPECT_NE(note(h, "draco_qp"), "<missing>");
+        for (float v : s.xyz) ASSERT_TRUE(std::isfinite(v));
+    }
+}
+
+TEST(DracoReader, CountsAgreeWithDracoDecoder) {
+    TempDir dir;
+    for (const char* f : {"drc/bunny_v1.1_draco3d-npm.drc", "drc/elephant_normals_sequential_cl0.drc"}) {
+        io::MeshHeader h;
+        read_soup(fixture(f), 4096, &h);
+        auto [v, t] = draco_decoder_counts(fixture(f), dir / "out.ply");
+        EXPECT_EQ(h.vertex_count, v) << f;
+        EXPECT_EQ(h.triangle_count, t) << f;
+    }
+}
+
+TEST(DracoReader, RefusesPointCloudsByName) {
+    try {
+        read_soup(fixture("drc/points_pointcloud.drc"));
+        FAIL() << "a point cloud was read as a mesh";
+    } catch (const io::Error& e) {
+        EXPECT_EQ(e.file(), fixture("drc/points_pointcloud.drc"));
+        EXPECT_NE(std::string(e.what()).find("Draco point cloud (no faces)"), std::string::npos) << e.what();
+    }
+}
+
+TEST(DracoReader, DetectedByMagicWhateverTheName) {
+    TempDir dir;
+    fs::copy_file(fixture("drc/cube_quads.drc"), dir / "cube.bin");
+    io::Input in = io::open_input(dir / "cube.bin");
+    EXPECT_EQ(in.format->name, "draco");
+}
+
+TEST(DracoReader, TruncationAtEveryByteThrows) {
+    TempDir dir;
+    std::string bytes = slurp(fixture("drc/cube_quads.drc"));
+    ASSERT_EQ(bytes.size(), 80u);
+    for (size_t n = 0; n < bytes.size(); ++n) {
+        std::ofstream(dir / "t.drc", std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(n));
+        EXPECT_THROW(read_soup(dir / "t.drc"), io::Error) << "truncated to " << n << " bytes";
+    }
+}
+
+TEST(DracoReader, ChunkBoundariesGiveIdenticalSoup) {
+    Soup whole = read_soup(fixture("drc/elephant_normals_sequential_cl0.drc"));
+    for (size_t cap : {size_t{1}, size_t{7}}) {
+        Soup pieces = read_soup(fixture("drc/elephant_normals_sequential_cl0.drc"), cap);
+        EXPECT_EQ(pieces.xyz, whole.xyz) << "capacity " << cap;
+    }
+}
+
+TEST(DracoWriter, RoundTripStaysWithinQuantizationBound) {
+    TempDir dir;
+    Soup bunny = read_soup(fixture("bunny_from_draco.bin.stl"));
+    ASSERT_EQ(bunny.triangles(), 69451u);
+    for (int qp : {14, 11}) {
+        SCOPED_TRACE(qp);
+        io::WriteOptions o;
+        o.draco_position_bits = qp;
+        write_soup(bunny, dir / "b.drc", o);
+        io::MeshHeader h;
+        Soup back = read_soup(dir / "b.drc", io::TriangleChunk::kDefaultCapacity, &h);
+        EXPECT_EQ(note(h, "draco_qp"), std::to_string(qp) + " bits");
+        EXPECT_EQ(note(h, "draco"), "bitstream 2.2, edgebreaker connectivity");
+        double worst = expect_within_quantization_bound(bunny, back, qp);
+        if (qp == 11) {
+            EXPECT_GT(worst, 0.0) << "11 bits must move the 14-bit bunny's coordinates";
+        }
+        auto [v, t] = draco_decoder_counts(dir / "b.drc", dir / "b.ply");
+        EXPECT_EQ(t, 69451u);
+        EXPECT_EQ(h.vertex_count, v);
+    }
+}
+
+TEST(DracoWriter, LevelZeroIsSequentialAndDecoderAgrees) {
+    TempDir dir;
+    Soup elephant = read_soup(fixture("drc/elephant_normals_sequential_cl0.drc"));
+    io::WriteOptions o;
+    o.draco_level = 0;
+    o.normals = true;
+    write_soup(elephant, dir / "e.drc", o);
+    io::MeshHeader h;
+    Soup back = read_soup(dir / "e.drc", 1000, &h);
+    EXPECT_EQ(note(h, "draco"), "bitstream 2.2, sequential connectivity");
+    EXPECT_EQ(note(h, "attributes"), "position, normal");
+    expect_within_quantization_bound(elephant, back, 14);
+    auto [v, t] = draco_decoder_counts(dir / "e.drc", dir / "e.ply");
+    EXPECT_EQ(t, 5558u);
+    EXPECT_EQ(h.vertex_count, v);
+}
+
+TEST(DracoWriter, UsesVertexIdsInsteadOfWelding) {
+    // Two triangles sharing an edge by position; with distinct vertex ids they stay 6 vertices.
+    TempDir dir;
+    const float quad[2][9] = {{0, 0, 0, 1, 0, 0, 1, 1, 0}, {0, 0, 0, 1, 1, 0, 0, 1, 0}};
+    for (bool ids : {false, true}) {
+        io::WriteOptions o;
+        io::Output out = io::open_output(dir / "q.drc", {}, o);
+        io::TriangleChunk chunk(4, io::Channels{.vertex_id = ids});
+        for (int t = 0; t < 2; ++t) {
+            chunk.push(quad[t]);
+            if (ids)
+                for (int k = 0; k < 3; ++k) chunk.id_at(t)[k] = uint64_t(10 * t + k);
+        }
+        out.write(chunk);
+        out.finish();
+        io::MeshHeader h;
+        Soup back = read_soup(dir / "q.drc", 16, &h);
+        EXPECT_EQ(back.triangles(), 2u);
+        EXPECT_EQ(h.vertex_count, ids ? 6u : 4u) << (ids ? "vertex ids" : "welding");
+        auto [v, t] = draco_decoder_counts(dir / "q.drc", dir / "q.ply");
+        EXPECT_EQ(v, ids ? 6u : 4u);
+        EXPECT_EQ(t, 2u);
+    }
+}
+
+TEST(DracoWriter, RefusesPastMemoryBudgetAndLeavesNoFile) {
+    TempDir dir;
+    Soup bunny = read_soup(fixture("bunny_from_draco.bin.stl"));
+    io::WriteOptions o;
+    o.memory_budget_bytes = 1 << 20;  // 1 MiB: the bunny needs several
+    try {
+        write_soup(bunny, dir / "b.drc", o);
+        FAIL() << "no memory error";
+    } catch (const io::Error& e) {
+        EXPECT_EQ(e.file(), dir / "b.drc");
+        EXPECT_NE(std::string(e.what()).find("raise --memory"), std::string::npos) << e.what();
+    }
+    EXPECT_TRUE(fs::is_empty(dir.path()));
+}
+
+TEST(DracoWriter, RefusesEmptyMeshAndNonFiniteCoordinates) {
+    TempDir dir;
+    EXPECT_THROW(write_soup(Soup{}, dir / "empty.drc"), io::Error);
+    Soup bad;
+    bad.xyz = {0, 0, 0, 1, 0, 0, 0, NAN, 0};
+    try {
+        write_soup(bad, dir / "nan.drc");
+        FAIL();
+    } catch (const io::Error& e) {
+        EXPECT_NE(std::string(e.what()).find("triangle 0 has a non-finite coordinate"), std::string::npos) << e.what();
+    }
+    EXPECT_TRUE(fs::is_empty(dir.path()));
+}
+
+TEST(DracoWriter, RejectsOutOfRangeSettings) {
+    TempDir dir;
+    io::WriteOptions o;
+    o.draco_level = 11;
+    EXPECT_THROW(io::open_output(dir / "x.drc", {}, o), io::Error);
+    o.draco_level = 7;
+    o.draco_position_bits = 31;
+    EXPECT_THROW(io::open_output(dir / "x.drc", {}, o), io::Error);
+}
+
+}  // namespace

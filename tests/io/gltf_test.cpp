@@ -1,0 +1,341 @@
+// glTF tests: the Khronos validator (a real client) must report 0 errors and 0 warnings on
+// every .glb/.gltf written here, Draco or not; exact counts on real files (GLB, embedded and
+// external buffers, Draco, KHR_mesh_quantization, strips and fans, instanced node trees);
+// world-space node transforms with mirrored winding; clean refusals naming the file and the
+// extension, mode or accessor; lossy and exact round trips; atomic .gltf + .bin output.
+#include "io/gltf.hpp"
+
+#include "io/error.hpp"
+#include "io/format.hpp"
+#include "web_test_util.hpp"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <cstdlib>
+#include <cstring>
+
+using namespace web_test;
+using nlohmann::json;
+
+namespace {
+
+std::string tools_modules_dir() {
+    const char* env = std::getenv("MESHSTREAM_TOOLS_DIR");
+    return std::string(env && *env ? env : MESHSTREAM_TOOLS_DIR) + "/node_modules";
+}
+
+// Runs tests/tools/validate_gltf.mjs; a missing node or validator fails the test (the set-up
+// script installs both), it is never skipped.
+json validate(const std::string& path) {
+    std::string node = MESHSTREAM_NODE;
+    EXPECT_TRUE(fs::exists(node)) << "node not found (" << node << "); run tools/bootstrap.sh";
+    std::string out;
+    int status = run(quote(node) + " " + quote(MESHSTREAM_VALIDATE_GLTF) + " " + quote(path) + " " +
+                         quote(tools_modules_dir()) + " 2>&1",
+                     &out);
+    EXPECT_NE(status, 2) << "validator could not run: " << out;
+    json report = json::parse(out, nullptr, false);
+    EXPECT_FALSE(report.is_discarded()) << out;
+    return report;
+}
+
+void expect_valid(const std::string& path) {
+    SCOPED_TRACE(path);
+    json report = validate(path);
+    if (report.is_discarded()) return;
+    const json& issues = report["issues"];
+    EXPECT_EQ(issues["numErrors"], 0) << issues.dump(2);
+    EXPECT_EQ(issues["numWarnings"], 0) << issues.dump(2);
+    // The only infos allowed: the validator cannot decode Draco, so it reports the extension
+    // as unsupported and the Draco bufferView as unused.
+    for (const json& m : issues["messages"]) {
+        std::string code = m["code"];
+        EXPECT_TRUE(code == "UNSUPPORTED_EXTENSION" || code == "UNUSED_OBJECT") << m.dump();
+    }
+}
+
+json glb_json(const std::string& path) {
+    std::string bytes = slurp(path);
+    EXPECT_GE(bytes.size(), 20u);
+    EXPECT_EQ(bytes.substr(0, 4), "glTF");
+    uint32_t len;
+    std::memcpy(&len, bytes.data() + 12, 4);
+    return json::parse(bytes.substr(20, len));
+}
+
+std::string error_of(const std::string& path) {
+    try {
+        read_soup(path);
+    } catch (const io::Error& e) {
+        EXPECT_EQ(e.file(), path);
+        return e.what();
+    }
+    ADD_FAILURE() << "no io::Error for " << path;
+    return {};
+}
+
+TEST(GltfReader, ExactCountsOnRealFiles) {
+    struct Case {
+        const char* file;
+        uint64_t triangles;
+    } cases[] = {
+        {"gltf/BoxTextured.glb", 12},
+        {"gltf/BoxTextured_draco_transcoder.glb", 12},
+        {"gltf/BoxTextured_embedded.gltf", 12},
+        {"gltf/BoxTextured_external/BoxTextured.gltf", 12},
+        {"gltf/elephant_draco_gltfpipeline.glb", 5558},
+        {"gltf/elephant_gltfpack_quantized.glb", 5558},
+        // 65311 triangles in 29 meshes; the default scene instances some of them: 110336.
+        {"gltf/2CylinderEngine_draco/2CylinderEngine.gltf", 110336},
+        {"gltf/primitive_modes/Mesh_PrimitiveMode_04.gltf", 2},
+        {"gltf/primitive_modes/Mesh_PrimitiveMode_05.gltf", 2},
+        {"gltf/primitive_modes/Mesh_PrimitiveMode_11.gltf", 2},
+    };
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.file);
+        io::MeshHeader h;
+        Soup s = read_soup(fixture(c.file), io::TriangleChunk::kDefaultCapacity, &h);
+        EXPECT_EQ(s.triangles(), c.triangles);
+        EXPECT_EQ(h.triangle_count, c.triangles);
+        for (float v : s.xyz) ASSERT_TRUE(std::isfinite(v));
+    }
+}
+
+TEST(GltfReader, SameBoxWhateverTheContainer) {
+    Soup glb = read_soup(fixture("gltf/BoxTextured.glb"));
+    EXPECT_EQ(read_soup(fixture("gltf/BoxTextured_embedded.gltf")).xyz, glb.xyz);
+    EXPECT_EQ(read_soup(fixture("gltf/BoxTextured_external/BoxTextured.gltf")).xyz, glb.xyz);
+}
+
+TEST(GltfReader, QuantizedAndDracoElephantsMatchTheSequentialDrc) {
+    // Three encodings of CGAL's elephant: same triangle count and (to quantization) same box.
+    auto box = [](const Soup& s) {
+        std::array<float, 6> b = {1e30f, 1e30f, 1e30f, -1e30f, -1e30f, -1e30f};
+        for (size_t i = 0; i < s.xyz.size(); i += 3)
+            for (int a = 0; a < 3; ++a) {
+                b[a] = std::min(b[a], s.xyz[i + a]);
+                b[3 + a] = std::max(b[3 + a], s.xyz[i + a]);
+            }
+        return b;
+    };
+    auto ref = box(read_soup(fixture("drc/elephant_normals_sequential_cl0.drc")));
+    for (const char* f : {"gltf/elephant_gltfpack_quantized.glb", "gltf/elephant_draco_gltfpipeline.glb"}) {
+        auto b = box(read_soup(fixture(f)));
+        for (int i = 0; i < 6; ++i) EXPECT_NEAR(b[i], ref[i], 2e-3) << f << " bbox " << i;
+    }
+}
+
+TEST(GltfReader, StripsAndFansKeepOneWinding) {
+    for (const char* f : {"gltf/primitive_modes/Mesh_PrimitiveMode_04.gltf", "gltf/primitive_modes/Mesh_PrimitiveMode_05.gltf",
+                          "gltf/primitive_modes/Mesh_PrimitiveMode_11.gltf"}) {
+        Soup s = read_soup(fixture(f));
+        ASSERT_EQ(s.triangles(), 2u) << f;
+        double nz[2];
+        for (int t = 0; t < 2; ++t) {
+            const float* p = &s.xyz[9 * t];
+            nz[t] = (double(p[3]) - p[0]) * (double(p[7]) - p[1]) - (double(p[4]) - p[1]) * (double(p[6]) - p[0]);
+        }
+        EXPECT_GT(nz[0] * nz[1], 0) << f << ": the two triangles face opposite ways";
+    }
+}
+
+TEST(GltfReader, ChunkBoundariesGiveIdenticalSoup) {
+    const std::string f = fixture("gltf/2CylinderEngine_draco/2CylinderEngine.gltf");
+    Soup whole = read_soup(f);
+    for (size_t cap : {size_t{1}, size_t{7}}) EXPECT_EQ(read_soup(f, cap).xyz, whole.xyz) << cap;
+}
+
+TEST(GltfReader, RefusesMeshoptNamingTheExtension) {
+    std::string what = error_of(fixture("gltf/elephant_meshopt.glb"));
+    EXPECT_NE(what.find("requires extension EXT_meshopt_compression"), std::string::npos) << what;
+}
+
+// A one-triangle document with an external buffer, for transform and refusal cases.
+struct HandMade {
+    TempDir dir;
+    std::string path = dir / "hand.gltf";
+    explicit HandMade(const std::string& extra_top, const std::string& mode = "4",
+                      const std::string& nodes = R"([{"mesh":0}])", const std::string& scene_nodes = "[0]",
+                      int position_count = 3) {
+        const float tri[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+        std::ofstream(dir / "hand.bin", std::ios::binary).write(reinterpret_cast<const char*>(tri), sizeof tri);
+        std::ofstream(path) << R"({"asset":{"version":"2.0"},)" << extra_top
+                            << R"("buffers":[{"uri":"hand.bin","byteLength":36}],)"
+                            << R"("bufferViews":[{"buffer":0,"byteLength":36}],)"
+                            << R"("accessors":[{"bufferView":0,"componentType":5126,"count":)" << position_count
+                            << R"(,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}],)"
+                            << R"("meshes":[{"name":"tri","primitives":[{"attributes":{"POSITION":0},"mode":)" << mode
+                            << "}]}],"
+                            << R"("nodes":)" << nodes << R"(,"scenes":[{"nodes":)" << scene_nodes << R"(}],"scene":0})";
+    }
+};
+
+TEST(GltfReader, AppliesNodeTransformsAndFlipsMirroredWinding) {
+    // Node 0 translates by +10 in x and holds node 1, which mirrors x and instances the mesh;
+    // node 2 instances it again untransformed.
+    HandMade doc("", "4", R"([{"translation":[10,0,0],"children":[1]},{"scale":[-1,1,1],"mesh":0},{"mesh":0,"matrix":[1,0,0,0,0,1,0,0,0,0,1,0,0,0,0,1]}])",
+                 "[0,2]");
+    io::MeshHeader h;
+    Soup s = read_soup(doc.path, 16, &h);
+    ASSERT_EQ(s.triangles(), 2u);
+    EXPECT_EQ(h.triangle_count, 2u);
+    // Mirrored: (10,0,0) (9,0,0) (10,1,0), corners 1 and 2 swapped to keep it facing +z.
+    const std::vector<float> mirrored = {10, 0, 0, 10, 1, 0, 9, 0, 0};
+    const std::vector<float> plain = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    EXPECT_EQ(std::vector<float>(s.xyz.begin(), s.xyz.begin() + 9), mirrored);
+    EXPECT_EQ(std::vector<float>(s.xyz.begin() + 9, s.xyz.end()), plain);
+}
+
+TEST(GltfReader, RefusesPointsAndLinesNamingMeshAndPrimitive) {
+    HandMade points("", "0");
+    std::string what = error_of(points.path);
+    EXPECT_NE(what.find("mesh 0 'tri' primitive 0 has mode POINTS"), std::string::npos) << what;
+    HandMade lines("", "1");
+    what = error_of(lines.path);
+    EXPECT_NE(what.find("has mode LINES"), std::string::npos) << what;
+}
+
+TEST(GltfReader, RefusesUnknownRequiredExtensionByName) {
+    HandMade doc(R"("extensionsUsed":["EXT_made_up"],"extensionsRequired":["EXT_made_up"],)");
+    std::string what = error_of(doc.path);
+    EXPECT_NE(what.find("requires extension EXT_made_up"), std::string::npos) << what;
+}
+
+TEST(GltfReader, RefusesAccessorsOutsideTheirBufferView) {
+    HandMade doc("", "4", R"([{"mesh":0}])", "[0]", 6);  // 6 positions promised, 3 stored
+    std::string what = error_of(doc.path);
+    EXPECT_NE(what.find("mesh 0 'tri' primitive 0 POSITION (accessor 0) reaches byte 72"), std::string::npos) << what;
+}
+
+TEST(GltfReader, RefusesTruncatedGlbAtEveryLength) {
+    TempDir dir;
+    std::string bytes = slurp(fixture("gltf/BoxTextured_draco_transcoder.glb"));
+    // From 4 bytes on, the magic says glTF (shorter prefixes such as "g" are other formats).
+    for (size_t n = 4; n < bytes.size(); n += (n < 64 ? 1 : 61)) {
+        std::ofstream(dir / "t.glb", std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(n));
+        EXPECT_THROW(read_soup(dir / "t.glb"), io::Error) << "truncated to " << n;
+    }
+    std::ofstream(dir / "t.glb", std::ios::binary).write(bytes.data(), 3968);
+    std::string what = error_of(dir / "t.glb");
+    EXPECT_NE(what.find("byte 8: GLB header states 3976 bytes, the file holds 3968"), std::string::npos) << what;
+}
+
+TEST(GltfWriter, DracoGlbIsValidAndWithinQuantizationBound) {
+    TempDir dir;
+    Soup bunny = read_soup(fixture("bunny_from_draco.bin.stl"));
+    write_soup(bunny, dir / "b.glb");
+    expect_valid(dir / "b.glb");
+    json doc = glb_json(dir / "b.glb");
+    EXPECT_EQ(doc["asset"]["generator"].get<std::string>().rfind("meshstream ", 0), 0u);
+    EXPECT_EQ(doc["extensionsRequired"], json::array({"KHR_draco_mesh_compression"}));
+    EXPECT_EQ(doc["extensionsUsed"], json::array({"KHR_draco_mesh_compression"}));
+    const json& prim = doc["meshes"][0]["primitives"][0];
+    EXPECT_TRUE(prim["extensions"]["KHR_draco_mesh_compression"].contains("bufferView"));
+    for (const json& a : doc["accessors"]) EXPECT_FALSE(a.contains("bufferView")) << a.dump();
+    EXPECT_EQ(doc["accessors"][prim["indices"].get<int>()]["count"], 3 * 69451);
+    EXPECT_EQ(doc["accessors"][prim["indices"].get<int>()]["componentType"], 5123);  // 34834 vertices
+    io::MeshHeader h;
+    Soup back = read_soup(dir / "b.glb", io::TriangleChunk::kDefaultCapacity, &h);
+    expect_within_quantization_bound(bunny, back, 14);
+    // POSITION min/max are the decoded bounds, exactly.
+    const json& pos = doc["accessors"][prim["attributes"]["POSITION"].get<int>()];
+    for (int a = 0; a < 3; ++a) {
+        float lo = 1e30f, hi = -1e30f;
+        for (size_t i = a; i < back.xyz.size(); i += 3) lo = std::min(lo, back.xyz[i]), hi = std::max(hi, back.xyz[i]);
+        EXPECT_EQ(pos["min"][a].get<float>(), lo) << a;
+        EXPECT_EQ(pos["max"][a].get<float>(), hi) << a;
+    }
+}
+
+TEST(GltfWriter, PlainGlbRoundTripsExactlyWithNormals) {
+    TempDir dir;
+    Soup bunny = read_soup(fixture("bunny_from_draco.bin.stl"));
+    io::WriteOptions o;
+    o.draco = false;
+    o.normals = true;
+    write_soup(bunny, dir / "p.glb", o);
+    expect_valid(dir / "p.glb");
+    json doc = glb_json(dir / "p.glb");
+    EXPECT_FALSE(doc.contains("extensionsRequired"));
+    EXPECT_TRUE(doc["meshes"][0]["primitives"][0]["attributes"].contains("NORMAL"));
+    EXPECT_EQ(read_soup(dir / "p.glb").xyz, bunny.xyz);
+}
+
+TEST(GltfWriter, GltfWithBinSideFileBothWaysIsValid) {
+    TempDir dir;
+    Soup bunny = read_soup(fixture("bunny_from_draco.bin.stl"));
+    for (bool draco : {false, true}) {
+        SCOPED_TRACE(draco);
+        io::WriteOptions o;
+        o.draco = draco;
+        o.normals = draco;
+        write_soup(bunny, dir / "scene one.gltf", o);
+        ASSERT_TRUE(fs::exists(dir / "scene one.bin"));
+        json doc = json::parse(slurp(dir / "scene one.gltf"));
+        EXPECT_EQ(doc["buffers"][0]["uri"], "scene%20one.bin");
+        expect_valid(dir / "scene one.gltf");
+        Soup back = read_soup(dir / "scene one.gltf");
+        if (draco) expect_within_quantization_bound(bunny, back, 14);
+        else EXPECT_EQ(back.xyz, bunny.xyz);
+    }
+}
+
+TEST(GltfWriter, SmallestIndexTypeAndEmptyMeshAreValid) {
+    TempDir dir;
+    Soup cube = read_soup(fixture("cube.bin.stl"));
+    io::WriteOptions o;
+    o.draco = false;
+    write_soup(cube, dir / "cube.glb", o);
+    expect_valid(dir / "cube.glb");
+    json doc = glb_json(dir / "cube.glb");
+    EXPECT_EQ(doc["accessors"][0]["componentType"], 5121);  // 8 vertices: unsigned byte
+    EXPECT_EQ(doc["accessors"][1]["count"], 8);
+
+    write_soup(Soup{}, dir / "empty.glb");
+    expect_valid(dir / "empty.glb");
+    EXPECT_EQ(read_soup(dir / "empty.glb").triangles(), 0u);
+}
+
+TEST(GltfWriter, UnfinishedGltfLeavesNeitherFile) {
+    TempDir dir;
+    Soup cube = read_soup(fixture("cube.bin.stl"));
+    {
+        io::Output out = io::open_output(dir / "c.gltf", {}, {});
+        io::TriangleChunk chunk(16);
+        for (size_t t = 0; t < cube.triangles(); ++t) {
+            float tri[9];
+            std::copy(&cube.xyz[9 * t], &cube.xyz[9 * t] + 9, tri);
+            chunk.push(tri);
+        }
+        out.write(chunk);
+    }  // destroyed without finish()
+    EXPECT_TRUE(fs::is_empty(dir.path()));
+}
+
+TEST(GltfWriter, RefusesPastMemoryBudget) {
+    TempDir dir;
+    Soup bunny = read_soup(fixture("bunny_from_draco.bin.stl"));
+    for (bool draco : {false, true}) {
+        io::WriteOptions o;
+        o.draco = draco;
+        o.memory_budget_bytes = 1 << 20;
+        try {
+            write_soup(bunny, dir / "b.glb", o);
+            ADD_FAILURE() << "no memory error";
+        } catch (const io::Error& e) {
+            EXPECT_NE(std::string(e.what()).find("raise --memory"), std::string::npos) << e.what();
+        }
+    }
+    EXPECT_TRUE(fs::is_empty(dir.path()));
+}
+
+TEST(GltfFormat, DetectedByContentWhateverTheName) {
+    TempDir dir;
+    fs::copy_file(fixture("gltf/BoxTextured.glb"), dir / "a.bin");
+    fs::copy_file(fixture("gltf/BoxTextured_embedded.gltf"), dir / "b.json");
+    EXPECT_EQ(io::open_input(dir / "a.bin").format->name, "glb");
+    EXPECT_EQ(io::open_input(dir / "b.json").format->name, "gltf");
+}
+
+}  // namespace
