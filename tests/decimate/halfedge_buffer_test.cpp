@@ -1,0 +1,105 @@
+// Tests of decimate/halfedge_buffer: READ (welding, twins, P_in bookkeeping) and the frozen
+// treatment of non-manifold and degenerate input.
+#include "decimate/halfedge_buffer.hpp"
+
+#include "mesh_util.hpp"
+
+#include <gtest/gtest.h>
+
+using namespace meshstream::decimate;
+using namespace meshstream::decimate::test;
+
+TEST(HalfEdgeBuffer, TwoTrianglesShareAnEdge) {
+    HalfEdgeBuffer buffer(64, 0);
+    const size_t free_before = buffer.free_vertex_count();
+    add_indexed(buffer, {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}}, {{0, 1, 2}, {1, 3, 2}});
+    EXPECT_EQ(buffer.face_count(), 2u);
+    EXPECT_EQ(free_before - buffer.free_vertex_count(), 4u);
+    const uint32_t b = vertex_at(buffer, {1, 0, 0}), c = vertex_at(buffer, {0, 1, 0});
+    const uint32_t bc = half_edge(buffer, b, c), cb = half_edge(buffer, c, b);
+    ASSERT_NE(bc, kNoIndex);
+    ASSERT_NE(cb, kNoIndex);
+    EXPECT_EQ(buffer.twin(bc), cb);
+    EXPECT_EQ(buffer.twin(cb), bc);
+    // The outer edges are still open towards the input: every vertex is on P_in.
+    EXPECT_EQ(buffer.vertex(b).open_edges, 2u);
+    EXPECT_TRUE(buffer.vertex(b).flags & kInHash);
+    EXPECT_EQ(buffer.interior_faces().size(), 0u);
+    EXPECT_TRUE(buffer_consistent(buffer));
+}
+
+TEST(HalfEdgeBuffer, ClosedMeshLeavesPin) {
+    HalfEdgeBuffer buffer(64, 0);
+    add_indexed(buffer, octahedron_points(), octahedron_faces());
+    EXPECT_EQ(buffer.face_count(), 8u);
+    for (const auto& p : octahedron_points()) {
+        const uint32_t v = vertex_at(buffer, p);
+        ASSERT_NE(v, kNoIndex);
+        EXPECT_EQ(buffer.vertex(v).open_edges, 0u);
+        EXPECT_FALSE(buffer.vertex(v).flags & kInHash);
+        EXPECT_EQ(buffer.vertex(v).face_count, 4u);
+    }
+    EXPECT_EQ(buffer.interior_faces().size(), 8u);
+    EXPECT_EQ(buffer.frontier_faces().size(), 0u);  // nothing written yet: no P_out
+    EXPECT_TRUE(buffer_consistent(buffer));
+}
+
+TEST(HalfEdgeBuffer, NegativeZeroWeldsWithPositiveZero) {
+    HalfEdgeBuffer buffer(64, 0);
+    add_indexed(buffer, {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {-0.0f, 0, 0}, {0, -1, 0}},
+                {{0, 1, 2}, {3, 4, 1}});
+    EXPECT_EQ(buffer.free_vertex_count(), 3 * 64 + 3 - 4u);
+}
+
+TEST(HalfEdgeBuffer, ThirdFaceOnAnEdgeIsFrozenAsNonManifold) {
+    HalfEdgeBuffer buffer(64, 0);
+    const auto faces = add_indexed(buffer, {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}},
+                                   {{0, 1, 2}, {1, 0, 3}, {0, 1, 4}});
+    EXPECT_EQ(buffer.nonmanifold_edges(), 1u);
+    const uint32_t a = vertex_at(buffer, {0, 0, 0}), b = vertex_at(buffer, {1, 0, 0});
+    EXPECT_TRUE(buffer.vertex(a).flags & kNonManifold);
+    EXPECT_TRUE(buffer.vertex(b).flags & kNonManifold);
+    EXPECT_EQ(buffer.twin(3 * faces[2] + 0), kNonManifoldEdge);
+    EXPECT_TRUE(buffer_consistent(buffer));
+}
+
+TEST(HalfEdgeBuffer, DuplicateAndMisorientedFacesAreFrozen) {
+    HalfEdgeBuffer buffer(64, 0);
+    // The same triangle twice: every edge of the second conflicts with the first.
+    add_indexed(buffer, {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {{0, 1, 2}, {0, 1, 2}});
+    EXPECT_EQ(buffer.nonmanifold_edges(), 3u);
+}
+
+TEST(HalfEdgeBuffer, DegenerateTriangleIsNotInserted) {
+    HalfEdgeBuffer buffer(64, 0);
+    const float tri[9] = {0, 0, 0, 1, 0, 0, 0, 0, 0};
+    const HalfEdgeBuffer::Added added = buffer.add_triangle(tri);
+    EXPECT_EQ(added.face, kNoIndex);
+    EXPECT_EQ(added.vertex[0], added.vertex[2]);
+    EXPECT_EQ(buffer.face_count(), 0u);
+}
+
+TEST(HalfEdgeBuffer, WeldGridMergesNearbyPositionsAndCounts) {
+    HalfEdgeBuffer buffer(64, 0.01);
+    // (0.1234, 0, 0) and (0.1236, 0, 0) share a 0.01 cell: the two triangles share an edge.
+    add_indexed(buffer, {{0.1234f, 0.005f, 0.005f}, {1.005f, 0.005f, 0.005f}, {0.005f, 1.005f, 0.005f},
+                         {0.1236f, 0.005f, 0.005f}, {0.5f, -1, 0.005f}},
+                {{0, 1, 2}, {1, 3, 4}});
+    EXPECT_EQ(buffer.vertices_merged(), 1u);
+    EXPECT_EQ(buffer.free_vertex_count(), 3 * 64 + 3 - 4u);
+}
+
+TEST(HalfEdgeBuffer, FreezingMarksNeighbourFacesAsFrontier) {
+    HalfEdgeBuffer buffer(64, 0);
+    add_indexed(buffer, octahedron_points(), octahedron_faces());
+    buffer.freeze(vertex_at(buffer, {0, 0, 1}), 0);
+    EXPECT_EQ(buffer.frontier_faces().size(), 4u);
+}
+
+TEST(HalfEdgeBuffer, FinalizedOpenVertexLeavesPin) {
+    HalfEdgeBuffer buffer(64, 0);
+    add_indexed(buffer, {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {{0, 1, 2}});
+    EXPECT_EQ(buffer.interior_faces().size(), 0u);
+    buffer.finalize_all();
+    EXPECT_EQ(buffer.interior_faces().size(), 1u);
+}

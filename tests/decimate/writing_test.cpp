@@ -1,0 +1,96 @@
+// Tests of decimate/writing: write-time placement at the quadric minimum (§4.4), freezing and
+// ids, P_out bookkeeping, and the preference for triangles on P_out.
+#include "decimate/writing.hpp"
+
+#include "mesh_util.hpp"
+
+#include <gtest/gtest.h>
+
+using namespace meshstream::decimate;
+using namespace meshstream::decimate::test;
+
+TEST(Writing, WriteFreezesVerticesAndOpensPout) {
+    HalfEdgeBuffer buffer(64, 0);
+    const auto faces = add_indexed(buffer, octahedron_points(), octahedron_faces());
+    TriangleOutput output(4);
+    std::vector<uint64_t> ids;
+    const Emit emit = [&](const meshstream::io::TriangleChunk& chunk) {
+        ids.insert(ids.end(), chunk.vertex_ids().begin(), chunk.vertex_ids().end());
+    };
+    uint64_t next_id = 0;
+    write_face(buffer, faces[0], next_id, output, emit);
+    output.flush(emit);
+    ASSERT_EQ(ids.size(), 3u);
+    EXPECT_EQ(ids, (std::vector<uint64_t>{0, 1, 2}));
+    EXPECT_EQ(buffer.face_count(), 7u);
+    // Every remaining face but the opposite one (-x, -y, -z) touches a written vertex.
+    EXPECT_EQ(buffer.frontier_faces().size(), 6u);
+    // The three neighbours across the written face's edges now border P_out.
+    int written_edges = 0;
+    const FaceSet& live = buffer.live_faces();
+    for (size_t i = 0; i < live.size(); ++i)
+        for (uint32_t k = 0; k < 3; ++k) written_edges += buffer.twin(3 * live.at(i) + k) == kWrittenEdge;
+    EXPECT_EQ(written_edges, 3);
+    // The next write reuses the frozen ids of shared vertices.
+    Rng rng(1);
+    const uint32_t f = pick_write(buffer, rng, 8);
+    ASSERT_NE(f, kNoIndex);
+    write_face(buffer, f, next_id, output, emit);
+    output.flush(emit);
+    EXPECT_LT(next_id, 6u);
+    EXPECT_TRUE(buffer_consistent(buffer));
+}
+
+TEST(Writing, VertexMovesToItsQuadricMinimumOnce) {
+    HalfEdgeBuffer buffer(64, 0);
+    add_indexed(buffer, octahedron_points(), octahedron_faces());
+    const uint32_t top = vertex_at(buffer, {0, 0, 1});
+    // Quadrics live in coordinates relative to the buffer's origin (the first vertex read).
+    double rel[3];
+    buffer.position(top, rel);
+    const double o[3] = {0 - rel[0], 0 - rel[1], 1 - rel[2]};
+    // Give the top vertex a quadric whose minimum is (0.1, -0.1, 0.9): three planes.
+    const double a[3] = {0.1 - o[0], -o[1], -o[2]}, b[3] = {0.1 - o[0], 1 - o[1], -o[2]}, c[3] = {0.1 - o[0], -o[1], 1 - o[2]};
+    const double d[3] = {-o[0], -0.1 - o[1], -o[2]}, e[3] = {-o[0], -0.1 - o[1], 1 - o[2]}, f[3] = {1 - o[0], -0.1 - o[1], -o[2]};
+    const double g[3] = {-o[0], -o[1], 0.9 - o[2]}, h[3] = {1 - o[0], -o[1], 0.9 - o[2]}, i[3] = {-o[0], 1 - o[1], 0.9 - o[2]};
+    buffer.quadric(top) = Quadric::from_triangle(a, b, c) + Quadric::from_triangle(d, e, f) +
+                          Quadric::from_triangle(g, h, i);
+    ASSERT_TRUE(place_vertex(buffer, top));
+    EXPECT_FLOAT_EQ(buffer.vertex(top).pos[0], 0.1f);
+    EXPECT_FLOAT_EQ(buffer.vertex(top).pos[1], -0.1f);
+    EXPECT_FLOAT_EQ(buffer.vertex(top).pos[2], 0.9f);
+    buffer.freeze(top, 0);
+    EXPECT_FALSE(place_vertex(buffer, top));  // frozen: never again
+}
+
+TEST(Writing, FarOrSingularOptimumKeepsThePosition) {
+    HalfEdgeBuffer buffer(64, 0);
+    add_indexed(buffer, octahedron_points(), octahedron_faces());
+    const uint32_t top = vertex_at(buffer, {0, 0, 1});
+    const double a[3] = {0, 0, 9}, b[3] = {1, 0, 9}, c[3] = {0, 1, 9};  // only the plane z = 9
+    buffer.quadric(top) = Quadric::from_triangle(a, b, c);
+    EXPECT_FALSE(place_vertex(buffer, top));  // singular
+    const double d[3] = {9, 0, 0}, e[3] = {9, 1, 0}, f[3] = {9, 0, 1};
+    const double g[3] = {0, 9, 0}, h[3] = {0, 9, 1}, i[3] = {1, 9, 0};
+    buffer.quadric(top) = buffer.quadric(top) + Quadric::from_triangle(d, e, f) + Quadric::from_triangle(g, h, i);
+    EXPECT_FALSE(place_vertex(buffer, top));  // minimum (9, 9, 9) is beyond the longest edge
+    EXPECT_EQ(buffer.vertex(top).pos[2], 1.0f);
+}
+
+TEST(Writing, PassThroughFreezesInPlace) {
+    HalfEdgeBuffer buffer(64, 0);
+    const float tri[9] = {0, 0, 0, 1, 0, 0, 0, 0, 0};
+    const HalfEdgeBuffer::Added added = buffer.add_triangle(tri);
+    TriangleOutput output(8);
+    std::vector<float> xyz;
+    std::vector<uint64_t> ids;
+    const Emit emit = [&](const meshstream::io::TriangleChunk& chunk) {
+        xyz.insert(xyz.end(), chunk.xyz().begin(), chunk.xyz().end());
+        ids.insert(ids.end(), chunk.vertex_ids().begin(), chunk.vertex_ids().end());
+    };
+    uint64_t next_id = 0;
+    pass_through(buffer, added.vertex, next_id, output, emit);
+    output.flush(emit);
+    EXPECT_EQ(xyz, std::vector<float>(tri, tri + 9));
+    EXPECT_EQ(ids, (std::vector<uint64_t>{0, 1, 0}));
+}
