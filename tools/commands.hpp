@@ -9,5 +9,7 @@ namespace meshstream::tools {
 void add_info(CLI::App& app);
 void add_convert(CLI::App& app);
 void add_decimate(CLI::App& app);
+void add_sort(CLI::App& app);
+void add_compare(CLI::App& app);
 
 }  // namespace meshstream::tools

@@ -18,6 +18,8 @@ int main(int argc, char** argv) {
     tools::add_info(app);
     tools::add_convert(app);
     tools::add_decimate(app);
+    tools::add_sort(app);
+    tools::add_compare(app);
 
     io::install_cleanup_handlers();
     try {
