@@ -36,6 +36,12 @@ public:
     ObjReader(ByteSource& source, const ReadOptions& options)
         : src_(source), options_(options), table_(options.memory_budget_bytes, options.tmpdir, false) {
         header_.channels.vertex_id = true;
+        // The leading comments are read now, so a "# meshstream sorted-axis=" line is in the
+        // header before the first chunk.
+        for (auto w = src_.peek(1); !w.empty() && w[0] == std::byte{'#'}; w = src_.peek(1)) {
+            next_line();
+            note_comment();
+        }
     }
 
     bool next(TriangleChunk& chunk) override {
@@ -108,11 +114,7 @@ private:
             std::string_view key = next_word(rest);
             if (key.empty()) continue;
             if (key[0] == '#') {
-                size_t at = line_.find(kSortMarker);
-                if (at != std::string_view::npos && at + kSortMarker.size() < line_.size()) {
-                    char axis = line_[at + kSortMarker.size()];
-                    if (axis >= 'x' && axis <= 'z') header_.sorted_axis = axis - 'x';
-                }
+                note_comment();
                 continue;
             }
             if (key == "v") {
@@ -126,6 +128,14 @@ private:
                 return true;
             }
             // vt vn vp g o s usemtl mtllib l p and anything else: not geometry we keep.
+        }
+    }
+
+    void note_comment() {
+        size_t at = line_.find(kSortMarker);
+        if (at != std::string_view::npos && at + kSortMarker.size() < line_.size()) {
+            char axis = line_[at + kSortMarker.size()];
+            if (axis >= 'x' && axis <= 'z') header_.sorted_axis = axis - 'x';
         }
     }
 

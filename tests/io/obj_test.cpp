@@ -1,0 +1,162 @@
+// OBJ reader and writer: corpus fixtures with the MANIFEST's counts, every face form, relative
+// indices, continuations, chunk boundaries, round trips, a spilled vertex table, and bad
+// input reported with file, line and offset.
+#include "io/obj.hpp"
+
+#include "indexed_test_util.hpp"
+
+#include <gtest/gtest.h>
+
+using namespace meshstream;
+using test::fixture;
+using test::read_soup;
+using test::TempDir;
+
+namespace {
+
+io::Error read_error(const std::string& path) {
+    try {
+        read_soup(path);
+    } catch (const io::Error& e) {
+        return e;
+    }
+    ADD_FAILURE() << path << ": no io::Error";
+    return io::Error(path, "no error");
+}
+
+}  // namespace
+
+TEST(ObjReader, ReadsCorpusFixturesWithManifestCounts) {
+    const std::pair<const char*, size_t> cases[] = {
+        {"obj/WusonOBJ.obj", 3732},          {"obj/WusonOBJ.obj.gz", 3732},
+        {"obj/box.obj", 12},                 {"obj/box_negative_indices.obj", 12},
+        {"obj/box_without_lineending.obj", 12}, {"obj/concave_polygon.obj", 64},
+        {"obj/cube_mtllib_after_g.obj", 12}, {"obj/cube_usemtl.obj", 12},
+        {"obj/cube_with_vertexcolors.obj", 12}, {"obj/double_torus_normals.obj", 466},
+        {"obj/multiple_spaces.obj", 1},      {"obj/regr_3429812.obj", 4},
+        {"obj/testmixed.obj", 12},
+    };
+    for (const auto& [file, triangles] : cases) {
+        SCOPED_TRACE(file);
+        io::Input in = io::open_input(fixture(file));
+        EXPECT_EQ(in.format->name, "obj");  // detected by content (and extension)
+        test::Soup s = read_soup(fixture(file));
+        EXPECT_EQ(s.triangles(), triangles);
+        EXPECT_EQ(s.ids.size(), 3 * triangles);
+    }
+}
+
+TEST(ObjReader, NegativeIndicesMatchPositiveOnes) {
+    test::Soup pos = read_soup(fixture("obj/box.obj"));
+    test::Soup neg = read_soup(fixture("obj/box_negative_indices.obj"));
+    EXPECT_EQ(pos.xyz, neg.xyz);
+    EXPECT_EQ(pos.ids, neg.ids);
+}
+
+TEST(ObjReader, ChunkCapacitiesGiveIdenticalTriangles) {
+    for (const char* file : {"obj/concave_polygon.obj", "obj/WusonOBJ.obj.gz", "obj/regr_3429812.obj"}) {
+        SCOPED_TRACE(file);
+        test::Soup whole = read_soup(fixture(file));
+        for (size_t capacity : {size_t{1}, size_t{7}}) {
+            test::Soup part = read_soup(fixture(file), capacity);
+            EXPECT_EQ(part.xyz, whole.xyz);
+            EXPECT_EQ(part.ids, whole.ids);
+        }
+    }
+}
+
+TEST(ObjReader, EveryFaceFormContinuationsCrlfAndSkippedStatements) {
+    TempDir dir;
+    test::spit(dir / "forms.obj",
+               "# comment\r\nmtllib x.mtl\r\no thing\r\nv 0 0 0\r\nv 1 0 0 1.0\r\nv 1 1 0 0.5 0.5 0.5\r\n"
+               "v 0 1 0\r\nvt 0 0\r\nvn 0 0 1\r\ng group\r\ns off\r\nusemtl m\r\n"
+               "f 1 2 3\r\nf 1/1 3/1 4/1\r\nf 1//1 2//1 4//1\r\nf 1/1/1 \\\r\n  2/1/1 -2/1/1\r\n"
+               "l 1 2\r\np 3\r\nv 5 5 5\r\nf -1 1 2 3\n");
+    test::Soup s = read_soup(dir / "forms.obj");
+    EXPECT_EQ(s.ids, (std::vector<uint64_t>{0, 1, 2, 0, 2, 3, 0, 1, 3, 0, 1, 2, 4, 0, 1, 4, 1, 2}));
+    EXPECT_EQ(std::vector<float>(s.xyz.end() - 3, s.xyz.end()), (std::vector<float>{1, 1, 0}));
+}
+
+TEST(ObjReader, BadInputNamesFileLineAndOffset) {
+    TempDir dir;
+    const std::string head = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+    struct Case {
+        std::string bytes, message;
+        uint64_t line, offset;
+    };
+    const Case cases[] = {
+        {head + "f 1 2 0\n", "vertex index 0 is invalid (OBJ indices start at 1)", 4, head.size()},
+        {head + "f 1 2 3\nf 1 2 4\nv 1 1 1\n", "vertex index 4 refers past the 3 vertices defined so far", 5, head.size() + 8},
+        {head + "f -4 1 2\n", "vertex index -4 refers past the 3 vertices defined so far", 4, head.size()},
+        {head + "# note\nv 1 x 2\n", "expected a coordinate, found 'x'", 5, head.size() + 7},
+        {head + "v 1 2\n", "'v' needs 3 coordinates, found 2", 4, head.size()},
+        {head + "f 1 2 a/1\n", "expected a vertex index, found 'a/1'", 4, head.size()},
+        {head + "f 1 \\\n 2 \\\n 9\n", "vertex index 9 refers past", 4, head.size()},
+    };
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.message);
+        test::spit(dir / "bad.obj", c.bytes);
+        io::Error e = read_error(dir / "bad.obj");
+        EXPECT_EQ(e.file(), dir / "bad.obj");
+        EXPECT_NE(e.message().find(c.message), std::string::npos) << e.what();
+        EXPECT_EQ(e.line(), c.line) << e.what();
+        EXPECT_EQ(e.byte_offset(), c.offset) << e.what();
+    }
+}
+
+TEST(ObjRoundTrip, PlyAndStlThroughObjAreExact) {
+    for (const char* file : {"gearwheel.ascii.stl", "ply/cactus_vcolor.binary_le.ply", "obj/WusonOBJ.obj.gz"}) {
+        SCOPED_TRACE(file);
+        TempDir dir;
+        test::Soup original = read_soup(fixture(file));
+        test::convert(fixture(file), dir / "a.obj.gz");
+        test::convert(dir / "a.obj.gz", dir / "b.obj");
+        test::Soup a = read_soup(dir / "a.obj.gz"), b = read_soup(dir / "b.obj");
+        EXPECT_TRUE(a.xyz == original.xyz);
+        EXPECT_TRUE(b.xyz == original.xyz);
+        EXPECT_EQ(a.ids, b.ids);  // OBJ -> OBJ keeps the numbering
+        EXPECT_TRUE(test::slurp(dir / "b.obj").starts_with("# generated by meshstream\nv "));
+    }
+}
+
+TEST(ObjWriter, RecordsSortedAxisAndWeldsPositions) {
+    TempDir dir;
+    io::WriteOptions wo;
+    wo.sorted_axis = 0;
+    // Two triangles sharing an edge, one corner written as -0.0.
+    test::write_soup(dir / "s.obj", {0, 0, 0, 1, 0, 0, 0, 1, 0, -0.0f, 1, 0, 1, 0, 0, 1, 1, 0}, {}, wo);
+    EXPECT_EQ(test::slurp(dir / "s.obj"),
+              "# generated by meshstream\n# meshstream sorted-axis=x\n"
+              "v 0 0 0\nv 0 1 0\nv 1 0 0\nv 1 1 0\nf 1 3 2\nf 2 3 4\n");
+    auto axis = read_soup(dir / "s.obj").header.sorted_axis;
+    ASSERT_TRUE(axis.has_value());
+    EXPECT_EQ(*axis, 0);
+}
+
+TEST(ObjMemory, TinyBudgetSpillsTheVertexTableWithTheSameResult) {
+    TempDir dir;
+    std::vector<float> grid = test::grid_soup(300);  // 178802 triangles, 90000 vertices
+    test::write_soup(dir / "grid.obj", grid);
+    io::ReadOptions tiny;
+    tiny.memory_budget_bytes = 256 << 10;
+    test::Soup spilled = read_soup(dir / "grid.obj", io::TriangleChunk::kDefaultCapacity, tiny);
+    test::Soup memory = read_soup(dir / "grid.obj");
+    EXPECT_TRUE(spilled.xyz == grid);
+    EXPECT_TRUE(memory.xyz == grid);
+    EXPECT_EQ(spilled.ids, memory.ids);
+    test::convert(dir / "grid.obj", dir / "tiny.obj", {}, 256 << 10);
+    EXPECT_TRUE(test::slurp(dir / "tiny.obj") == test::slurp(dir / "grid.obj"));
+}
+
+TEST(ObjFormat, ProbeAcceptsObjTextAndRejectsBinaryAndStl) {
+    auto probe = [](std::string_view s) {
+        return io::probe_obj({reinterpret_cast<const std::byte*>(s.data()), s.size()}, std::nullopt);
+    };
+    EXPECT_TRUE(probe("# Blender\nmtllib a.mtl\no Cube\nv 1 2 3\n"));
+    EXPECT_TRUE(probe("\r\n  v 1 2 3\r\n"));
+    EXPECT_TRUE(probe("# only a comment\n"));
+    EXPECT_FALSE(probe("solid cube\n facet normal 0 0 1\n"));
+    EXPECT_FALSE(probe(std::string_view("# binary STL header\0\0\0\x01", 23)));
+    EXPECT_FALSE(probe("ply\nformat ascii 1.0\n"));
+    EXPECT_FALSE(probe(""));
+}

@@ -1,0 +1,76 @@
+// The vertex table returns what was appended whether it sits in memory, in a spilled and
+// mapped temp file (with reads while still appending), or in a mapped input file.
+#include "io/vertex_table.hpp"
+
+#include "indexed_test_util.hpp"
+
+#include <gtest/gtest.h>
+
+using namespace meshstream;
+
+namespace {
+
+void expect_vertex(io::VertexTable& t, uint64_t i) {
+    float xyz[3];
+    uint8_t rgb[3];
+    t.get(i, xyz, rgb);
+    ASSERT_EQ(xyz[0], static_cast<float>(i) * 0.5f) << i;
+    ASSERT_EQ(xyz[1], -static_cast<float>(i)) << i;
+    ASSERT_EQ(xyz[2], 3.0f) << i;
+    if (t.color()) {
+        ASSERT_EQ(rgb[1], static_cast<uint8_t>(i)) << i;
+    }
+}
+
+}  // namespace
+
+TEST(VertexTable, SpillsPastTheBudgetAndReadsWhileAppending) {
+    for (bool color : {false, true}) {
+        test::TempDir dir;
+        io::VertexTable t(1 << 20, dir.path(), color);
+        const uint64_t n = 300000;  // 3.6-4.8 MB: well past the budget and the 1 MiB tail
+        for (uint64_t i = 0; i < n; ++i) {
+            const float xyz[3] = {static_cast<float>(i) * 0.5f, -static_cast<float>(i), 3.0f};
+            const uint8_t rgb[3] = {1, static_cast<uint8_t>(i), 2};
+            t.append(xyz, rgb);
+            if (i % 9973 == 0) {  // OBJ reads earlier vertices between appends
+                expect_vertex(t, i);
+                expect_vertex(t, i / 2);
+            }
+        }
+        EXPECT_EQ(t.storage(), io::VertexTable::Storage::kTempFile);
+        EXPECT_EQ(dir.entries().size(), 1u);
+        for (uint64_t i = 0; i < n; i += 7) expect_vertex(t, i);
+        for (uint64_t i = n / 4; i-- > 0;) expect_vertex(t, (i * 7919) % n);  // scattered: drops pages
+    }
+}
+
+TEST(VertexTable, StaysInMemoryWithinTheBudget) {
+    io::VertexTable t(1 << 20, {}, false);
+    for (uint64_t i = 0; i < 1000; ++i) {
+        const float xyz[3] = {static_cast<float>(i) * 0.5f, -static_cast<float>(i), 3.0f};
+        t.append(xyz, nullptr);
+    }
+    EXPECT_EQ(t.storage(), io::VertexTable::Storage::kMemory);
+    for (uint64_t i = 0; i < 1000; ++i) expect_vertex(t, i);
+}
+
+TEST(VertexTable, MapsRecordsOfAnInputFile) {
+    test::TempDir dir;
+    // 5 junk bytes, then records of 20 bytes: pad(2) x y z pad(3) r g b ... (stride 20).
+    std::string bytes(5, 'j');
+    const uint64_t n = 5000;
+    for (uint64_t i = 0; i < n; ++i) {
+        char rec[20] = {};
+        const float xyz[3] = {static_cast<float>(i) * 0.5f, -static_cast<float>(i), 3.0f};
+        std::memcpy(rec + 2, xyz, 12);
+        rec[17] = static_cast<char>(i);
+        bytes.append(rec, 20);
+    }
+    test::spit(dir / "v.bin", bytes);
+    const size_t xyz_offsets[3] = {2, 6, 10};
+    const size_t rgb_offsets[3] = {16, 17, 18};
+    auto t = io::VertexTable::map_input_file(dir / "v.bin", 5, n, 20, xyz_offsets, rgb_offsets, 16 << 10);
+    EXPECT_EQ(t->storage(), io::VertexTable::Storage::kInputFile);
+    for (uint64_t i = n; i-- > 0;) expect_vertex(*t, (i * 31) % n);
+}
