@@ -7,10 +7,30 @@
 #include <cmath>
 #include <cstring>
 
+#ifdef __linux__
+#include <sys/mman.h>
+#endif
+
 namespace meshstream::decimate {
 
+void* allocate_pool(size_t bytes) {
+    constexpr size_t kHugePage = size_t{2} << 20;
+    if (bytes < 2 * kHugePage) {
+        void* p = std::malloc(bytes == 0 ? 1 : bytes);
+        if (!p) throw std::bad_alloc();
+        return p;
+    }
+    const size_t rounded = (bytes + kHugePage - 1) / kHugePage * kHugePage;
+    void* p = std::aligned_alloc(kHugePage, rounded);
+    if (!p) throw std::bad_alloc();
+#ifdef __linux__
+    madvise(p, rounded, MADV_HUGEPAGE);  // a hint: failure only costs speed
+#endif
+    return p;
+}
+
 FaceSet::FaceSet(size_t capacity)
-    : items_(new uint32_t[capacity]), where_(new uint32_t[capacity]) {}
+    : items_(raw_array<uint32_t>(capacity)), where_(raw_array<uint32_t>(capacity)) {}
 
 void FaceSet::insert(uint32_t f) {
     if (where_[f] != kNoIndex) return;
@@ -55,22 +75,22 @@ HalfEdgeBuffer::HalfEdgeBuffer(size_t triangle_capacity, double weld_eps)
       // are evicted when the pool runs short.
       vertex_capacity_(3 * triangle_capacity + 3),
       weld_eps_(weld_eps),
-      corner_vertex_(new uint32_t[3 * triangle_capacity]),
-      twin_(new uint32_t[3 * triangle_capacity]),
-      next_corner_(new uint32_t[3 * triangle_capacity]),
-      pin_count_(new uint8_t[triangle_capacity]),
-      touches_out_(new uint8_t[triangle_capacity]),
-      free_faces_(new uint32_t[triangle_capacity]),
+      corner_vertex_(raw_array<uint32_t>(3 * triangle_capacity)),
+      twin_(raw_array<uint32_t>(3 * triangle_capacity)),
+      next_corner_(raw_array<uint32_t>(3 * triangle_capacity)),
+      pin_count_(raw_array<uint8_t>(triangle_capacity)),
+      touches_out_(raw_array<uint8_t>(triangle_capacity)),
+      free_faces_(raw_array<uint32_t>(triangle_capacity)),
       live_(triangle_capacity),
       interior_(triangle_capacity),
       frontier_(triangle_capacity),
       vertex_(raw_array<Vertex>(vertex_capacity_)),
       quadric_(raw_array<Quadric>(vertex_capacity_)),
-      stamp_(new uint32_t[vertex_capacity_]),
-      free_vertices_(new uint32_t[vertex_capacity_]) {
+      stamp_(raw_array<uint32_t>(vertex_capacity_)),
+      free_vertices_(raw_array<uint32_t>(vertex_capacity_)) {
     assert(triangle_capacity >= 4 && triangle_capacity < (size_t{1} << 30));
     const size_t slots = pow2_at_least(2 * vertex_capacity_);
-    hash_.reset(new uint32_t[slots]);
+    hash_ = raw_array<uint32_t>(slots);
     std::fill_n(hash_.get(), slots, kNoIndex);
     hash_mask_ = slots - 1;
     const size_t stub_slots = pow2_at_least(triangle_capacity / 8);
