@@ -3,6 +3,7 @@
 #include "io/error.hpp"
 #include "tools/commands.hpp"
 #include "tools/common.hpp"
+#include "tools/order.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -17,6 +18,8 @@ namespace {
 struct InfoOptions {
     std::string input;
     bool json = false;
+    bool order = false;        // --order: measure the stream's width (tools/order.hpp)
+    uint64_t buffer = 400000;  // --buffer: decimation buffer to judge against the width
     ReadFlags read;
 };
 
@@ -62,10 +65,13 @@ void run_info(const InfoOptions& opt) {
     const io::MeshHeader& header = in.reader->header();
     InfoStats stats;
     io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, header.channels);
+    std::optional<OrderMeter> meter;
+    if (opt.order) meter.emplace(opt.read.options().memory_budget_bytes);
     {
         Progress progress("reading", header.triangle_count);
         while (in.reader->next(chunk)) {
             accumulate(chunk, stats);
+            if (meter) meter->add(chunk);
             progress.update(stats.triangles);
         }
     }
@@ -95,6 +101,20 @@ void run_info(const InfoOptions& opt) {
         }
         if (header.sorted_axis) j["sorted_axis"] = kAxes[*header.sorted_axis];
         for (const auto& [k, v] : header.notes) j["notes"][k] = v;
+        if (meter) {
+            OrderReport r = meter->finish();
+            BufferVerdict v = buffer_verdict(r, opt.buffer);
+            auto& o = j["order"];
+            o["width"] = r.width;
+            o["width_error"] = r.width_error;
+            o["exact"] = r.exact();
+            o["sample_rate"] = r.sample_rate;
+            o["width_at"] = r.width_at;
+            o["buffer"] = opt.buffer;
+            o["buffer_suffices"] = v == BufferVerdict::kSuffices ? nlohmann::json(true)
+                                   : v == BufferVerdict::kTooSmall ? nlohmann::json(false) : nlohmann::json(nullptr);
+            o["key_descents"] = {{"x", r.descents[0]}, {"y", r.descents[1]}, {"z", r.descents[2]}};
+        }
         std::printf("%s\n", j.dump(2).c_str());
         return;
     }
@@ -115,6 +135,7 @@ void run_info(const InfoOptions& opt) {
     }
     if (header.sorted_axis) std::printf("sorted along: %s\n", kAxes[*header.sorted_axis]);
     for (const auto& [k, v] : header.notes) std::printf("%-12s %s\n", (k + ":").c_str(), v.c_str());
+    if (meter) std::printf("%s", format_order_text(meter->finish(), opt.buffer).c_str());
 }
 
 }  // namespace
@@ -124,6 +145,10 @@ void add_info(CLI::App& app) {
     CLI::App* cmd = app.add_subcommand("info", "Print format, triangle count, bounding box, file size and degenerate triangles");
     cmd->add_option("file", opt->input, "Mesh file ('-' = stdin; gzip is detected)")->required();
     cmd->add_flag("--json", opt->json, "Print JSON instead of text");
+    cmd->add_flag("--order", opt->order,
+                  "Measure the stream's width: triangles held at once until all their vertices' uses were read "
+                  "(exact within --memory, else sampled; see docs/cli.md)");
+    cmd->add_option("--buffer", opt->buffer, "With --order: decimation buffer (triangles) to judge (default 400000)");
     add_read_flags(cmd, opt->read);
     cmd->callback([opt] { run_info(*opt); });
 }

@@ -139,7 +139,9 @@ TEST(ExternalSorter, EqualKeysKeepInputOrderAcrossRuns) {
     EXPECT_GT(r.stats.runs, 10u);
     ASSERT_EQ(r.tris.size(), input.size());
     for (size_t i = 1; i < r.tris.size(); ++i)
-        if (r.tris[i - 1][5] == r.tris[i][5]) ASSERT_LT(r.tris[i - 1][0], r.tris[i][0]) << "at " << i;
+        if (r.tris[i - 1][5] == r.tris[i][5]) {
+            ASSERT_LT(r.tris[i - 1][0], r.tris[i][0]) << "at " << i;
+        }
     EXPECT_TRUE(r.tris == stable_sorted(input, 2));
 }
 

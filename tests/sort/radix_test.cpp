@@ -60,7 +60,9 @@ TEST(RadixSort, SortsKeysThatDifferOnlyInOneDigit) {
         auto sorted = radix_sort_by_key(items, scratch);
         for (size_t i = 1; i < sorted.size(); ++i) {
             ASSERT_LE(sorted[i - 1] >> 32, sorted[i] >> 32);
-            if (sorted[i - 1] >> 32 == sorted[i] >> 32) ASSERT_LT(uint32_t(sorted[i - 1]), uint32_t(sorted[i]));
+            if (sorted[i - 1] >> 32 == sorted[i] >> 32) {
+                ASSERT_LT(uint32_t(sorted[i - 1]), uint32_t(sorted[i]));
+            }
         }
     }
 }

@@ -1,0 +1,281 @@
+// End-to-end tests of `meshstream sort` and `info --order` through the built binary
+// (MESHSTREAM_BINARY): exit codes, messages, sorted and complete output, the recorded axis,
+// stdin→stdout, multi-pass merging, and temporary files gone after success, failure and SIGINT.
+#include "io/format.hpp"
+#include "sort/radix.hpp"
+
+#include <gtest/gtest.h>
+
+#include <fcntl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <thread>
+#include <vector>
+
+namespace fs = std::filesystem;
+using namespace meshstream;
+using Tri = std::array<float, 9>;
+
+namespace {
+
+struct TempDir {
+    fs::path path;
+    TempDir() {
+        std::string pattern = (fs::temp_directory_path() / "sort_cli_test-XXXXXX").string();
+        path = ::mkdtemp(pattern.data());
+    }
+    ~TempDir() { fs::remove_all(path); }
+    std::string operator/(const std::string& name) const { return (path / name).string(); }
+};
+
+size_t file_count(const std::string& dir) {
+    return static_cast<size_t>(std::distance(fs::directory_iterator(dir), {}));
+}
+
+struct CliRun {
+    int code;
+    std::string out, err;
+};
+
+// Runs `meshstream ARGS` through the shell; `args` may contain pipes and redirections of stdin.
+CliRun run(const std::string& args, const TempDir& dir) {
+    std::string cmd = std::string(MESHSTREAM_BINARY) + " -q " + args + " > " + dir / "stdout.txt" + " 2> " + dir / "stderr.txt";
+    int status = std::system(cmd.c_str());
+    auto slurp = [](const std::string& p) {
+        std::ifstream in(p, std::ios::binary);
+        return std::string((std::istreambuf_iterator<char>(in)), {});
+    };
+    CliRun r{WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(dir / "stdout.txt"), slurp(dir / "stderr.txt")};
+    fs::remove(dir / "stdout.txt");
+    fs::remove(dir / "stderr.txt");
+    return r;
+}
+
+std::vector<Tri> read_fixture(const std::string& name) {
+    std::ifstream in(std::string(MESHSTREAM_FIXTURES_DIR) + "/" + name, std::ios::binary);
+    std::vector<char> bytes((std::istreambuf_iterator<char>(in)), {});
+    uint32_t n;
+    std::memcpy(&n, bytes.data() + 80, 4);
+    std::vector<Tri> tris(n);
+    for (uint32_t i = 0; i < n; ++i) std::memcpy(tris[i].data(), bytes.data() + 84 + 50 * size_t{i} + 12, 36);
+    return tris;
+}
+
+// Binary STL written by hand (zero normals), so the input does not depend on the writer.
+void write_stl(const std::string& path, const std::vector<Tri>& tris) {
+    std::ofstream out(path, std::ios::binary);
+    char header[80] = "sort_test input";
+    out.write(header, 80);
+    uint32_t n = static_cast<uint32_t>(tris.size());
+    out.write(reinterpret_cast<const char*>(&n), 4);
+    for (const Tri& t : tris) {
+        char facet[50] = {};
+        std::memcpy(facet + 12, t.data(), 36);
+        out.write(facet, 50);
+    }
+}
+
+struct Mesh {
+    std::vector<Tri> tris;
+    std::optional<int> sorted_axis;
+};
+
+Mesh read_mesh(const std::string& path) {
+    io::Input in = io::open_input(path);
+    Mesh m;
+    m.sorted_axis = in.reader->header().sorted_axis;
+    io::TriangleChunk chunk;
+    while (in.reader->next(chunk)) {
+        auto xyz = chunk.xyz();
+        for (size_t i = 0; i < chunk.size(); ++i) std::memcpy(m.tris.emplace_back().data(), &xyz[9 * i], 36);
+    }
+    return m;
+}
+
+void expect_sorted_permutation(const std::vector<Tri>& out, std::vector<Tri> in, int axis) {
+    ASSERT_EQ(out.size(), in.size());
+    for (size_t i = 1; i < out.size(); ++i)
+        ASSERT_LE(sort::triangle_key(out[i - 1].data(), axis), sort::triangle_key(out[i].data(), axis)) << "at " << i;
+    std::vector<Tri> a = out;
+    auto less = [](const Tri& x, const Tri& y) { return std::memcmp(x.data(), y.data(), sizeof(Tri)) < 0; };
+    std::sort(a.begin(), a.end(), less);
+    std::sort(in.begin(), in.end(), less);
+    EXPECT_TRUE(std::memcmp(a.data(), in.data(), a.size() * sizeof(Tri)) == 0) << "triangles changed";
+}
+
+// n triangles scattered over a box 1 × 10 × 2 (longest along y), in random order.
+std::vector<Tri> random_triangles(size_t n, uint64_t seed) {
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<float> u(0, 1);
+    std::vector<Tri> tris(n);
+    for (Tri& t : tris) {
+        float x = u(rng), y = 10 * u(rng), z = 2 * u(rng);
+        t = {x, y, z, x + 0.01f, y, z, x, y + 0.01f, z + 0.01f};
+    }
+    return tris;
+}
+
+uint64_t width_of(const std::string& info_text) {
+    size_t at = info_text.find("width:");
+    EXPECT_NE(at, std::string::npos) << info_text;
+    return at == std::string::npos ? 0 : std::stoull(info_text.substr(at + 6));
+}
+
+}  // namespace
+
+TEST(SortCommand, SortsShuffledFixtureAndRecordsAxis) {
+    TempDir dir;
+    std::vector<Tri> tris = read_fixture("bunny_from_draco.bin.stl");
+    std::shuffle(tris.begin(), tris.end(), std::mt19937_64(3));
+    write_stl(dir / "shuffled.stl", tris);
+    fs::create_directory(dir / "tmp");
+    CliRun r = run("sort --axis z --memory 1M --tmpdir " + dir / "tmp" + " " + dir / "shuffled.stl" + " " + dir / "sorted.stl", dir);
+    ASSERT_EQ(r.code, 0) << r.err;
+    Mesh m = read_mesh(dir / "sorted.stl");
+    expect_sorted_permutation(m.tris, tris, 2);
+    EXPECT_EQ(m.sorted_axis, 2);
+    EXPECT_EQ(file_count(dir / "tmp"), 0u);
+}
+
+TEST(SortCommand, AutoAxisIsTheLongestExtent) {
+    TempDir dir;
+    std::vector<Tri> tris = random_triangles(20000, 1);
+    write_stl(dir / "in.stl", tris);
+    CliRun r = run("sort " + dir / "in.stl" + " " + dir / "out.stl", dir);
+    ASSERT_EQ(r.code, 0) << r.err;
+    Mesh m = read_mesh(dir / "out.stl");
+    EXPECT_EQ(m.sorted_axis, 1);
+    expect_sorted_permutation(m.tris, tris, 1);
+    // Default temporary directory: next to the output, and emptied.
+    EXPECT_EQ(file_count(dir.path.string()), 2u);
+}
+
+TEST(SortCommand, StdinToStdout) {
+    TempDir dir;
+    std::vector<Tri> tris = random_triangles(30000, 2);
+    write_stl(dir / "in.stl", tris);
+    CliRun r = run("sort --axis x --memory 1M --to stl - - < " + dir / "in.stl", dir);
+    ASSERT_EQ(r.code, 0) << r.err;
+    std::ofstream(dir / "out.stl", std::ios::binary) << r.out;
+    Mesh m = read_mesh(dir / "out.stl");
+    expect_sorted_permutation(m.tris, tris, 0);
+    EXPECT_EQ(m.sorted_axis, 0);
+    // Through a pipe as well (not a seekable file).
+    r = run("sort --axis x --to stl - - < /dev/null", dir);
+    EXPECT_EQ(r.code, 1);  // empty input is not a mesh
+    r = run("sort --axis y --to stl - " + dir / "piped.stl" + " < " + dir / "in.stl", dir);
+    ASSERT_EQ(r.code, 0) << r.err;
+    expect_sorted_permutation(read_mesh(dir / "piped.stl").tris, tris, 1);
+}
+
+TEST(SortCommand, AutoAxisNeedsAFile) {
+    TempDir dir;
+    write_stl(dir / "in.stl", random_triangles(10, 3));
+    CliRun r = run("sort --to stl - - < " + dir / "in.stl", dir);
+    EXPECT_EQ(r.code, 1);
+    EXPECT_NE(r.err.find("give --axis x, y or z"), std::string::npos) << r.err;
+    r = run("sort --axis w " + dir / "in.stl" + " " + dir / "out.stl", dir);
+    EXPECT_EQ(r.code, 2);  // bad command line
+    EXPECT_FALSE(fs::exists(dir / "out.stl"));
+}
+
+TEST(SortCommand, MultiPassMergeUnderOneMebibyte) {
+    TempDir dir;
+    std::vector<Tri> tris = random_triangles(500000, 4);
+    write_stl(dir / "in.stl", tris);
+    CliRun r = run("sort --stats --axis z --memory 1M " + dir / "in.stl" + " " + dir / "out.stl", dir);
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.err.find("2 merge passes"), std::string::npos) << r.err;
+    expect_sorted_permutation(read_mesh(dir / "out.stl").tris, tris, 2);
+    EXPECT_EQ(file_count(dir.path.string()), 2u);  // in.stl and out.stl only
+}
+
+TEST(SortCommand, TruncatedInputLeavesNoOutputAndNoTemporaryFiles) {
+    TempDir dir;
+    write_stl(dir / "in.stl", random_triangles(100000, 5));
+    fs::resize_file(dir / "in.stl", 84 + 50 * 60000 + 17);  // runs are already on disk when it fails
+    fs::create_directory(dir / "tmp");
+    CliRun r = run("sort --axis z --memory 1M --tmpdir " + dir / "tmp" + " " + dir / "in.stl" + " " + dir / "out.stl", dir);
+    EXPECT_EQ(r.code, 1);
+    EXPECT_NE(r.err.find("in.stl"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir / "out.stl"));
+    EXPECT_EQ(file_count(dir / "tmp"), 0u);
+    EXPECT_EQ(file_count(dir.path.string()), 2u);  // in.stl and tmp/
+}
+
+TEST(SortCommand, MissingOutputDirectoryFailsBeforeSorting) {
+    TempDir dir;
+    write_stl(dir / "in.stl", random_triangles(10, 6));
+    CliRun r = run("sort --axis z " + dir / "in.stl" + " " + dir / "no/such/out.stl", dir);
+    EXPECT_EQ(r.code, 1);
+    EXPECT_NE(r.err.find("does not exist or is not writable"), std::string::npos) << r.err;
+}
+
+TEST(SortCommand, SigintRemovesTemporaryFiles) {
+    TempDir dir;
+    write_stl(dir / "in.stl", random_triangles(500000, 7));
+    fs::create_directory(dir / "tmp");
+    fs::create_directory(dir / "out");
+    const std::string tmp = dir / "tmp", in = dir / "in.stl", out = dir / "out/out.stl";
+    pid_t pid = ::fork();
+    ASSERT_GE(pid, 0);
+    if (pid == 0) {
+        int null_fd = ::open("/dev/null", O_WRONLY);
+        ::dup2(null_fd, 2);
+        ::execl(MESHSTREAM_BINARY, "meshstream", "-q", "sort", "--axis", "z", "--memory", "1M", "--tmpdir", tmp.c_str(),
+                in.c_str(), out.c_str(), static_cast<char*>(nullptr));
+        ::_exit(127);
+    }
+    int status = 0;
+    bool finished = false;
+    auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+    while (file_count(tmp) == 0 && std::chrono::steady_clock::now() < deadline) {
+        if (::waitpid(pid, &status, WNOHANG) == pid) {
+            finished = true;
+            break;
+        }
+        std::this_thread::sleep_for(std::chrono::microseconds(200));
+    }
+    if (!finished) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));  // past mkstemp → registration
+        ::kill(pid, SIGINT);
+        ::waitpid(pid, &status, 0);
+    }
+    if (WIFEXITED(status) && WEXITSTATUS(status) == 0) GTEST_SKIP() << "the sort finished before it could be interrupted";
+    EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGINT) << status;
+    EXPECT_EQ(file_count(tmp), 0u);
+    EXPECT_EQ(file_count(dir / "out"), 0u);
+}
+
+TEST(InfoOrder, DistinguishesShuffledFromSorted) {
+    TempDir dir;
+    std::vector<Tri> tris = read_fixture("bunny_from_draco.bin.stl");
+    std::shuffle(tris.begin(), tris.end(), std::mt19937_64(9));
+    write_stl(dir / "shuffled.stl", tris);
+    ASSERT_EQ(run("sort --axis y " + dir / "shuffled.stl" + " " + dir / "sorted.stl", dir).code, 0);
+    CliRun shuffled = run("info --order --buffer 20000 " + dir / "shuffled.stl", dir);
+    CliRun sorted = run("info --order --buffer 20000 " + dir / "sorted.stl", dir);
+    ASSERT_EQ(shuffled.code, 0) << shuffled.err;
+    ASSERT_EQ(sorted.code, 0) << sorted.err;
+    uint64_t w_shuffled = width_of(shuffled.out), w_sorted = width_of(sorted.out);
+    EXPECT_GT(w_shuffled, 69451u / 2) << shuffled.out;
+    EXPECT_LT(w_sorted, 69451u / 10) << sorted.out;
+    EXPECT_NE(shuffled.out.find("--buffer 20000 is too small"), std::string::npos) << shuffled.out;
+    EXPECT_NE(sorted.out.find("--buffer 20000 suffices"), std::string::npos) << sorted.out;
+    EXPECT_NE(sorted.out.find("(sorted along y by minimum coordinate)"), std::string::npos) << sorted.out;
+    EXPECT_NE(sorted.out.find("(exact)"), std::string::npos) << sorted.out;
+    // --json carries the same numbers.
+    CliRun json = run("info --order --json " + dir / "sorted.stl", dir);
+    ASSERT_EQ(json.code, 0) << json.err;
+    EXPECT_NE(json.out.find("\"width\": " + std::to_string(w_sorted)), std::string::npos) << json.out;
+    EXPECT_NE(json.out.find("\"buffer_suffices\": true"), std::string::npos) << json.out;
+}

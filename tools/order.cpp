@@ -1,0 +1,300 @@
+// The order measure of `info --order` and decimate's "sorting would help" hint (definitions
+// and error analysis in order.hpp). The vertex table is open addressing with linear probing
+// and backward-shift deletion (Knuth TAOCP vol. 3, §6.4, Algorithm R), so dropping samples
+// frees slots without tombstones.
+#include "tools/order.hpp"
+
+#include "io/error.hpp"
+#include "sort/radix.hpp"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+
+namespace meshstream::tools {
+namespace {
+
+constexpr uint64_t kMinBudgetBytes = uint64_t{1} << 20;
+
+uint64_t mix64(uint64_t x) {  // splitmix64's finaliser
+    x ^= x >> 30;
+    x *= 0xBF58476D1CE4E5B9ull;
+    x ^= x >> 27;
+    x *= 0x94D049BB133111EBull;
+    x ^= x >> 31;
+    return x;
+}
+
+// Position bits with -0 folded into +0 and every NaN into one pattern, so equal positions
+// (as floats) are one vertex.
+uint32_t canonical_bits(float f) {
+    if (f == 0) return 0;
+    if (std::isnan(f)) return 0x7FC00000u;
+    uint32_t u;
+    std::memcpy(&u, &f, sizeof u);
+    return u;
+}
+
+std::string short_count(double n) {
+    char buf[32];
+    if (n >= 1e9) std::snprintf(buf, sizeof buf, "%.3g G", n / 1e9);
+    else if (n >= 1e6) std::snprintf(buf, sizeof buf, "%.3g M", n / 1e6);
+    else if (n >= 1e4) std::snprintf(buf, sizeof buf, "%.3g k", n / 1e3);
+    else std::snprintf(buf, sizeof buf, "%.0f", n);
+    return buf;
+}
+
+const char* const kAxisNames[] = {"x", "y", "z"};
+
+}  // namespace
+
+struct OrderMeter::Table {
+    struct Slot {
+        uint32_t p[3];
+        uint32_t refs;  // samples using this vertex (per corner); 0 = empty slot
+        uint64_t last;  // index of the last triangle seen with a corner here
+    };
+    std::vector<Slot> slots;
+    size_t used = 0;
+    size_t max_slots;
+
+    explicit Table(size_t max) : slots(1024), max_slots(std::max<size_t>(max, 1024)) {}
+    // Home slot: the hash scaled to the table size (Lemire's multiply-shift), so the table can
+    // use its budget exactly rather than the largest power of two below it.
+    size_t home(const uint32_t* p) const {
+        uint64_t h = mix64((uint64_t{p[0]} << 32 | p[1]) ^ mix64(p[2] + 0x9E3779B97F4A7C15ull));
+        return static_cast<size_t>((static_cast<unsigned __int128>(h) * slots.size()) >> 64);
+    }
+    size_t step(size_t i) const { return i + 1 == slots.size() ? 0 : i + 1; }
+    Slot* find(const uint32_t* p) {
+        for (size_t i = home(p);; i = step(i)) {
+            Slot& s = slots[i];
+            if (s.refs == 0) return nullptr;
+            if (s.p[0] == p[0] && s.p[1] == p[1] && s.p[2] == p[2]) return &s;
+        }
+    }
+    // True when `extra` more vertices fit at load <= 1/2, growing the table if allowed.
+    bool reserve(size_t extra) {
+        while (2 * (used + extra) > slots.size()) {
+            if (slots.size() >= max_slots) return false;
+            // Doubling, then one jump to the cap from at most half of it: the old copy never
+            // exceeds half the cap.
+            std::vector<Slot> old(4 * slots.size() <= max_slots ? 2 * slots.size() : max_slots);
+            old.swap(slots);
+            for (const Slot& s : old)
+                if (s.refs) {
+                    size_t i = home(s.p);
+                    while (slots[i].refs) i = step(i);
+                    slots[i] = s;
+                }
+        }
+        return true;
+    }
+    // Adds one reference (inserting the vertex); precondition: reserve(1) succeeded.
+    void ref(const uint32_t* p, uint64_t index) {
+        for (size_t i = home(p);; i = step(i)) {
+            Slot& s = slots[i];
+            if (s.refs == 0) {
+                std::memcpy(s.p, p, sizeof s.p);
+                s.refs = 1;
+                s.last = index;
+                ++used;
+                return;
+            }
+            if (s.p[0] == p[0] && s.p[1] == p[1] && s.p[2] == p[2]) {
+                ++s.refs;
+                s.last = index;
+                return;
+            }
+        }
+    }
+    void unref(const uint32_t* p) {
+        Slot* s = find(p);
+        assert(s);
+        if (--s->refs > 0) return;
+        --used;
+        // Backward-shift deletion: pull later members of the probe run into the hole.
+        size_t hole = static_cast<size_t>(s - slots.data());
+        for (size_t j = step(hole); slots[j].refs; j = step(j)) {
+            size_t h = home(slots[j].p);
+            // Slot j may move to the hole unless its home lies cyclically in (hole, j].
+            bool home_between = hole <= j ? (h > hole && h <= j) : (h > hole || h <= j);
+            if (!home_between) {
+                slots[hole] = slots[j];
+                hole = j;
+            }
+        }
+        slots[hole].refs = 0;
+    }
+};
+
+int OrderReport::best_axis() const {
+    return static_cast<int>(std::min_element(descents.begin(), descents.end()) - descents.begin());
+}
+
+OrderMeter::OrderMeter(uint64_t memory_budget_bytes) : budget_bytes_(std::max(memory_budget_bytes, kMinBudgetBytes)) {
+    // Half the budget for the table (while it grows it briefly holds its old copy too, at most
+    // another quarter) and a fifth for the samples, reserved up front so they never
+    // reallocate; finish() needs 16 bytes per sample more. A sample brings up to three
+    // vertices (48 bytes each at load 1/2), so the table is the scarcer of the two.
+    table_ = std::make_unique<Table>(budget_bytes_ / 2 / sizeof(Table::Slot));
+    max_samples_ = budget_bytes_ / 5 / sizeof(Sample);
+    samples_.reserve(max_samples_);
+}
+
+OrderMeter::~OrderMeter() = default;
+
+void OrderMeter::add(const io::TriangleChunk& chunk) {
+    auto xyz = chunk.xyz();
+    for (size_t i = 0; i < chunk.size(); ++i) add_triangle(&xyz[9 * i]);
+}
+
+void OrderMeter::add_triangle(const float* xyz) {
+    const uint64_t index = count_++;
+    for (int a = 0; a < 3; ++a) {
+        uint32_t key = sort::triangle_key(xyz, a);
+        if (index > 0 && key < prev_key_[a]) ++descents_[a];
+        prev_key_[a] = key;
+    }
+    uint32_t corner[9];
+    for (int k = 0; k < 9; ++k) corner[k] = canonical_bits(xyz[k]);
+
+    auto sampled = [&] { return (mix64(index) & ((uint64_t{1} << level_) - 1)) == 0; };
+    if (!sampled()) {
+        for (int v = 0; v < 3; ++v)
+            if (Table::Slot* s = table_->find(&corner[3 * v])) s->last = index;
+        return;
+    }
+    while (samples_.size() >= max_samples_ || !table_->reserve(3)) {
+        downsample();
+        if (!sampled()) {
+            for (int v = 0; v < 3; ++v)
+                if (Table::Slot* s = table_->find(&corner[3 * v])) s->last = index;
+            return;
+        }
+    }
+    for (int v = 0; v < 3; ++v) table_->ref(&corner[3 * v], index);
+    Sample& s = samples_.emplace_back();
+    s.index = index;
+    std::memcpy(s.corner, corner, sizeof corner);
+}
+
+void OrderMeter::downsample() {
+    ++level_;
+    const uint64_t mask = (uint64_t{1} << level_) - 1;
+    size_t kept = 0;
+    for (const Sample& s : samples_) {
+        if ((mix64(s.index) & mask) == 0) {
+            samples_[kept++] = s;
+        } else {
+            for (int v = 0; v < 3; ++v) table_->unref(&s.corner[3 * v]);
+        }
+    }
+    samples_.resize(kept);
+}
+
+OrderReport OrderMeter::finish() {
+    OrderReport r;
+    r.triangles = count_;
+    r.descents = descents_;
+    r.sample_rate = std::ldexp(1.0, -level_);
+    // L(i) for each sample; samples are in index order, so opens come sorted.
+    std::vector<uint64_t> close(samples_.size());
+    for (size_t k = 0; k < samples_.size(); ++k) {
+        uint64_t l = samples_[k].index;
+        for (int v = 0; v < 3; ++v) l = std::max(l, table_->find(&samples_[k].corner[3 * v])->last);
+        close[k] = l;
+    }
+    std::vector<uint64_t> closes;
+    closes.reserve(close.size());
+    for (size_t k = 0; k < samples_.size(); ++k)
+        if (close[k] > samples_[k].index) closes.push_back(close[k]);
+    std::sort(closes.begin(), closes.end());
+    // Sweep: the open count only rises at an open, so its maximum is seen right after one.
+    uint64_t open = 0, best = 0, best_at = 0;
+    size_t c = 0;
+    for (size_t k = 0; k < samples_.size(); ++k) {
+        const uint64_t i = samples_[k].index;
+        while (c < closes.size() && closes[c] <= i) {
+            --open;
+            ++c;
+        }
+        if (close[k] > i && ++open > best) {
+            best = open;
+            best_at = i;
+        }
+    }
+    r.width = static_cast<uint64_t>(std::llround(static_cast<double>(best) / r.sample_rate));
+    r.width_at = best_at;
+    if (!r.exact()) r.width_error = 3 * std::sqrt(static_cast<double>(r.width) * (1 - r.sample_rate) / r.sample_rate);
+    samples_ = {};
+    table_ = std::make_unique<Table>(1024);
+    return r;
+}
+
+BufferVerdict buffer_verdict(const OrderReport& report, uint64_t buffer_triangles) {
+    const double b = static_cast<double>(buffer_triangles);
+    const double w = static_cast<double>(report.width);
+    if (w + report.width_error <= b) return BufferVerdict::kSuffices;
+    if (w - report.width_error > b) return BufferVerdict::kTooSmall;
+    return BufferVerdict::kUncertain;
+}
+
+std::optional<OrderReport> measure_file_order(const std::string& path, std::string_view from,
+                                              const io::ReadOptions& options) {
+    if (path == "-") return std::nullopt;
+    io::Input in = io::open_input(path, from, options);
+    io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, in.reader->header().channels);
+    OrderMeter meter(options.memory_budget_bytes);
+    while (in.reader->next(chunk)) meter.add(chunk);
+    return meter.finish();
+}
+
+std::optional<std::string> sorting_hint(const OrderReport& report, uint64_t buffer_triangles) {
+    if (buffer_verdict(report, buffer_triangles) == BufferVerdict::kSuffices) return std::nullopt;
+    const int axis = report.best_axis();
+    std::string width = short_count(static_cast<double>(report.width)) + " triangles";
+    if (report.descents[axis] == 0)
+        return "the input is already sorted along " + std::string(kAxisNames[axis]) + " but its width is " + width +
+               "; a --buffer of at least that would avoid forced writes";
+    return "the input's width is " + width + " (a --buffer of " + std::to_string(buffer_triangles) +
+           " holds fewer): sorting it first would help (meshstream sort --axis " + kAxisNames[axis] + ")";
+}
+
+std::string format_order_text(const OrderReport& r, uint64_t buffer_triangles) {
+    std::string out = "width:       " + std::to_string(r.width) + " triangles";
+    char buf[160];
+    if (r.exact()) {
+        out += " (exact)";
+    } else {
+        std::snprintf(buf, sizeof buf, " ± %.0f (≈95%%; sampled 1/%.0f of the triangles to fit --memory)",
+                      r.width_error, 1 / r.sample_rate);
+        out += buf;
+    }
+    if (r.triangles > 0) {
+        std::snprintf(buf, sizeof buf, ", %.3g%% of the file, reached at triangle %llu\n",
+                      100.0 * static_cast<double>(r.width) / static_cast<double>(r.triangles),
+                      static_cast<unsigned long long>(r.width_at));
+        out += buf;
+    } else {
+        out += "\n";
+    }
+    BufferVerdict v = buffer_verdict(r, buffer_triangles);
+    out += "buffer:      --buffer " + std::to_string(buffer_triangles) +
+           (v == BufferVerdict::kSuffices  ? " suffices\n"
+            : v == BufferVerdict::kTooSmall ? " is too small (decimate would force-write)\n"
+                                            : " may be too small (within the estimate's error)\n");
+    std::snprintf(buf, sizeof buf, "key descents: x %llu, y %llu, z %llu",
+                  static_cast<unsigned long long>(r.descents[0]), static_cast<unsigned long long>(r.descents[1]),
+                  static_cast<unsigned long long>(r.descents[2]));
+    out += buf;
+    const int axis = r.best_axis();
+    if (r.triangles > 0 && r.descents[axis] == 0)
+        out += std::string(" (sorted along ") + kAxisNames[axis] + " by minimum coordinate)";
+    out += "\n";
+    return out;
+}
+
+}  // namespace meshstream::tools
