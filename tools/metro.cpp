@@ -437,6 +437,7 @@ struct EdgeCounter::Impl {
     std::vector<Key> buffer;
     size_t buffer_capacity;
     std::vector<std::unique_ptr<io::TempFile>> parts;
+    bool spilled = false;
 
     static uint32_t bits(float f) {
         uint32_t u;
@@ -449,6 +450,7 @@ struct EdgeCounter::Impl {
         return static_cast<size_t>(h % kPartitions);
     }
     void spill() {
+        spilled = true;
         if (parts.empty())
             for (size_t i = 0; i < kPartitions; ++i) parts.push_back(std::make_unique<io::TempFile>(tmpdir, "meshstream-edges"));
         for (const Key& k : buffer) parts[partition_of(k)]->write(k.data(), sizeof k);
@@ -471,8 +473,8 @@ EdgeCounter::EdgeCounter(uint64_t budget_bytes, std::string tmpdir) : impl_(std:
     impl_->budget_bytes = budget_bytes;
     impl_->tmpdir = std::move(tmpdir);
     // The spill partitions' write buffers (1 MiB each) come out of the same budget.
-    uint64_t usable = budget_bytes > (uint64_t{48} << 20) ? budget_bytes - (uint64_t{32} << 20) : (uint64_t{16} << 20);
-    impl_->buffer_capacity = static_cast<size_t>(usable / sizeof(Impl::Key));
+    uint64_t overhead = std::min(budget_bytes / 2, uint64_t{Impl::kPartitions} << 20);
+    impl_->buffer_capacity = static_cast<size_t>(std::max<uint64_t>((budget_bytes - overhead) / sizeof(Impl::Key), 1024));
 }
 
 EdgeCounter::~EdgeCounter() = default;
@@ -492,6 +494,8 @@ void EdgeCounter::add_triangle(const float* tri) {
         if (m.buffer.size() >= m.buffer_capacity) m.spill();
     }
 }
+
+bool EdgeCounter::spilled() const { return impl_->spilled; }
 
 EdgeCounts EdgeCounter::finish() {
     Impl& m = *impl_;

@@ -100,6 +100,8 @@ public:
     void add_triangle(const float* tri);
     // Finishes counting. Call once.
     EdgeCounts finish();
+    // True when edge records were spilled to temporary files.
+    bool spilled() const;
 
 private:
     struct Impl;

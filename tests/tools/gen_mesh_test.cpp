@@ -1,0 +1,164 @@
+// Tests of meshstream-gen (tools/gen_mesh.cpp) through its binary (MESHSTREAM_GEN_BINARY):
+// the triangle count within ±5 % of the request, the output approximately sorted along z (no
+// centroid more than one grid cell below an earlier one), a watertight manifold surface after
+// exact welding (the derived case table is consistent across cells), holes that open it,
+// a shuffle that keeps the same triangles in another order, same seed same bytes, and exit codes.
+#include "io/format.hpp"
+#include "tools/metro.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace fs = std::filesystem;
+using namespace meshstream;
+
+namespace {
+
+struct TempDir {
+    fs::path path;
+    TempDir() {
+        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+        path = fs::temp_directory_path() / (std::string("gen_mesh_test_") + info->name() + "_" + std::to_string(::getpid()));
+        fs::remove_all(path);
+        fs::create_directories(path);
+    }
+    ~TempDir() { fs::remove_all(path); }
+};
+
+std::string slurp(const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+struct GenRun {
+    int exit_code;
+    std::string err;
+};
+
+GenRun gen(const TempDir& dir, const std::string& args) {
+    std::string cmd = std::string(MESHSTREAM_GEN_BINARY) + " " + args + " 2> " + (dir.path / "stderr.txt").string();
+    int status = std::system(cmd.c_str());
+    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(dir.path / "stderr.txt")};
+}
+
+std::vector<std::array<float, 9>> read_all(const fs::path& p) {
+    io::Input in = io::open_input(p.string());
+    io::TriangleChunk chunk;
+    std::vector<std::array<float, 9>> out;
+    while (in.reader->next(chunk))
+        for (size_t t = 0; t < chunk.size(); ++t) {
+            std::array<float, 9> tri;
+            std::copy_n(&chunk.xyz()[9 * t], 9, tri.begin());
+            out.push_back(tri);
+        }
+    return out;
+}
+
+int grid_of(const std::string& err) {
+    size_t at = err.find("grid ");
+    return at == std::string::npos ? 0 : std::atoi(err.c_str() + at + 5);
+}
+
+// Largest drop of the centroid z below the running maximum, and the fraction of consecutive
+// pairs whose centroid z decreases.
+std::pair<double, double> disorder(const std::vector<std::array<float, 9>>& tris) {
+    double running = -1e30, worst = 0;
+    size_t drops = 0;
+    double prev = -1e30;
+    for (const auto& t : tris) {
+        double z = (double(t[2]) + t[5] + t[8]) / 3;
+        running = std::max(running, z);
+        worst = std::max(worst, running - z);
+        drops += z < prev;
+        prev = z;
+    }
+    return {worst, tris.empty() ? 0.0 : double(drops) / double(tris.size())};
+}
+
+tools::EdgeCounts edges_of(const std::vector<std::array<float, 9>>& tris) {
+    tools::EdgeCounter counter;
+    for (const auto& t : tris) counter.add_triangle(t.data());
+    return counter.finish();
+}
+
+}  // namespace
+
+TEST(GenMesh, CountWithinFivePercentAndSortedAlongZ) {
+    TempDir dir;
+    for (uint64_t target : {5'000ull, 40'000ull}) {
+        fs::path out = dir.path / ("g" + std::to_string(target) + ".stl");
+        GenRun r = gen(dir, "--triangles " + std::to_string(target) + " " + out.string());
+        ASSERT_EQ(r.exit_code, 0) << r.err;
+        auto tris = read_all(out);
+        EXPECT_NEAR(double(tris.size()), double(target), 0.05 * double(target));
+        int n = grid_of(r.err);
+        ASSERT_GT(n, 0) << r.err;
+        // Slab k holds triangles with corners in [z_k, z_k+1]: a centroid never drops more than
+        // one cell (2/n) below an earlier one.
+        auto [worst, drops] = disorder(tris);
+        EXPECT_LE(worst, 2.0 / n + 1e-6);
+        EXPECT_GT(worst, 0.0);  // approximately, not exactly sorted, like a scanner's output
+        tools::EdgeCounts e = edges_of(tris);
+        EXPECT_EQ(e.boundary_edges, 0u);
+        EXPECT_EQ(e.non_manifold_edges, 0u);
+        EXPECT_EQ(2 * e.edges, 3 * tris.size());
+    }
+}
+
+TEST(GenMesh, HolesOpenTheSurface) {
+    TempDir dir;
+    GenRun r = gen(dir, "-q --holes -n 40000 " + (dir.path / "h.stl").string());
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    auto tris = read_all(dir.path / "h.stl");
+    tools::EdgeCounts e = edges_of(tris);
+    EXPECT_GT(e.boundary_edges, 50u);
+    EXPECT_EQ(e.non_manifold_edges, 0u);
+    EXPECT_NEAR(double(tris.size()), 40000.0, 2000.0);
+}
+
+TEST(GenMesh, ShuffleKeepsTheTrianglesInRandomOrder) {
+    TempDir dir;
+    ASSERT_EQ(gen(dir, "-q -n 20000 --seed 3 " + (dir.path / "s.stl").string()).exit_code, 0);
+    ASSERT_EQ(gen(dir, "-q -n 20000 --seed 3 --shuffle --tmpdir " + dir.path.string() + " " + (dir.path / "r.stl").string())
+                  .exit_code,
+              0);
+    auto sorted = read_all(dir.path / "s.stl"), shuffled = read_all(dir.path / "r.stl");
+    EXPECT_GT(disorder(shuffled).second, 0.4);
+    EXPECT_LT(disorder(sorted).second, disorder(shuffled).second);
+    std::sort(sorted.begin(), sorted.end());
+    std::sort(shuffled.begin(), shuffled.end());
+    EXPECT_EQ(sorted, shuffled);
+    // The bucket files are gone.
+    size_t left = 0;
+    for (const auto& entry : fs::directory_iterator(dir.path)) left += entry.path().filename().string().starts_with("meshstream-gen");
+    EXPECT_EQ(left, 0u);
+}
+
+TEST(GenMesh, SameSeedSameBytesAcrossThreadCounts) {
+    TempDir dir;
+    ASSERT_EQ(gen(dir, "-q -n 20000 --threads 1 " + (dir.path / "a.stl").string()).exit_code, 0);
+    ASSERT_EQ(gen(dir, "-q -n 20000 --threads 3 " + (dir.path / "b.stl").string()).exit_code, 0);
+    ASSERT_EQ(gen(dir, "-q -n 20000 --seed 2 " + (dir.path / "c.stl").string()).exit_code, 0);
+    EXPECT_EQ(slurp(dir.path / "a.stl"), slurp(dir.path / "b.stl"));
+    EXPECT_NE(slurp(dir.path / "a.stl"), slurp(dir.path / "c.stl"));
+}
+
+TEST(GenMesh, ExitCodes) {
+    TempDir dir;
+    EXPECT_EQ(gen(dir, "-n 1000").exit_code, 2);                                      // no output
+    EXPECT_EQ(gen(dir, "-n 5 " + (dir.path / "x.stl").string()).exit_code, 2);         // below 100
+    GenRun r = gen(dir, "-n 1000 " + (dir.path / "x.unknown").string());
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_NE(r.err.find("x.unknown"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir.path / "x.unknown"));
+}
