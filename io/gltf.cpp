@@ -530,6 +530,15 @@ public:
         header_.notes.emplace_back("instances", std::to_string(instances_.size()) + " mesh instance(s) of " +
                                                     std::to_string(model_.meshes.size()) + " mesh(es)");
         if (!model_.asset.generator.empty()) header_.notes.emplace_back("generator", model_.asset.generator);
+        // Draco settings, from the first Draco primitive of the scene (decoded now, then cached).
+        for (const Instance& inst : instances_) {
+            const auto& prims = model_.meshes[inst.mesh].primitives;
+            auto it = std::find_if(prims.begin(), prims.end(), [this](const tinygltf::Primitive& p) { return is_draco(p); });
+            if (it == prims.end()) continue;
+            geometry(inst.mesh, static_cast<int>(it - prims.begin()));
+            header_.notes.emplace_back("draco", draco_settings_);
+            break;
+        }
         std::string used;
         for (const std::string& e : model_.extensionsUsed) used += (used.empty() ? "" : ", ") + e;
         if (!used.empty()) header_.notes.emplace_back("extensions", used);
@@ -571,7 +580,8 @@ private:
     tinygltf::Model model_;
     std::vector<Instance> instances_;
     std::map<std::pair<int, int>, std::shared_ptr<const PrimitiveGeometry>> draco_cache_;
-    std::map<std::pair<int, int>, int> draco_indices_;  // (mesh, primitive) -> hidden indices accessor
+    std::map<std::pair<int, int>, int> draco_indices_;
+    std::string draco_settings_;  // of the first Draco primitive decoded, for `info`  // (mesh, primitive) -> hidden indices accessor
     // Streaming position: instance, primitive, triangle; world-space positions of the current one.
     size_t inst_ = 0, prim_ = 0, tri_ = 0;
     bool loaded_ = false;
@@ -765,6 +775,11 @@ std::shared_ptr<const PrimitiveGeometry> GltfReader::geometry(int mesh, int prim
         if (d.indices.size() / 3 != stated)
             throw Error(name_, at + ": accessors state " + std::to_string(stated) + " triangles, the Draco data holds " +
                                    std::to_string(d.indices.size() / 3));
+        if (draco_settings_.empty())
+            draco_settings_ = "bitstream " + std::to_string(d.version_major) + "." + std::to_string(d.version_minor) + ", " +
+                              (d.edgebreaker ? "edgebreaker" : "sequential") + " connectivity, positions " +
+                              (d.position_bits ? std::to_string(d.position_bits) + " bits" : std::string("not quantized")) +
+                              " (" + at + ")";
         geo->positions = std::move(d.positions);
         geo->triangles = std::move(d.indices);
         draco_cache_[{mesh, prim}] = geo;

@@ -238,6 +238,10 @@ TEST(GltfWriter, DracoGlbIsValidAndWithinQuantizationBound) {
     io::MeshHeader h;
     Soup back = read_soup(dir / "b.glb", io::TriangleChunk::kDefaultCapacity, &h);
     expect_within_quantization_bound(bunny, back, 14);
+    bool noted = false;
+    for (const auto& [k, v] : h.notes)
+        if (k == "draco") noted = v == "bitstream 2.2, edgebreaker connectivity, positions 14 bits (mesh 0 primitive 0)";
+    EXPECT_TRUE(noted) << "info must report the Draco settings found";
     // POSITION min/max are the decoded bounds, exactly.
     const json& pos = doc["accessors"][prim["attributes"]["POSITION"].get<int>()];
     for (int a = 0; a < 3; ++a) {
