@@ -3,6 +3,7 @@
 #include "io/error.hpp"
 #include "tools/commands.hpp"
 #include "tools/common.hpp"
+#include "tools/topology.hpp"
 #include "tools/order.hpp"
 
 #include <nlohmann/json.hpp>
@@ -18,6 +19,7 @@ namespace {
 struct InfoOptions {
     std::string input;
     bool json = false;
+    bool topology = false;  // --topology: vertex and edge counts (tools/topology.hpp)
     bool order = false;        // --order: measure the stream's width (tools/order.hpp)
     uint64_t buffer = 400000;  // --buffer: decimation buffer to judge against the width
     ReadFlags read;
@@ -65,12 +67,15 @@ void run_info(const InfoOptions& opt) {
     const io::MeshHeader& header = in.reader->header();
     InfoStats stats;
     io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, header.channels);
+    std::unique_ptr<TopologyCounter> topology;
+    if (opt.topology) topology = std::make_unique<TopologyCounter>(opt.read.options().memory_budget_bytes, opt.read.tmpdir);
     std::optional<OrderMeter> meter;
     if (opt.order) meter.emplace(opt.read.options().memory_budget_bytes);
     {
         Progress progress("reading", header.triangle_count);
         while (in.reader->next(chunk)) {
             accumulate(chunk, stats);
+            if (topology) topology->add(chunk);
             if (meter) meter->add(chunk);
             progress.update(stats.triangles);
         }
@@ -101,6 +106,14 @@ void run_info(const InfoOptions& opt) {
         }
         if (header.sorted_axis) j["sorted_axis"] = kAxes[*header.sorted_axis];
         for (const auto& [k, v] : header.notes) j["notes"][k] = v;
+        if (topology) {
+            TopologyReport t = topology->finish();
+            j["topology"] = {{"welded_by", t.by_vertex_id ? "vertex id" : "position"},
+                             {"vertices", t.vertices},
+                             {"edges", t.edges},
+                             {"boundary_edges", t.boundary_edges},
+                             {"non_manifold_edges", t.non_manifold_edges}};
+        }
         if (meter) {
             OrderReport r = meter->finish();
             BufferVerdict v = buffer_verdict(r, opt.buffer);
@@ -135,6 +148,13 @@ void run_info(const InfoOptions& opt) {
     }
     if (header.sorted_axis) std::printf("sorted along: %s\n", kAxes[*header.sorted_axis]);
     for (const auto& [k, v] : header.notes) std::printf("%-12s %s\n", (k + ":").c_str(), v.c_str());
+    if (topology) {
+        TopologyReport t = topology->finish();
+        std::printf("topology:    %llu vertices (welded by %s), %llu edges, %llu boundary, %llu non-manifold\n",
+                    (unsigned long long)t.vertices, t.by_vertex_id ? "vertex id" : "position",
+                    (unsigned long long)t.edges, (unsigned long long)t.boundary_edges,
+                    (unsigned long long)t.non_manifold_edges);
+    }
     if (meter) std::printf("%s", format_order_text(meter->finish(), opt.buffer).c_str());
 }
 
@@ -145,6 +165,9 @@ void add_info(CLI::App& app) {
     CLI::App* cmd = app.add_subcommand("info", "Print format, triangle count, bounding box, file size and degenerate triangles");
     cmd->add_option("file", opt->input, "Mesh file ('-' = stdin; gzip is detected)")->required();
     cmd->add_flag("--json", opt->json, "Print JSON instead of text");
+    cmd->add_flag("--topology", opt->topology,
+                  "Count vertices, boundary and non-manifold edges (welded by vertex id for PLY/OBJ, else by "
+                  "position; sorts 144 bytes a triangle within --memory, spilling beyond)");
     cmd->add_flag("--order", opt->order,
                   "Measure the stream's width: triangles held at once until all their vertices' uses were read "
                   "(exact within --memory, else sampled; see docs/cli.md)");
