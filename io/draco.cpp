@@ -219,8 +219,8 @@ DracoDecoded decode_draco(std::span<const std::byte> bytes, const std::string& f
     out.version_minor = header.version_minor;
     out.edgebreaker = header.encoder_method == draco::MESH_EDGEBREAKER_ENCODING;
     if (header.encoder_type == draco::POINT_CLOUD)
-        throw Error(file_name, base_offset, 0,
-                    "is a Draco point cloud (no faces); meshstream reads triangle meshes only");
+        throw Error(file_name, base_offset + 7, 0,
+                    "geometry type is a Draco point cloud (no faces); meshstream reads triangle meshes only");
     if (header.encoder_type != draco::TRIANGULAR_MESH)
         throw Error(file_name, base_offset + 7, 0,
                     "unknown Draco geometry type " + std::to_string(int(header.encoder_type)));
