@@ -279,3 +279,20 @@ TEST(InfoOrder, DistinguishesShuffledFromSorted) {
     EXPECT_NE(json.out.find("\"width\": " + std::to_string(w_sorted)), std::string::npos) << json.out;
     EXPECT_NE(json.out.find("\"buffer_suffices\": true"), std::string::npos) << json.out;
 }
+
+TEST(SortCommand, FullDiskIsAClearErrorAndLeavesNothing) {
+    TempDir dir;
+    write_stl(dir / "in.stl", random_triangles(200000, 8));  // 7.2 MB of run records
+    fs::create_directory(dir / "small");
+    // A 1 MiB tmpfs as the temporary directory (needs root; skipped elsewhere).
+    if (std::system(("mount -t tmpfs -o size=1M tmpfs " + dir / "small" + " 2>/dev/null").c_str()) != 0)
+        GTEST_SKIP() << "cannot mount a small tmpfs here";
+    CliRun r = run("sort --axis z --memory 1M --tmpdir " + dir / "small" + " " + dir / "in.stl" + " " + dir / "out.stl", dir);
+    size_t left = file_count(dir / "small");
+    std::system(("umount " + dir / "small").c_str());
+    EXPECT_EQ(r.code, 1);
+    EXPECT_NE(r.err.find("No space left on device"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("--tmpdir"), std::string::npos) << r.err;
+    EXPECT_EQ(left, 0u);
+    EXPECT_FALSE(fs::exists(dir / "out.stl"));
+}
