@@ -5,6 +5,7 @@
 #include "io/error.hpp"
 
 #include <atomic>
+#include <cassert>
 #include <cerrno>
 #include <csignal>
 #include <cstdlib>
@@ -49,11 +50,11 @@ private:
 class GzipInput : public RawInput {
 public:
     GzipInput(std::unique_ptr<RawInput> raw, std::vector<std::byte> prefix, std::string name)
-        : raw_(std::move(raw)), name_(std::move(name)), in_(size_t{1} << 18) {
+        : raw_(std::move(raw)), name_(std::move(name)), in_(std::make_unique_for_overwrite<std::byte[]>(kInBytes)) {
         std::memset(&zs_, 0, sizeof zs_);
         if (inflateInit2(&zs_, 16 + MAX_WBITS) != Z_OK) throw Error(name_, "zlib inflateInit failed");
-        std::memcpy(in_.data(), prefix.data(), prefix.size());
-        zs_.next_in = reinterpret_cast<Bytef*>(in_.data());
+        std::memcpy(in_.get(), prefix.data(), prefix.size());
+        zs_.next_in = reinterpret_cast<Bytef*>(in_.get());
         zs_.avail_in = static_cast<uInt>(prefix.size());
         compressed_ = prefix.size();
     }
@@ -66,7 +67,7 @@ public:
         const uInt want = zs_.avail_out;
         while (zs_.avail_out == want) {
             if (zs_.avail_in == 0) {
-                size_t got = raw_->read(in_.data(), in_.size());
+                size_t got = raw_->read(in_.get(), kInBytes);
                 if (got == 0) {
                     if (member_started_)
                         throw Error(name_, compressed_, 0,
@@ -75,7 +76,7 @@ public:
                     break;
                 }
                 compressed_ += got;
-                zs_.next_in = reinterpret_cast<Bytef*>(in_.data());
+                zs_.next_in = reinterpret_cast<Bytef*>(in_.get());
                 zs_.avail_in = static_cast<uInt>(got);
             }
             member_started_ = true;
@@ -93,9 +94,10 @@ public:
     }
 
 private:
+    static constexpr size_t kInBytes = size_t{1} << 18;
     std::unique_ptr<RawInput> raw_;
     std::string name_;
-    std::vector<std::byte> in_;
+    std::unique_ptr<std::byte[]> in_;
     z_stream zs_;
     uint64_t compressed_ = 0;
     bool member_started_ = false;
@@ -198,16 +200,16 @@ std::unique_ptr<ByteSource> ByteSource::open(const std::string& path) {
 }
 
 ByteSource::ByteSource(std::unique_ptr<RawInput> raw, std::string name)
-    : raw_(std::move(raw)), name_(std::move(name)), buf_(kBufferBytes) {
+    : raw_(std::move(raw)), name_(std::move(name)), buf_(std::make_unique_for_overwrite<std::byte[]>(kBufferBytes)) {
     // Sniff the gzip magic (1f 8b) before anything else sees the bytes.
     size_t got = 0;
     while (got < 2) {
-        size_t n = raw_->read(buf_.data() + got, 2 - got);
+        size_t n = raw_->read(buf_.get() + got, 2 - got);
         if (n == 0) break;
         got += n;
     }
     if (got == 2 && buf_[0] == std::byte{0x1f} && buf_[1] == std::byte{0x8b}) {
-        std::vector<std::byte> prefix(buf_.begin(), buf_.begin() + 2);
+        std::vector<std::byte> prefix(buf_.get(), buf_.get() + 2);
         raw_ = std::make_unique<GzipInput>(std::move(raw_), std::move(prefix), name_);
         gzip_ = true;
     } else {
@@ -226,12 +228,12 @@ std::optional<uint64_t> ByteSource::size() const {
 bool ByteSource::fill(size_t want) {
     if (end_ - begin_ >= want) return true;
     if (begin_ > 0) {  // carry the unconsumed tail to the front
-        std::memmove(buf_.data(), buf_.data() + begin_, end_ - begin_);
+        std::memmove(buf_.get(), buf_.get() + begin_, end_ - begin_);
         end_ -= begin_;
         begin_ = 0;
     }
     while (end_ < want && !eof_) {
-        size_t n = raw_->read(buf_.data() + end_, buf_.size() - end_);
+        size_t n = raw_->read(buf_.get() + end_, kBufferBytes - end_);
         if (n == 0) eof_ = true;
         end_ += n;
     }
@@ -244,7 +246,7 @@ size_t ByteSource::read(void* dst, size_t n) {
     while (done < n) {
         if (begin_ == end_) {
             // Large reads bypass the buffer.
-            if (n - done >= buf_.size() && !eof_) {
+            if (n - done >= kBufferBytes && !eof_) {
                 size_t got = raw_->read(out + done, n - done);
                 if (got == 0) { eof_ = true; break; }
                 done += got;
@@ -254,7 +256,7 @@ size_t ByteSource::read(void* dst, size_t n) {
             if (!fill(1)) break;
         }
         size_t take = std::min(n - done, end_ - begin_);
-        std::memcpy(out + done, buf_.data() + begin_, take);
+        std::memcpy(out + done, buf_.get() + begin_, take);
         begin_ += take;
         done += take;
         offset_ += take;
@@ -263,17 +265,18 @@ size_t ByteSource::read(void* dst, size_t n) {
 }
 
 std::span<const std::byte> ByteSource::peek(size_t n) {
-    if (n > buf_.size()) n = buf_.size();
+    if (n > kBufferBytes) n = kBufferBytes;
     fill(n);
-    return {buf_.data() + begin_, std::min(n, end_ - begin_)};
+    return {buf_.get() + begin_, std::min(n, end_ - begin_)};
 }
 
 std::span<const std::byte> ByteSource::window() {
     if (begin_ == end_) fill(1);
-    return {buf_.data() + begin_, end_ - begin_};
+    return {buf_.get() + begin_, end_ - begin_};
 }
 
 void ByteSource::consume(size_t n) {
+    assert(n <= end_ - begin_);
     begin_ += n;
     offset_ += n;
 }

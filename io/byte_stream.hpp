@@ -72,7 +72,7 @@ private:
     std::string name_;
     std::string regular_path_;
     bool gzip_ = false;
-    std::vector<std::byte> buf_;
+    std::unique_ptr<std::byte[]> buf_;  // kBufferBytes, left uninitialised (opening stays cheap)
     size_t begin_ = 0, end_ = 0;
     uint64_t offset_ = 0;
     bool eof_ = false;
