@@ -107,6 +107,9 @@ inline std::string slurp(const std::string& path) {
 }
 
 inline void spit(const std::string& path, std::string_view bytes) {
+    // A new file, not a truncated one: ext4 flushes files truncated and rewritten
+    // (auto_da_alloc), which made loops over many small files wait on the disk.
+    std::filesystem::remove(path);
     std::ofstream f(path, std::ios::binary);
     f.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
 }
