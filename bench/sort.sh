@@ -5,6 +5,7 @@
 # of --tmpdir), next to baselines: `cat` of the same file (the I/O floor) and GNU `sort -g` on
 # a text file with one line per triangle (key first) given the same memory, on the first
 # GNU_SORT_LINES triangles only (GNU sort parses floats at ~0.03 M lines/s; compare rates).
+# cpu_s (user + system) is printed too: on a shared, loaded machine wall time overstates.
 # Then decimates the
 # sorted file and the generator's original order and reports both (error and forced writes, from decimate --report).
 #
@@ -46,25 +47,26 @@ du_peak() {
 
 rate() { awk -v n="$1" -v s="$2" 'BEGIN { printf "%.2f M/s", (s > 0 ? n / s / 1e6 : 0) }'; }
 
-printf "%-10s %-26s %8s %12s %10s %12s\n" triangles run seconds rate peak_RSS temp_disk
+printf "%-10s %-26s %8s %12s %10s %12s %8s %12s\n" triangles run seconds rate peak_RSS temp_disk cpu_s rate_by_cpu
 for n in $sizes; do
     "$gen" -q -n "$n" --tmpdir "$work/tmp" "$work/orig.stl"
     "$gen" -q -n "$n" --shuffle --tmpdir "$work/tmp" "$work/shuffled.stl"
     tris=$("$ms" -q info --json "$work/shuffled.stl" | sed -n 's/.*"triangles": \([0-9]*\).*/\1/p')
     cat "$work/shuffled.stl" > /dev/null  # warm the page cache like every run after it
 
-    /usr/bin/time -f "%e %M" -o "$work/time.txt" sh -c 'cat "$1" > "$2"' sh "$work/shuffled.stl" "$work/cat.stl"
-    read -r s rss < "$work/time.txt"
-    printf "%-10s %-26s %8s %12s %10s %12s\n" "$tris" "cat (I/O floor)" "$s" "$(rate "$tris" "$s")" "$((rss / 1024)) MB" -
+    /usr/bin/time -f "%e %M %U %S" -o "$work/time.txt" sh -c 'cat "$1" > "$2"' sh "$work/shuffled.stl" "$work/cat.stl"
+    read -r s rss us ss < "$work/time.txt"
+    printf "%-10s %-26s %8s %12s %10s %12s %8s %12s\n" "$tris" "cat (I/O floor)" "$s" "$(rate "$tris" "$s")" "$((rss / 1024)) MB" - "$(awk -v u="$us" -v s="$ss" 'BEGIN{print u+s}')" -
     rm -f "$work/cat.stl"
 
     for mem in 64M 1G; do
-        peak=$(du_peak "$work/tmp" /usr/bin/time -f "%e %M" -o "$work/time.txt" \
+        peak=$(du_peak "$work/tmp" /usr/bin/time -f "%e %M %U %S" -o "$work/time.txt" \
             "$ms" -q sort --stats --axis z --memory "$mem" --tmpdir "$work/tmp" "$work/shuffled.stl" "$work/sorted.stl" \
             2> "$work/stats.txt")
-        read -r s rss < "$work/time.txt"
-        printf "%-10s %-26s %8s %12s %10s %12s\n" "$tris" "meshstream sort $mem" "$s" "$(rate "$tris" "$s")" \
-            "$((rss / 1024)) MB" "$((peak / 1048576)) MB"
+        read -r s rss us ss < "$work/time.txt"
+        printf "%-10s %-26s %8s %12s %10s %12s %8s %12s\n" "$tris" "meshstream sort $mem" "$s" "$(rate "$tris" "$s")" \
+            "$((rss / 1024)) MB" "$((peak / 1048576)) MB" "$(awk -v u="$us" -v s="$ss" 'BEGIN{print u+s}')" \
+            "$(rate "$tris" "$(awk -v u="$us" -v s="$ss" 'BEGIN{print u+s}')")"
         sed 's/^/           /' "$work/stats.txt"
     done
 
@@ -80,11 +82,12 @@ with open(sys.argv[1], "rb") as f:
         out.write("%.9g %s\n" % (min(c[2], c[5], c[8]), " ".join("%.9g" % v for v in c)))
 PY
         for mem in 64M 1G; do
-            peak=$(du_peak "$work/tmp" /usr/bin/time -f "%e %M" -o "$work/time.txt" \
+            peak=$(du_peak "$work/tmp" /usr/bin/time -f "%e %M %U %S" -o "$work/time.txt" \
                 env LC_ALL=C sort -s -g -k1,1 -S "$mem" -T "$work/tmp" -o "$work/lines.sorted" "$work/lines.txt")
-            read -r s rss < "$work/time.txt"
-            printf "%-10s %-26s %8s %12s %10s %12s\n" "$(wc -l < "$work/lines.txt")" "GNU sort -S $mem (text)" "$s" "$(rate "$(wc -l < "$work/lines.txt")" "$s")" \
-                "$((rss / 1024)) MB" "$((peak / 1048576)) MB"
+            read -r s rss us ss < "$work/time.txt"
+            printf "%-10s %-26s %8s %12s %10s %12s %8s %12s\n" "$(wc -l < "$work/lines.txt")" "GNU sort -S $mem (text)" "$s" "$(rate "$(wc -l < "$work/lines.txt")" "$s")" \
+                "$((rss / 1024)) MB" "$((peak / 1048576)) MB" "$(awk -v u="$us" -v s="$ss" 'BEGIN{print u+s}')" \
+            "$(rate "$tris" "$(awk -v u="$us" -v s="$ss" 'BEGIN{print u+s}')")"
         done
         rm -f "$work/lines.txt" "$work/lines.sorted"
     fi
