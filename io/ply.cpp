@@ -415,11 +415,19 @@ private:
         }
     }
 
+    // A count whose byte size overflows 64 bits cannot be in any file.
+    void check_size(const Element& e, size_t fixed) const {
+        if (e.count > ~uint64_t{0} / fixed)
+            throw Error(src_.name(), src_.offset(), 0,
+                        "element '" + e.name + "': header promises " + std::to_string(e.count) + " items, more than any file holds");
+    }
+
     void skip_element(size_t index) {
         element_ = index;
         const Element& e = elements_[index];
         size_t fixed = e.fixed_bytes();
         if (encoding_ != Encoding::kAscii && fixed > 0) {
+            check_size(e, fixed);
             uint64_t bytes = e.count * fixed;
             uint64_t got = src_.skip(bytes);
             if (got != bytes) {
@@ -463,6 +471,7 @@ private:
             if (s < 3 && t != PlyType::kFloat32) direct = false;
             if (s >= 3 && has_color_ && t != PlyType::kUint8) direct = false;
         }
+        if (fixed > 0 && encoding_ != Encoding::kAscii) check_size(e, fixed);
         if (direct) {
             uint64_t start = src_.offset();
             uint64_t bytes = e.count * fixed;

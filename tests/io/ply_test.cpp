@@ -188,6 +188,21 @@ TEST(PlyRoundTrip, StlThroughEveryPlyEncodingAndObjBackToStlIsExact) {
     }
 }
 
+TEST(PlyWriter, ChunkCapacitiesGiveIdenticalFiles) {
+    TempDir dir;
+    for (const char* to : {"ply", "ply-ascii", "obj"}) {
+        SCOPED_TRACE(to);
+        test::convert(fixture("gearwheel.bin.stl"), dir / "whole", to);
+        test::convert(fixture("ply/mpi_ngons.ascii.ply"), dir / "whole2", to);
+        for (size_t capacity : {size_t{1}, size_t{7}}) {
+            test::convert(fixture("gearwheel.bin.stl"), dir / "part", to, uint64_t{256} << 20, capacity);
+            EXPECT_TRUE(test::slurp(dir / "part") == test::slurp(dir / "whole"));
+            test::convert(fixture("ply/mpi_ngons.ascii.ply"), dir / "part2", to, uint64_t{256} << 20, capacity);
+            EXPECT_TRUE(test::slurp(dir / "part2") == test::slurp(dir / "whole2"));
+        }
+    }
+}
+
 TEST(PlyWriter, WeldsExactPositionsWithMinusZeroEqualToPlusZero) {
     TempDir dir;
     test::convert(fixture("tetrahedronMinusZero.bin.stl"), dir / "t.ply");
