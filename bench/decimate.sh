@@ -1,0 +1,138 @@
+#!/usr/bin/env bash
+# Decimation benchmark: `meshstream decimate` next to two in-core references on the same inputs
+# in the same run, printing end-to-end speed (input triangles/s, file to file), peak RSS and
+# the compare error against the input. Medians of RUNS runs (compare runs once: it is
+# deterministic).
+#
+#   bench/decimate.sh                  # 1 M, 10 M, 50 M generated meshes + the bunny
+#   SIZES="1000000" RUNS=1 bench/decimate.sh
+#
+# Environment:
+#   BENCH_DIR  work dir for meshes and outputs (default /tmp/meshstream-bench; ~6 GB for 50 M)
+#   BUILD_DIR  build dir, configured here with -DMESHSTREAM_BUILD_BENCH=ON (default $BENCH_DIR/build)
+#   SIZES      generated mesh sizes in triangles (default "1000000 10000000 50000000")
+#   RATIOS     decimation ratios (default "0.1 0.01")
+#   RUNS       runs per measurement, median reported (default 3)
+#   CGAL_MAX   largest input given to the (slow) CGAL reference (default 1500000: the 1 M mesh)
+#   COMPARE    0 to skip the error columns (default 1)
+#   DECIMATE_ARGS  extra options for `meshstream decimate` (e.g. "--buffer 200000")
+# Needs: cmake, g++, libmeshoptimizer-dev, libcgal-dev + libeigen3-dev (else no CGAL rows),
+# GNU time (/usr/bin/time, Debian package `time`) and python3 (table).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+src=$(pwd)
+
+BENCH_DIR=${BENCH_DIR:-/tmp/meshstream-bench}
+BUILD_DIR=${BUILD_DIR:-$BENCH_DIR/build}
+SIZES=${SIZES:-"1000000 10000000 50000000"}
+RATIOS=${RATIOS:-"0.1 0.01"}
+RUNS=${RUNS:-3}
+CGAL_MAX=${CGAL_MAX:-1500000}
+COMPARE=${COMPARE:-1}
+DECIMATE_ARGS=${DECIMATE_ARGS:-}
+
+die() { echo "bench/decimate.sh: $*" >&2; exit 1; }
+[ -x /usr/bin/time ] || die "GNU time is missing: apt-get install time"
+command -v python3 >/dev/null || die "python3 is missing"
+mkdir -p "$BENCH_DIR"
+
+echo "== building in $BUILD_DIR" >&2
+cmake -S "$src" -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release -DMESHSTREAM_BUILD_BENCH=ON -DMESHSTREAM_BUILD_TESTS=OFF >/dev/null
+cmake --build "$BUILD_DIR" -j"$(nproc)" >/dev/null || die "build failed (run: cmake --build $BUILD_DIR)"
+ms=$BUILD_DIR/tools/meshstream
+gen=$BUILD_DIR/tools/meshstream-gen
+ref_meshopt=$BUILD_DIR/bench/ref_meshopt
+ref_cgal=$BUILD_DIR/bench/ref_cgal
+"$ms" decimate --help >/dev/null 2>&1 || die "'meshstream decimate' does not exist in this build: nothing to benchmark"
+[ -x "$ref_cgal" ] || echo "bench/decimate.sh: no ref_cgal (apt-get install libcgal-dev libeigen3-dev): CGAL rows skipped" >&2
+
+# Inputs: generated meshes (made once, kept in BENCH_DIR) and the bunny fixture.
+inputs=()
+for n in $SIZES; do
+  f=$BENCH_DIR/gen_$n.stl
+  if [ ! -s "$f" ]; then
+    echo "== generating $f" >&2
+    "$gen" --triangles "$n" "$f"
+  fi
+  inputs+=("$f")
+done
+inputs+=("$src/fixtures/bunny_from_draco.bin.stl")
+
+results=$BENCH_DIR/results.tsv
+: >"$results"
+
+# time_run LABEL CMD...: runs CMD under GNU time; appends "seconds<TAB>rss_kb" lines to $BENCH_DIR/runs.txt
+measure() {
+  local log=$BENCH_DIR/time.log
+  if ! /usr/bin/time -v -o "$log" "$@" >"$BENCH_DIR/cmd.out" 2>"$BENCH_DIR/cmd.err"; then
+    cat "$BENCH_DIR/cmd.err" >&2
+    die "failed: $*"
+  fi
+  python3 - "$log" <<'EOF'
+import re, sys
+text = open(sys.argv[1]).read()
+wall = re.search(r"Elapsed \(wall clock\) time .*: (\S+)", text).group(1).split(":")
+seconds = sum(float(x) * 60 ** i for i, x in enumerate(reversed(wall)))
+rss = int(re.search(r"Maximum resident set size \(kbytes\): (\d+)", text).group(1))
+print(f"{seconds}\t{rss}")
+EOF
+}
+
+median_of_runs() {  # CMD...: prints "median_seconds<TAB>median_rss_kb"
+  local lines=()
+  for ((r = 0; r < RUNS; r++)); do lines+=("$(measure "$@")"); done
+  printf '%s\n' "${lines[@]}" | python3 -c '
+import sys, statistics
+rows = [l.split("\t") for l in sys.stdin.read().split("\n") if l]
+print(f"{statistics.median(float(r[0]) for r in rows)}\t{int(statistics.median(int(r[1]) for r in rows))}")'
+}
+
+error_of() {  # INPUT OUTPUT: prints "rms_pct<TAB>max_pct<TAB>rms<TAB>max"
+  if [ "$COMPARE" = 0 ]; then printf -- '-\t-\t-\t-\n'; return; fi
+  "$ms" -q compare --json "$1" "$2" >"$BENCH_DIR/compare.json" || die "compare failed: $1 $2"
+  python3 - "$BENCH_DIR/compare.json" <<'EOF'
+import json, sys
+s = json.load(open(sys.argv[1]))["symmetric"]
+print("%.5f\t%.4f\t%.6g\t%.6g" % (s["rms_pct"], s["max_pct"], s["rms"], s["max"]))
+EOF
+}
+
+for in in "${inputs[@]}"; do
+  n=$("$ms" -q info --json "$in" | python3 -c 'import json,sys; print(json.load(sys.stdin)["triangles"])')
+  name=$(basename "$in" .stl)
+  for ratio in $RATIOS; do
+    target=$(python3 -c "print(round($ratio * $n))")
+    tools="meshstream meshopt"
+    if [ -x "$ref_cgal" ] && [ "$n" -le "$CGAL_MAX" ]; then tools="$tools cgal"; fi
+    for tool in $tools; do
+      out=$BENCH_DIR/out_${name}_${ratio}_$tool.stl
+      echo "== $tool $name ratio $ratio ($RUNS runs)" >&2
+      case $tool in
+        meshstream) m=$(median_of_runs "$ms" -q decimate $DECIMATE_ARGS "$in" "$out" --ratio "$ratio") ;;
+        meshopt) m=$(median_of_runs "$ref_meshopt" "$in" "$out" --target "$target") ;;
+        cgal) m=$(median_of_runs "$ref_cgal" "$in" "$out" --target "$target") ;;
+      esac
+      out_n=$("$ms" -q info --json "$out" | python3 -c 'import json,sys; print(json.load(sys.stdin)["triangles"])')
+      e=$(error_of "$in" "$out")
+      printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$name" "$n" "$ratio" "$tool" "$out_n" "$m" "$e" >>"$results"
+    done
+  done
+done
+
+python3 - "$results" "$RUNS" <<'EOF'
+import sys
+rows = [l.rstrip("\n").split("\t") for l in open(sys.argv[1]) if l.strip()]
+print(f"median of {sys.argv[2]} runs; error = meshstream compare against the input (symmetric, % of input bbox diagonal)")
+head = ["input", "triangles", "ratio", "tool", "out", "seconds", "M in-tri/s", "peak RSS MB", "RMS %", "Hausdorff %"]
+table = []
+for name, n, ratio, tool, out, sec, rss, rms_pct, max_pct, rms, mx in rows:
+    sec = float(sec)
+    table.append([name, n, ratio, tool, out, f"{sec:.2f}", f"{int(n) / sec / 1e6:.2f}", f"{int(rss) / 1024:.0f}",
+                  rms_pct, max_pct])
+widths = [max(len(str(r[i])) for r in table + [head]) for i in range(len(head))]
+print(" | ".join(h.ljust(w) for h, w in zip(head, widths)))
+print("-|-".join("-" * w for w in widths))
+for r in table:
+    print(" | ".join(str(c).ljust(w) for c, w in zip(r, widths)))
+EOF
+echo "(raw rows: $results)" >&2
