@@ -36,6 +36,8 @@ public:
     ObjReader(ByteSource& source, const ReadOptions& options)
         : src_(source), options_(options), table_(options.memory_budget_bytes, options.tmpdir, false) {
         header_.channels.vertex_id = true;
+        auto bom = src_.peek(3);  // a UTF-8 byte order mark would hide the first statement
+        if (bom.size() == 3 && std::memcmp(bom.data(), "\xEF\xBB\xBF", 3) == 0) src_.consume(3);
         // The leading comments are read now, so a "# meshstream sorted-axis=" line is in the
         // header before the first chunk.
         for (auto w = src_.peek(1); !w.empty() && w[0] == std::byte{'#'}; w = src_.peek(1)) {
@@ -265,6 +267,7 @@ bool probe_obj(std::span<const std::byte> head, std::optional<uint64_t>) {
         if (c < 0x20 && c != '\t' && c != '\n' && c != '\r' && c != '\v' && c != '\f') return false;  // binary
     }
     std::string_view text(reinterpret_cast<const char*>(head.data()), head.size());
+    if (text.starts_with("\xEF\xBB\xBF")) text.remove_prefix(3);  // UTF-8 byte order mark
     static constexpr std::string_view kKeywords[] = {"v", "vt", "vn", "vp", "f", "o", "g", "s", "usemtl", "mtllib", "l", "p"};
     while (!text.empty()) {
         size_t nl = text.find('\n');

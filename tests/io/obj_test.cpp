@@ -159,4 +159,8 @@ TEST(ObjFormat, ProbeAcceptsObjTextAndRejectsBinaryAndStl) {
     EXPECT_FALSE(probe(std::string_view("# binary STL header\0\0\0\x01", 23)));
     EXPECT_FALSE(probe("ply\nformat ascii 1.0\n"));
     EXPECT_FALSE(probe(""));
+    EXPECT_TRUE(probe("\xEF\xBB\xBFv 1 2 3\n"));
+    TempDir dir;
+    test::spit(dir / "bom.obj", "\xEF\xBB\xBFv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    EXPECT_EQ(read_soup(dir / "bom.obj").triangles(), 1u);
 }
