@@ -209,7 +209,7 @@ bool decimate_once(HalfEdgeBuffer& buffer, Rng& rng, int candidates) {
             const uint64_t bits = draw[b];
             const uint32_t f = live.at(static_cast<size_t>(((bits >> 32) * size) >> 32));
             half_edges[b] = 3 * f + static_cast<uint32_t>((bits & 0xffff) % 3);
-            buffer.prefetch_half_edge(half_edges[b]);
+            buffer.prefetch_face(f);
         }
         for (int b = 0; b < batch; ++b) {
             buffer.prefetch_vertex(buffer.corner_vertex(half_edges[b]));

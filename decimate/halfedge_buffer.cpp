@@ -16,7 +16,8 @@ namespace meshstream::decimate {
 void* allocate_pool(size_t bytes) {
     constexpr size_t kHugePage = size_t{2} << 20;
     if (bytes < 2 * kHugePage) {
-        void* p = std::malloc(bytes == 0 ? 1 : bytes);
+        // 128-byte aligned: vertex slots are line pairs and face records lines.
+        void* p = std::aligned_alloc(128, (std::max<size_t>(bytes, 1) + 127) / 128 * 128);
         if (!p) throw std::bad_alloc();
         return p;
     }
@@ -29,23 +30,8 @@ void* allocate_pool(size_t bytes) {
     return p;
 }
 
-FaceSet::FaceSet(size_t capacity)
-    : items_(raw_array<uint32_t>(capacity)), where_(raw_array<uint32_t>(capacity)) {}
-
-void FaceSet::insert(uint32_t f) {
-    if (where_[f] != kNoIndex) return;
-    where_[f] = static_cast<uint32_t>(size_);
-    items_[size_++] = f;
-}
-
-void FaceSet::erase(uint32_t f) {
-    const uint32_t i = where_[f];
-    if (i == kNoIndex) return;
-    const uint32_t last = items_[--size_];
-    items_[i] = last;
-    where_[last] = i;
-    where_[f] = kNoIndex;
-}
+FaceSet::FaceSet(size_t capacity, Face* faces, int slot)
+    : items_(raw_array<uint32_t>(capacity)), faces_(faces), slot_(slot) {}
 
 namespace {
 
@@ -75,18 +61,12 @@ HalfEdgeBuffer::HalfEdgeBuffer(size_t triangle_capacity, double weld_eps)
       // are evicted when the pool runs short.
       vertex_capacity_(3 * triangle_capacity + 3),
       weld_eps_(weld_eps),
-      corner_vertex_(raw_array<uint32_t>(3 * triangle_capacity)),
-      twin_(raw_array<uint32_t>(3 * triangle_capacity)),
-      next_corner_(raw_array<uint32_t>(3 * triangle_capacity)),
-      pin_count_(raw_array<uint8_t>(triangle_capacity)),
-      touches_out_(raw_array<uint8_t>(triangle_capacity)),
+      faces_(raw_array<Face>(triangle_capacity)),
       free_faces_(raw_array<uint32_t>(triangle_capacity)),
-      live_(triangle_capacity),
-      interior_(triangle_capacity),
-      frontier_(triangle_capacity),
-      vertex_(raw_array<Vertex>(vertex_capacity_)),
-      quadric_(raw_array<Quadric>(vertex_capacity_)),
-      stamp_(raw_array<uint32_t>(vertex_capacity_)),
+      live_(triangle_capacity, faces_.get(), 0),
+      interior_(triangle_capacity, faces_.get(), 1),
+      frontier_(triangle_capacity, faces_.get(), 2),
+      slots_(raw_array<VertexSlot>(vertex_capacity_)),
       free_vertices_(raw_array<uint32_t>(vertex_capacity_)) {
     assert(triangle_capacity >= 4 && triangle_capacity < (size_t{1} << 30));
     const size_t slots = pow2_at_least(2 * vertex_capacity_);
@@ -128,23 +108,23 @@ uint32_t HalfEdgeBuffer::alloc_vertex() {
         v = free_vertices_[--free_vertex_stack_];  // generation already bumped by free_vertex
     } else {
         v = vertex_high_++;
-        vertex_[v].generation = 1;
+        slots_[v].vertex.generation = 1;
     }
     ++vertex_used_;
     if (vertex_used_ > vertex_used_peak_) vertex_used_peak_ = vertex_used_;
-    Vertex& x = vertex_[v];
-    x.first_corner = kNoIndex;
-    x.face_count = 0;
-    x.open_edges = 0;
-    x.flags = kAlive;
-    x.id = 0;
-    quadric_[v] = Quadric{};
-    stamp_[v] = 0;
+    VertexSlot& slot = slots_[v];
+    slot.vertex.first_corner = kNoIndex;
+    slot.vertex.face_count = 0;
+    slot.vertex.open_edges = 0;
+    slot.vertex.flags = kAlive;
+    slot.vertex.id = 0;
+    slot.quadric = Quadric{};
+    slot.stamp = 0;
     return v;
 }
 
 void HalfEdgeBuffer::free_vertex(uint32_t v) {
-    Vertex& x = vertex_[v];
+    Vertex& x = slots_[v].vertex;
     assert(x.face_count == 0 && (x.flags & kInHash) == 0);
     x.flags = 0;
     ++x.generation;
@@ -157,8 +137,8 @@ uint32_t HalfEdgeBuffer::weld(const float p[3]) {
     for (;;) {
         const uint32_t v = hash_[slot];
         if (v == kNoIndex) break;
-        if (same_key(vertex_[v].pos, p)) {
-            Vertex& x = vertex_[v];
+        if (same_key(slots_[v].vertex.pos, p)) {
+            Vertex& x = slots_[v].vertex;
             if (weld_eps_ != 0 && (x.flags & kWeldMerged) == 0 &&
                 (float_key(x.pos[0]) != float_key(p[0]) || float_key(x.pos[1]) != float_key(p[1]) ||
                  float_key(x.pos[2]) != float_key(p[2]))) {
@@ -170,7 +150,7 @@ uint32_t HalfEdgeBuffer::weld(const float p[3]) {
         slot = (slot + 1) & hash_mask_;
     }
     const uint32_t v = alloc_vertex();
-    Vertex& x = vertex_[v];
+    Vertex& x = slots_[v].vertex;
     // The first position seen in a weld cell represents the cell (less distortion than
     // moving every vertex to the grid point).
     for (int i = 0; i < 3; ++i) x.pos[i] = p[i] == 0.0f ? 0.0f : p[i];
@@ -180,7 +160,7 @@ uint32_t HalfEdgeBuffer::weld(const float p[3]) {
 }
 
 void HalfEdgeBuffer::hash_erase(uint32_t v) {
-    size_t slot = hash_slot(vertex_[v].pos);
+    size_t slot = hash_slot(slots_[v].vertex.pos);
     while (hash_[slot] != v) {
         assert(hash_[slot] != kNoIndex);
         slot = (slot + 1) & hash_mask_;
@@ -190,7 +170,7 @@ void HalfEdgeBuffer::hash_erase(uint32_t v) {
     for (size_t i = (hole + 1) & hash_mask_;; i = (i + 1) & hash_mask_) {
         const uint32_t w = hash_[i];
         if (w == kNoIndex) break;
-        const size_t home = hash_slot(vertex_[w].pos);
+        const size_t home = hash_slot(slots_[w].vertex.pos);
         // Move w into the hole when its home is not cyclically within (hole, i].
         const bool home_in_range = hole <= i ? (home > hole && home <= i) : (home > hole || home <= i);
         if (!home_in_range) {
@@ -202,15 +182,15 @@ void HalfEdgeBuffer::hash_erase(uint32_t v) {
 }
 
 uint32_t HalfEdgeBuffer::find_half_edge(uint32_t from, uint32_t to) const {
-    for (uint32_t c = vertex_[from].first_corner; c != kNoIndex; c = next_corner_[c])
-        if (corner_vertex_[next_in_face(c)] == to) return c;
+    for (uint32_t c = slots_[from].vertex.first_corner; c != kNoIndex; c = next_corner(c))
+        if (corner_vertex(next_in_face(c)) == to) return c;
     return kNoIndex;
 }
 
 void HalfEdgeBuffer::update_face_sets(uint32_t f) {
-    if (pin_count_[f] == 0) {
+    if (faces_[f].pin_count == 0) {
         interior_.insert(f);
-        if (touches_out_[f]) frontier_.insert(f);
+        if (faces_[f].touches_out) frontier_.insert(f);
         else frontier_.erase(f);
     } else {
         interior_.erase(f);
@@ -220,7 +200,7 @@ void HalfEdgeBuffer::update_face_sets(uint32_t f) {
 
 bool HalfEdgeBuffer::take_written_stub(uint32_t a, uint32_t b) {
     if (stub_count_ == 0) return false;
-    const uint32_t ga = vertex_[a].generation, gb = vertex_[b].generation;
+    const uint32_t ga = slots_[a].vertex.generation, gb = slots_[b].vertex.generation;
     size_t slot = mix64((uint64_t(a) << 32) ^ b) & stub_mask_;
     for (;; slot = (slot + 1) & stub_mask_) {
         Stub& s = stubs_[slot];
@@ -250,7 +230,7 @@ void HalfEdgeBuffer::add_written_stub(uint32_t a, uint32_t b) {
     if (2 * (stub_count_ + 1) > stub_mask_ + 1) return;
     size_t slot = mix64((uint64_t(a) << 32) ^ b) & stub_mask_;
     while (stubs_[slot].a != kNoIndex) slot = (slot + 1) & stub_mask_;
-    stubs_[slot] = Stub{a, vertex_[a].generation, b, vertex_[b].generation};
+    stubs_[slot] = Stub{a, slots_[a].vertex.generation, b, slots_[b].vertex.generation};
     ++stub_count_;
 }
 
@@ -271,7 +251,7 @@ HalfEdgeBuffer::Added HalfEdgeBuffer::add_triangle(const float tri[9]) {
     double p[3][3];
     for (int k = 0; k < 3; ++k) position(v[k], p[k]);
     const Quadric q = Quadric::from_triangle(p[0], p[1], p[2]);
-    for (int k = 0; k < 3; ++k) quadric_[v[k]] += q;
+    for (int k = 0; k < 3; ++k) slots_[v[k]].quadric += q;
 
     const uint32_t f = free_face_count_ > 0 ? free_faces_[--free_face_count_] : face_high_++;
     live_.reset(f);
@@ -282,87 +262,97 @@ HalfEdgeBuffer::Added HalfEdgeBuffer::add_triangle(const float tri[9]) {
     // both ends are frozen against collapses.
     for (int k = 0; k < 3; ++k) {
         const uint32_t a = v[k], b = v[(k + 1) % 3], h = 3 * f + k;
-        corner_vertex_[h] = a;
+        faces_[f].vertex[k] = a;
         const uint32_t same = find_half_edge(a, b);
         const uint32_t opposite = find_half_edge(b, a);
-        if (same == kNoIndex && opposite != kNoIndex && twin_[opposite] == kOpenEdge) {
-            twin_[h] = opposite;
-            twin_[opposite] = h;
-            --vertex_[a].open_edges;
-            --vertex_[b].open_edges;
+        if (same == kNoIndex && opposite != kNoIndex && twin(opposite) == kOpenEdge) {
+            faces_[f].twin[k] = opposite;
+            set_twin(opposite, h);
+            --slots_[a].vertex.open_edges;
+            --slots_[b].vertex.open_edges;
         } else if (same == kNoIndex && opposite == kNoIndex) {
             if (take_written_stub(b, a)) {
-                twin_[h] = kWrittenEdge;  // the partner was force-written earlier
-                --vertex_[a].open_edges;
-                --vertex_[b].open_edges;
+                faces_[f].twin[k] = kWrittenEdge;  // the partner was force-written earlier
+                --slots_[a].vertex.open_edges;
+                --slots_[b].vertex.open_edges;
             } else {
-                twin_[h] = kOpenEdge;
-                ++vertex_[a].open_edges;
-                ++vertex_[b].open_edges;
+                faces_[f].twin[k] = kOpenEdge;
+                ++slots_[a].vertex.open_edges;
+                ++slots_[b].vertex.open_edges;
             }
         } else {
-            twin_[h] = kNonManifoldEdge;
-            vertex_[a].flags |= kNonManifold;
-            vertex_[b].flags |= kNonManifold;
+            faces_[f].twin[k] = kNonManifoldEdge;
+            slots_[a].vertex.flags |= kNonManifold;
+            slots_[b].vertex.flags |= kNonManifold;
             ++nonmanifold_edges_;
         }
     }
     bool out = false;
-    for (int k = 0; k < 3; ++k) {
-        Vertex& x = vertex_[v[k]];
-        next_corner_[3 * f + k] = x.first_corner;
-        x.first_corner = 3 * f + k;
-        ++x.face_count;
-        out |= (x.flags & kFrozen) != 0;
+    for (uint32_t k = 0; k < 3; ++k) {
+        link_corner(v[k], 3 * f + k);
+        out |= (slots_[v[k]].vertex.flags & kFrozen) != 0;
     }
     // Every corner was found through (or entered into) the hash table, so all three are on
     // P_in; vertices whose fan just closed leave it.
-    pin_count_[f] = 3;
-    touches_out_[f] = out;
+    faces_[f].pin_count = 3;
+    faces_[f].touches_out = out;
     live_.insert(f);
     for (int k = 0; k < 3; ++k)
-        if (vertex_[v[k]].open_edges == 0) finalize_vertex(v[k]);
+        if (slots_[v[k]].vertex.open_edges == 0) finalize_vertex(v[k]);
     update_face_sets(f);
     added.face = f;
     return added;
 }
 
 void HalfEdgeBuffer::finalize_vertex(uint32_t v) {
-    Vertex& x = vertex_[v];
+    Vertex& x = slots_[v].vertex;
     if ((x.flags & kInHash) == 0) return;
     hash_erase(v);
     x.flags &= ~kInHash;
-    for (uint32_t c = x.first_corner; c != kNoIndex; c = next_corner_[c]) {
+    for (uint32_t c = x.first_corner; c != kNoIndex; c = next_corner(c)) {
         const uint32_t f = c / 3;
-        --pin_count_[f];
+        --faces_[f].pin_count;
         update_face_sets(f);
     }
     if (x.face_count == 0) free_vertex(v);
 }
 
 void HalfEdgeBuffer::freeze(uint32_t v, uint64_t id) {
-    Vertex& x = vertex_[v];
+    Vertex& x = slots_[v].vertex;
     assert((x.flags & kFrozen) == 0);
     x.flags |= kFrozen;
     x.id = id;
-    for (uint32_t c = x.first_corner; c != kNoIndex; c = next_corner_[c]) {
+    for (uint32_t c = x.first_corner; c != kNoIndex; c = next_corner(c)) {
         const uint32_t f = c / 3;
-        if (!touches_out_[f]) {
-            touches_out_[f] = 1;
+        if (!faces_[f].touches_out) {
+            faces_[f].touches_out = 1;
             update_face_sets(f);
         }
     }
 }
 
+void HalfEdgeBuffer::link_corner(uint32_t v, uint32_t c) {
+    Vertex& x = slots_[v].vertex;
+    Face& face = faces_[c / 3];
+    face.next[c % 3] = x.first_corner;
+    face.prev[c % 3] = kNoIndex;
+    if (x.first_corner != kNoIndex) faces_[x.first_corner / 3].prev[x.first_corner % 3] = c;
+    x.first_corner = c;
+    ++x.face_count;
+}
+
+void HalfEdgeBuffer::unlink_corner(uint32_t v, uint32_t c) {
+    Vertex& x = slots_[v].vertex;
+    const Face& face = faces_[c / 3];
+    const uint32_t next = face.next[c % 3], prev = face.prev[c % 3];
+    if (prev == kNoIndex) x.first_corner = next;
+    else faces_[prev / 3].next[prev % 3] = next;
+    if (next != kNoIndex) faces_[next / 3].prev[next % 3] = prev;
+    --x.face_count;
+}
+
 void HalfEdgeBuffer::detach_face(uint32_t f) {
-    for (int k = 0; k < 3; ++k) {
-        const uint32_t c = 3 * f + k;
-        Vertex& x = vertex_[corner_vertex_[c]];
-        uint32_t* link = &x.first_corner;
-        while (*link != c) link = &next_corner_[*link];
-        *link = next_corner_[c];
-        --x.face_count;
-    }
+    for (uint32_t k = 0; k < 3; ++k) unlink_corner(faces_[f].vertex[k], 3 * f + k);
     live_.erase(f);
     interior_.erase(f);
     frontier_.erase(f);
@@ -370,19 +360,16 @@ void HalfEdgeBuffer::detach_face(uint32_t f) {
 }
 
 void HalfEdgeBuffer::move_corners(uint32_t p, uint32_t q) {
-    Vertex& from = vertex_[p];
-    Vertex& to = vertex_[q];
-    const bool q_frozen = (to.flags & kFrozen) != 0;
+    Vertex& from = slots_[p].vertex;
+    const bool q_frozen = (slots_[q].vertex.flags & kFrozen) != 0;
     uint32_t c = from.first_corner;
     while (c != kNoIndex) {
-        const uint32_t next = next_corner_[c];
-        corner_vertex_[c] = q;
-        next_corner_[c] = to.first_corner;
-        to.first_corner = c;
-        ++to.face_count;
+        const uint32_t next = next_corner(c);
+        faces_[c / 3].vertex[c % 3] = q;
+        link_corner(q, c);  // at the head of q's list, in p's order reversed (as before)
         const uint32_t f = c / 3;
-        if (q_frozen && !touches_out_[f]) {
-            touches_out_[f] = 1;
+        if (q_frozen && !faces_[f].touches_out) {
+            faces_[f].touches_out = 1;
             update_face_sets(f);
         }
         c = next;
@@ -393,13 +380,13 @@ void HalfEdgeBuffer::move_corners(uint32_t p, uint32_t q) {
 
 void HalfEdgeBuffer::finalize_all() {
     for (uint32_t v = 0; v < vertex_high_; ++v)
-        if ((vertex_[v].flags & (kAlive | kInHash)) == (kAlive | kInHash)) finalize_vertex(v);
+        if ((slots_[v].vertex.flags & (kAlive | kInHash)) == (kAlive | kInHash)) finalize_vertex(v);
 }
 
 size_t HalfEdgeBuffer::evict_orphans() {
     size_t evicted = 0;
     for (uint32_t v = 0; v < vertex_high_; ++v) {
-        const Vertex& x = vertex_[v];
+        const Vertex& x = slots_[v].vertex;
         if ((x.flags & (kAlive | kInHash)) == (kAlive | kInHash) && x.face_count == 0) {
             finalize_vertex(v);
             ++evicted;

@@ -17,10 +17,16 @@
 // Two dense index sets serve the writer (§4.4): faces touching no P_in vertex ("interior"),
 // and the subset of those touching P_out (a frozen, already written vertex).
 //
-// Memory bound: for capacity N triangles, about 52·N bytes of faces, 3·N vertices of
-// 40 + 80 (quadric) + 12 bytes, and a 4-byte hash slot per 1/2 vertex: about 470·N bytes
-// reserved, of which only the touched part becomes resident (pools hand out the most recently
-// freed slot first).
+// Layout (the pools are far larger than the caches and are read at random, so the number of
+// distinct cache lines touched per operation is what costs): everything about a face — its
+// three corner vertices, twins, both corner-list links and its places in the face sets — is
+// one 64-byte line; everything about a vertex — the record, the walk stamp and its quadric —
+// is one 128-byte pair of lines.
+//
+// Memory bound: for capacity N triangles, 64·N bytes of faces plus 12·N of face sets and free
+// list, 3·N+3 vertex slots of 128 + 4 bytes and a 4-byte hash slot per 1/2 vertex: about
+// 490·N bytes reserved, of which only the touched part becomes resident (pools hand out the
+// most recently freed slot first, and a manifold buffer holds about N/2 vertices).
 #pragma once
 
 #include "decimate/quadric.hpp"
@@ -73,21 +79,50 @@ template <class T> RawArray<T> raw_array(size_t n) {
     return RawArray<T>(static_cast<T*>(allocate_pool(n * sizeof(T))));
 }
 
-// A set of face indices with O(1) insert, erase and uniform sampling.
+// Everything about one face, in one cache line. Corner k of face f is corner 3·f + k, which is
+// also the half-edge from corner k to corner (k+1) mod 3.
+struct alignas(64) Face {
+    uint32_t vertex[3];     // corner → vertex
+    uint32_t twin[3];       // half-edge → twin half-edge or marker
+    uint32_t next[3];       // corner → next corner of the same vertex (kNoIndex: last)
+    uint32_t prev[3];       // corner → previous corner of the same vertex (kNoIndex: first)
+    uint32_t where[3];      // index in the live, interior and frontier FaceSets (kNoIndex: absent)
+    uint8_t pin_count;      // vertices on P_in
+    uint8_t touches_out;    // has a frozen vertex
+};
+static_assert(sizeof(Face) == 64);
+
+// A set of face indices with O(1) insert, erase and uniform sampling. The item array is dense;
+// a face's index in it is kept in the face record (Face::where[slot]).
 class FaceSet {
 public:
-    explicit FaceSet(size_t capacity);
-    bool contains(uint32_t f) const { return where_[f] != kNoIndex; }
-    void insert(uint32_t f);
-    void erase(uint32_t f);
+    FaceSet(size_t capacity, Face* faces, int slot);
+    bool contains(uint32_t f) const { return faces_[f].where[slot_] != kNoIndex; }
+    void insert(uint32_t f) {
+        uint32_t& w = faces_[f].where[slot_];
+        if (w != kNoIndex) return;
+        w = static_cast<uint32_t>(size_);
+        items_[size_++] = f;
+    }
+    void erase(uint32_t f) {
+        uint32_t& w = faces_[f].where[slot_];
+        if (w == kNoIndex) return;
+        const uint32_t i = w;
+        const uint32_t last = items_[--size_];
+        items_[i] = last;
+        faces_[last].where[slot_] = i;
+        w = kNoIndex;
+    }
     // Call when slot f is (re)allocated: marks it absent.
-    void reset(uint32_t f) { where_[f] = kNoIndex; }
+    void reset(uint32_t f) { faces_[f].where[slot_] = kNoIndex; }
     size_t size() const { return size_; }
     uint32_t at(size_t i) const { return items_[i]; }
     void prefetch(size_t i) const { __builtin_prefetch(&items_[i]); }
 
 private:
-    RawArray<uint32_t> items_, where_;
+    RawArray<uint32_t> items_;
+    Face* faces_;
+    int slot_;
     size_t size_ = 0;
 };
 
@@ -133,30 +168,27 @@ public:
     void finalize_all();
 
     // Accessors.
-    uint32_t corner_vertex(uint32_t h) const { return corner_vertex_[h]; }
-    uint32_t twin(uint32_t h) const { return twin_[h]; }
+    uint32_t corner_vertex(uint32_t h) const { return faces_[h / 3].vertex[h % 3]; }
+    uint32_t twin(uint32_t h) const { return faces_[h / 3].twin[h % 3]; }
     // Cache prefetch hints for batched random sampling (no effect on results).
-    void prefetch_half_edge(uint32_t h) const {
-        __builtin_prefetch(&corner_vertex_[h]);
-        __builtin_prefetch(&twin_[h]);
-    }
+    void prefetch_face(uint32_t f) const { __builtin_prefetch(&faces_[f]); }
     void prefetch_vertex(uint32_t v) const {
-        __builtin_prefetch(&vertex_[v]);
-        __builtin_prefetch(&quadric_[v]);
-        __builtin_prefetch(reinterpret_cast<const char*>(&quadric_[v]) + 64);
+        __builtin_prefetch(&slots_[v]);
+        __builtin_prefetch(reinterpret_cast<const char*>(&slots_[v]) + 64);
     }
-    void set_twin(uint32_t h, uint32_t t) { twin_[h] = t; }
-    uint32_t next_corner(uint32_t c) const { return next_corner_[c]; }
-    Vertex& vertex(uint32_t v) { return vertex_[v]; }
-    const Vertex& vertex(uint32_t v) const { return vertex_[v]; }
-    Quadric& quadric(uint32_t v) { return quadric_[v]; }
-    const Quadric& quadric(uint32_t v) const { return quadric_[v]; }
+    void set_twin(uint32_t h, uint32_t t) { faces_[h / 3].twin[h % 3] = t; }
+    uint32_t next_corner(uint32_t c) const { return faces_[c / 3].next[c % 3]; }
+    Vertex& vertex(uint32_t v) { return slots_[v].vertex; }
+    const Vertex& vertex(uint32_t v) const { return slots_[v].vertex; }
+    Quadric& quadric(uint32_t v) { return slots_[v].quadric; }
+    const Quadric& quadric(uint32_t v) const { return slots_[v].quadric; }
     // Position relative to origin() in double (what quadrics are expressed in).
     void position(uint32_t v, double out[3]) const {
-        for (int i = 0; i < 3; ++i) out[i] = double(vertex_[v].pos[i]) - origin_[i];
+        const float* pos = slots_[v].vertex.pos;
+        for (int i = 0; i < 3; ++i) out[i] = double(pos[i]) - origin_[i];
     }
     void set_position(uint32_t v, const double rel[3]) {
-        for (int i = 0; i < 3; ++i) vertex_[v].pos[i] = float(rel[i] + origin_[i]);
+        for (int i = 0; i < 3; ++i) slots_[v].vertex.pos[i] = float(rel[i] + origin_[i]);
     }
     const FaceSet& live_faces() const { return live_; }
     const FaceSet& interior_faces() const { return interior_; }  // no P_in vertex
@@ -164,12 +196,12 @@ public:
     // A fresh mark value for stamp(): vertices stamped with it are "in the current set".
     uint32_t new_stamp() {
         if (++stamp_counter_ == 0) {  // wrapped: old marks could alias
-            std::fill_n(stamp_.get(), vertex_high_, 0u);
+            for (uint32_t v = 0; v < vertex_high_; ++v) slots_[v].stamp = 0;
             stamp_counter_ = 1;
         }
         return stamp_counter_;
     }
-    uint32_t& stamp(uint32_t v) { return stamp_[v]; }
+    uint32_t& stamp(uint32_t v) { return slots_[v].stamp; }
 
     // Running counts for Stats.
     uint64_t vertices_merged() const { return vertices_merged_; }
@@ -191,17 +223,24 @@ private:
     bool origin_set_ = false;
     double origin_[3] = {0, 0, 0};
 
-    RawArray<uint32_t> corner_vertex_, twin_, next_corner_;
-    RawArray<uint8_t> pin_count_;    // per face: vertices on P_in
-    RawArray<uint8_t> touches_out_;  // per face: has a frozen vertex
+    // Everything about one vertex, in one 128-byte pair of cache lines.
+    struct alignas(128) VertexSlot {
+        Vertex vertex;
+        uint32_t stamp;
+        Quadric quadric;
+    };
+    static_assert(sizeof(VertexSlot) == 128);
+
+    void link_corner(uint32_t v, uint32_t c);
+    void unlink_corner(uint32_t v, uint32_t c);
+
+    RawArray<Face> faces_;
     RawArray<uint32_t> free_faces_;
     size_t free_face_count_ = 0;
     uint32_t face_high_ = 0;
     FaceSet live_, interior_, frontier_;
 
-    RawArray<Vertex> vertex_;
-    RawArray<Quadric> quadric_;
-    RawArray<uint32_t> stamp_;
+    RawArray<VertexSlot> slots_;
     RawArray<uint32_t> free_vertices_;
     size_t free_vertex_stack_ = 0;
     uint32_t vertex_high_ = 0;
