@@ -85,37 +85,70 @@ bool collapse_valid(HalfEdgeBuffer& buffer, uint32_t h) {
     const Vertex& vp = buffer.vertex(p);
     const Vertex& vq = buffer.vertex(q);
 
+    if (!boundary && vp.face_count == 3 && vq.face_count == 3) return false;  // tetrahedron
+
     // p's faces must form one fan reachable from h (a closed one for an interior edge, an
     // open one starting at h for a boundary edge): a vertex where two fans touch is not a
-    // manifold vertex and must not move.
+    // manifold vertex and must not move. The fan walk and the walk of q's corner list are two
+    // chains of dependent cache misses; advancing them in lockstep overlaps them. q's
+    // neighbours are gathered from the face records alone (no vertex reads) for the link
+    // condition below; p's neighbours are prefetched for the geometric check.
+    constexpr uint32_t kMaxRing = 48;
+    uint32_t ring[2 * kMaxRing];
+    uint32_t ring_size = 0;
+    const bool use_ring = vq.face_count <= kMaxRing;
     uint32_t count = 0;
-    for (uint32_t cur = h;;) {
-        if (++count > vp.face_count) return false;
-        const uint32_t around = buffer.twin(prev_in_face(cur));
-        if (!is_half_edge(around)) {
-            if (!boundary) return false;
-            break;
+    bool fan_done = false;
+    uint32_t cur = h;
+    uint32_t c = use_ring ? vq.first_corner : kNoIndex;
+    while (!fan_done || c != kNoIndex) {
+        if (c != kNoIndex) {
+            ring[ring_size++] = buffer.corner_vertex(next_in_face(c));
+            ring[ring_size++] = buffer.corner_vertex(prev_in_face(c));
+            c = buffer.next_corner(c);
         }
-        cur = around;
-        if (cur == h) {
-            if (boundary) return false;
-            break;
+        if (!fan_done) {
+            if (++count > vp.face_count) return false;
+            buffer.prefetch_vertex(buffer.corner_vertex(prev_in_face(cur)));
+            const uint32_t around = buffer.twin(prev_in_face(cur));
+            if (!is_half_edge(around)) {
+                if (!boundary) return false;
+                fan_done = true;
+            } else {
+                cur = around;
+                if (cur == h) {
+                    if (boundary) return false;
+                    fan_done = true;
+                }
+            }
         }
     }
     if (count != vp.face_count) return false;
-    if (!boundary && vp.face_count == 3 && vq.face_count == 3) return false;  // tetrahedron
 
     // Link condition: the common neighbours of p and q are exactly r (and s).
-    const uint32_t mark = buffer.new_stamp();
-    for (uint32_t c = vq.first_corner; c != kNoIndex; c = buffer.next_corner(c)) {
-        buffer.stamp(buffer.corner_vertex(next_in_face(c))) = mark;
-        buffer.stamp(buffer.corner_vertex(prev_in_face(c))) = mark;
-    }
-    for (uint32_t c = vp.first_corner; c != kNoIndex; c = buffer.next_corner(c)) {
-        const uint32_t x = buffer.corner_vertex(next_in_face(c));
-        const uint32_t y = buffer.corner_vertex(prev_in_face(c));
-        if (x != q && x != r && x != s && buffer.stamp(x) == mark) return false;
-        if (y != q && y != r && y != s && buffer.stamp(y) == mark) return false;
+    auto shared = [&](uint32_t x) {
+        if (x == q || x == r || x == s) return false;
+        for (uint32_t i = 0; i < ring_size; ++i)
+            if (ring[i] == x) return true;
+        return false;
+    };
+    if (use_ring) {
+        for (uint32_t cp = vp.first_corner; cp != kNoIndex; cp = buffer.next_corner(cp))
+            if (shared(buffer.corner_vertex(next_in_face(cp))) || shared(buffer.corner_vertex(prev_in_face(cp))))
+                return false;
+    } else {
+        // A high-valence q: mark its neighbours instead of searching a list.
+        const uint32_t mark = buffer.new_stamp();
+        for (uint32_t cq = vq.first_corner; cq != kNoIndex; cq = buffer.next_corner(cq)) {
+            buffer.stamp(buffer.corner_vertex(next_in_face(cq))) = mark;
+            buffer.stamp(buffer.corner_vertex(prev_in_face(cq))) = mark;
+        }
+        for (uint32_t cp = vp.first_corner; cp != kNoIndex; cp = buffer.next_corner(cp)) {
+            const uint32_t x = buffer.corner_vertex(next_in_face(cp));
+            const uint32_t y = buffer.corner_vertex(prev_in_face(cp));
+            if (x != q && x != r && x != s && buffer.stamp(x) == mark) return false;
+            if (y != q && y != r && y != s && buffer.stamp(y) == mark) return false;
+        }
     }
 
     double from[3], to[3];
