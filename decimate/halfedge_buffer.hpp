@@ -176,6 +176,20 @@ public:
         __builtin_prefetch(&slots_[v]);
         __builtin_prefetch(reinterpret_cast<const char*>(&slots_[v]) + 64);
     }
+    // Prefetch hints for reading a triangle soon: `stage` 0 fetches the corners' hash slots,
+    // stage 1 (a few triangles later, once the slots are cached) the vertices they name.
+    // Hints only: the table may change before the triangle is read.
+    void prefetch_triangle(const float tri[9], int stage) const {
+        for (int k = 0; k < 3; ++k) {
+            const size_t slot = hash_slot(tri + 3 * k);
+            if (stage == 0) {
+                __builtin_prefetch(&hash_[slot]);
+            } else if (hash_[slot] != kNoIndex) {
+                __builtin_prefetch(&slots_[hash_[slot]]);
+                __builtin_prefetch(reinterpret_cast<const char*>(&slots_[hash_[slot]]) + 64);
+            }
+        }
+    }
     void set_twin(uint32_t h, uint32_t t) { faces_[h / 3].twin[h % 3] = t; }
     uint32_t next_corner(uint32_t c) const { return faces_[c / 3].next[c % 3]; }
     Vertex& vertex(uint32_t v) { return slots_[v].vertex; }
