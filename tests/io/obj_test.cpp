@@ -135,16 +135,16 @@ TEST(ObjWriter, RecordsSortedAxisAndWeldsPositions) {
 
 TEST(ObjMemory, TinyBudgetSpillsTheVertexTableWithTheSameResult) {
     TempDir dir;
-    std::vector<float> grid = test::grid_soup(300);  // 178802 triangles, 90000 vertices
+    std::vector<float> grid = test::grid_soup(200);  // 79202 triangles, 40000 vertices
     test::write_soup(dir / "grid.obj", grid);
     io::ReadOptions tiny;
-    tiny.memory_budget_bytes = 256 << 10;
+    tiny.memory_budget_bytes = 128 << 10;
     test::Soup spilled = read_soup(dir / "grid.obj", io::TriangleChunk::kDefaultCapacity, tiny);
     test::Soup memory = read_soup(dir / "grid.obj");
     EXPECT_TRUE(spilled.xyz == grid);
     EXPECT_TRUE(memory.xyz == grid);
     EXPECT_EQ(spilled.ids, memory.ids);
-    test::convert(dir / "grid.obj", dir / "tiny.obj", {}, 256 << 10);
+    test::convert(dir / "grid.obj", dir / "tiny.obj", {}, 128 << 10);
     EXPECT_TRUE(test::slurp(dir / "tiny.obj") == test::slurp(dir / "grid.obj"));
 }
 

@@ -62,15 +62,15 @@ Welded weld(const std::vector<float>& soup, uint64_t budget, io::Channels channe
 }  // namespace
 
 TEST(Welder, HashAndExternalSortPathsAgree) {
-    std::vector<float> grid = test::grid_soup(120);  // 28322 triangles, 14400 vertices
+    std::vector<float> grid = test::grid_soup(80);  // 12482 triangles, 6400 vertices
     for (bool color : {false, true}) {
         io::Channels ch;
         ch.color = color;
         Welded memory = weld(grid, uint64_t{64} << 20, ch);
-        Welded tiny = weld(grid, 64 << 10, ch);
+        Welded tiny = weld(grid, 32 << 10, ch);
         EXPECT_FALSE(memory.out_of_core);
         EXPECT_TRUE(tiny.out_of_core);
-        EXPECT_EQ(memory.xyz.size(), 3u * 14400);
+        EXPECT_EQ(memory.xyz.size(), 3u * 6400);
         EXPECT_EQ(memory.xyz, tiny.xyz);
         EXPECT_EQ(memory.rgb, tiny.rgb);
         EXPECT_EQ(memory.indices, tiny.indices);
@@ -104,9 +104,9 @@ TEST(RecordSorter, SortsAcrossSpilledRuns) {
         bool operator()(uint64_t a, uint64_t b) const { return a < b; }
     };
     std::mt19937_64 rng(42);
-    std::vector<uint64_t> values(100000);
+    std::vector<uint64_t> values(30000);
     for (auto& v : values) v = rng() % 5000;
-    for (uint64_t budget : {uint64_t{1} << 30, uint64_t{8} << 10}) {
+    for (uint64_t budget : {uint64_t{1} << 30, uint64_t{16} << 10}) {
         io::RecordSorter<uint64_t, Less> sorter(budget, {});
         for (uint64_t v : values) sorter.push(v);
         sorter.finish_input(budget);
