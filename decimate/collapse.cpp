@@ -103,8 +103,12 @@ bool collapse_valid(HalfEdgeBuffer& buffer, uint32_t h) {
     uint32_t c = use_ring ? vq.first_corner : kNoIndex;
     while (!fan_done || c != kNoIndex) {
         if (c != kNoIndex) {
+            // Every neighbour x of q is the next corner of a face with q→x, or else the
+            // previous corner of one with x→q whose twin is no half-edge: listing prev only
+            // then keeps the ring free of duplicates on a manifold fan.
             ring[ring_size++] = buffer.corner_vertex(next_in_face(c));
-            ring[ring_size++] = buffer.corner_vertex(prev_in_face(c));
+            if (!is_half_edge(buffer.twin(prev_in_face(c))))
+                ring[ring_size++] = buffer.corner_vertex(prev_in_face(c));
             c = buffer.next_corner(c);
         }
         if (!fan_done) {
@@ -133,9 +137,11 @@ bool collapse_valid(HalfEdgeBuffer& buffer, uint32_t h) {
         return false;
     };
     if (use_ring) {
-        for (uint32_t cp = vp.first_corner; cp != kNoIndex; cp = buffer.next_corner(cp))
-            if (shared(buffer.corner_vertex(next_in_face(cp))) || shared(buffer.corner_vertex(prev_in_face(cp))))
+        for (uint32_t cp = vp.first_corner; cp != kNoIndex; cp = buffer.next_corner(cp)) {
+            if (shared(buffer.corner_vertex(next_in_face(cp)))) return false;
+            if (!is_half_edge(buffer.twin(prev_in_face(cp))) && shared(buffer.corner_vertex(prev_in_face(cp))))
                 return false;
+        }
     } else {
         // A high-valence q: mark its neighbours instead of searching a list.
         const uint32_t mark = buffer.new_stamp();
@@ -202,6 +208,7 @@ void apply_collapse(HalfEdgeBuffer& buffer, uint32_t h) {
 
     buffer.move_corners(p, q);
     buffer.quadric(q) += buffer.quadric(p);
+    if ((buffer.vertex(q).flags & kFrozen) == 0) buffer.set_partner(q, buffer.vertex(p).pos);
     Vertex& vp = buffer.vertex(p);
     buffer.vertex(q).open_edges += vp.open_edges;
     vp.open_edges = 0;

@@ -91,6 +91,16 @@ bool HalfEdgeBuffer::same_key(const float a[3], const float b[3]) const {
 }
 
 size_t HalfEdgeBuffer::hash_slot(const float p[3]) const {
+    if (weld_eps_ == 0) {
+        // Exact welding hashes every corner (and prefetches hash it again): one multiply-
+        // xorshift round over the 96 key bits is enough to spread float bit patterns.
+        const uint64_t xy = uint64_t{float_key(p[0])} | uint64_t{float_key(p[1])} << 32;
+        uint64_t h = xy * 0x9e3779b97f4a7c15ull ^ uint64_t{float_key(p[2])} * 0xc2b2ae3d27d4eb4full;
+        h ^= h >> 32;
+        h *= 0xd6e8feb86659fd93ull;
+        h ^= h >> 32;
+        return h & hash_mask_;
+    }
     uint64_t k[3];
     for (int i = 0; i < 3; ++i)
         k[i] = weld_eps_ == 0 ? float_key(p[i])
@@ -181,12 +191,6 @@ void HalfEdgeBuffer::hash_erase(uint32_t v) {
     hash_[hole] = kNoIndex;
 }
 
-uint32_t HalfEdgeBuffer::find_half_edge(uint32_t from, uint32_t to) const {
-    for (uint32_t c = slots_[from].vertex.first_corner; c != kNoIndex; c = next_corner(c))
-        if (corner_vertex(next_in_face(c)) == to) return c;
-    return kNoIndex;
-}
-
 void HalfEdgeBuffer::update_face_sets(uint32_t f) {
     if (faces_[f].pin_count == 0) {
         interior_.insert(f);
@@ -260,17 +264,32 @@ HalfEdgeBuffer::Added HalfEdgeBuffer::add_triangle(const float tri[9]) {
     // Connect each half-edge a→b to an open partner b→a. Anything else (a second a→b, or
     // b→a already taken) makes the edge non-manifold: the new half-edge stays unconnected and
     // both ends are frozen against collapses.
-    for (int k = 0; k < 3; ++k) {
+    //
+    // One walk over each corner's list finds, for every edge, the first existing a→b ("same")
+    // and b→a ("opposite") in list order (the new face is not linked yet, so the lists do not
+    // change during the walks).
+    uint32_t same[3] = {kNoIndex, kNoIndex, kNoIndex}, opposite[3] = {kNoIndex, kNoIndex, kNoIndex};
+    for (uint32_t k = 0; k < 3; ++k) {
+        const uint32_t to_next = v[k == 2 ? 0 : k + 1], to_prev = v[k == 0 ? 2 : k - 1];
+        const uint32_t k_prev = k == 0 ? 2 : k - 1;
+        for (uint32_t c = slots_[v[k]].vertex.first_corner; c != kNoIndex;) {
+            const Face& face = faces_[c / 3];
+            const uint32_t j = c % 3;
+            const uint32_t w = face.vertex[j == 2 ? 0 : j + 1];
+            if (w == to_next && same[k] == kNoIndex) same[k] = c;               // v[k]→v[k+1]
+            if (w == to_prev && opposite[k_prev] == kNoIndex) opposite[k_prev] = c;  // v[k]→v[k−1]
+            c = face.next[j];
+        }
+    }
+    for (uint32_t k = 0; k < 3; ++k) {
         const uint32_t a = v[k], b = v[(k + 1) % 3], h = 3 * f + k;
         faces_[f].vertex[k] = a;
-        const uint32_t same = find_half_edge(a, b);
-        const uint32_t opposite = find_half_edge(b, a);
-        if (same == kNoIndex && opposite != kNoIndex && twin(opposite) == kOpenEdge) {
-            faces_[f].twin[k] = opposite;
-            set_twin(opposite, h);
+        if (same[k] == kNoIndex && opposite[k] != kNoIndex && twin(opposite[k]) == kOpenEdge) {
+            faces_[f].twin[k] = opposite[k];
+            set_twin(opposite[k], h);
             --slots_[a].vertex.open_edges;
             --slots_[b].vertex.open_edges;
-        } else if (same == kNoIndex && opposite == kNoIndex) {
+        } else if (same[k] == kNoIndex && opposite[k] == kNoIndex) {
             if (take_written_stub(b, a)) {
                 faces_[f].twin[k] = kWrittenEdge;  // the partner was force-written earlier
                 --slots_[a].vertex.open_edges;

@@ -55,6 +55,7 @@ inline constexpr uint8_t kFrozen = 2;        // written (on P_out): position fin
 inline constexpr uint8_t kNonManifold = 4;   // touches a non-manifold edge: never collapsed
 inline constexpr uint8_t kWeldMerged = 8;    // absorbed another input position (--weld)
 inline constexpr uint8_t kAlive = 16;
+inline constexpr uint8_t kHasPartner = 32;  // partner_position() holds a collapsed edge's far end
 
 struct Vertex {
     float pos[3];           // input position, moved once when written (§4.4)
@@ -63,7 +64,10 @@ struct Vertex {
     uint32_t open_edges;    // incident half-edges without partner (kOpenEdge), also written ones
     uint32_t generation;    // bumped at every allocation (stale references detect reuse)
     uint8_t flags;
-    uint64_t id;            // output vertex id, valid once kFrozen
+    union {
+        uint64_t id;               // output vertex id, valid once kFrozen
+        float partner_xy[2];       // before freezing: see HalfEdgeBuffer::partner_position
+    };
 };
 
 // An array of an implicit-lifetime type left uninitialized, so that pages nobody touches
@@ -201,6 +205,23 @@ public:
         const float* pos = slots_[v].vertex.pos;
         for (int i = 0; i < 3; ++i) out[i] = double(pos[i]) - origin_[i];
     }
+    // The position (relative to origin()) of the vertex p last collapsed into v, the far end
+    // of that edge: a fallback placement when v's quadric has no unique minimum (§4.4).
+    // Returns false when nothing was collapsed into v. Valid until v is frozen.
+    bool partner_position(uint32_t v, double out[3]) const {
+        const VertexSlot& slot = slots_[v];
+        if ((slot.vertex.flags & kHasPartner) == 0) return false;
+        const float pos[3] = {slot.vertex.partner_xy[0], slot.vertex.partner_xy[1], slot.partner_z};
+        for (int i = 0; i < 3; ++i) out[i] = double(pos[i]) - origin_[i];
+        return true;
+    }
+    void set_partner(uint32_t v, const float pos[3]) {
+        VertexSlot& slot = slots_[v];
+        slot.vertex.partner_xy[0] = pos[0];
+        slot.vertex.partner_xy[1] = pos[1];
+        slot.partner_z = pos[2];
+        slot.vertex.flags |= kHasPartner;
+    }
     void set_position(uint32_t v, const double rel[3]) {
         for (int i = 0; i < 3; ++i) slots_[v].vertex.pos[i] = float(rel[i] + origin_[i]);
     }
@@ -225,7 +246,6 @@ public:
 private:
     uint32_t weld(const float p[3]);
     uint32_t alloc_vertex();
-    uint32_t find_half_edge(uint32_t from, uint32_t to) const;
     void update_face_sets(uint32_t f);
     void hash_erase(uint32_t v);
     size_t hash_slot(const float p[3]) const;
@@ -241,6 +261,7 @@ private:
     struct alignas(128) VertexSlot {
         Vertex vertex;
         uint32_t stamp;
+        float partner_z;  // with Vertex::partner_xy
         Quadric quadric;
     };
     static_assert(sizeof(VertexSlot) == 128);

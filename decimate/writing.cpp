@@ -60,7 +60,27 @@ bool place_vertex(HalfEdgeBuffer& buffer, uint32_t v) {
     const Quadric& q = buffer.quadric(v);
     double old[3], best[3];
     buffer.position(v, old);
-    if (!q.minimum(best)) return false;
+    if (!q.minimum(best)) {
+        // No unique minimum (flat or cylindrical neighbourhood): as Garland & Heckbert, take
+        // the best of the collapsed edge's ends and its midpoint — here the far end p of the
+        // last collapse into v (v itself is the other end, the old position).
+        double far_end[3];
+        if (!buffer.partner_position(v, far_end)) return false;
+        double error = q.error(old);
+        bool found = false;
+        const double mid[3] = {0.5 * (old[0] + far_end[0]), 0.5 * (old[1] + far_end[1]),
+                               0.5 * (old[2] + far_end[2])};
+        const double* candidates[2] = {far_end, mid};
+        for (const double* candidate : candidates) {
+            const double e = q.error(candidate);
+            if (e < error) {
+                error = e;
+                std::copy(candidate, candidate + 3, best);
+                found = true;
+            }
+        }
+        if (!found) return false;
+    }
     double reach2 = 0;
     for (uint32_t c = x.first_corner; c != kNoIndex; c = buffer.next_corner(c)) {
         double w[3];

@@ -38,8 +38,10 @@ uint32_t pick_write(const HalfEdgeBuffer& buffer, Rng& rng, int candidates);
 
 // Moves vertex v to its quadric minimum when its quadric is complete (not on P_in, manifold,
 // no open edge), the 3×3 system is well conditioned, the move stays within the longest
-// incident edge and no incident face flips or degenerates; otherwise it keeps its position
-// (the fallback: v is either an input position or a collapse target, both on the surface).
+// incident edge and no incident face flips or degenerates. When the system is singular it
+// takes instead the best, by v's quadric error, of the last collapsed edge's ends and its
+// midpoint (v's own position, the far end p, (v+p)/2), under the same checks. Otherwise it
+// keeps its position (an input position or a collapse target, both on the surface).
 // Returns true when it moved.
 bool place_vertex(HalfEdgeBuffer& buffer, uint32_t v);
 
