@@ -77,6 +77,44 @@ TEST(Writing, FarOrSingularOptimumKeepsThePosition) {
     EXPECT_EQ(buffer.vertex(top).pos[2], 1.0f);
 }
 
+TEST(Writing, SingularQuadricFallsBackToTheBestEndOfTheCollapsedEdge) {
+    HalfEdgeBuffer buffer(64, 0);
+    add_indexed(buffer, octahedron_points(), octahedron_faces());
+    const uint32_t top = vertex_at(buffer, {0, 0, 1});
+    double rel[3];
+    buffer.position(top, rel);
+    const double o[3] = {0 - rel[0], 0 - rel[1], 1 - rel[2]};
+    // Only the plane z = 0.9: singular (no unique minimum).
+    const double a[3] = {-o[0], -o[1], 0.9 - o[2]}, b[3] = {1 - o[0], -o[1], 0.9 - o[2]}, c[3] = {-o[0], 1 - o[1], 0.9 - o[2]};
+    buffer.quadric(top) = Quadric::from_triangle(a, b, c);
+    // Nothing collapsed into it: no fallback, it stays.
+    EXPECT_FALSE(place_vertex(buffer, top));
+    // As if p = (0.05, 0, 0.9) had been collapsed into it: p lies on the plane (error 0),
+    // better than the midpoint (0.025, 0, 0.95) and the old position (0, 0, 1).
+    const float far_end[3] = {0.05f, 0.0f, 0.9f};
+    buffer.set_partner(top, far_end);
+    ASSERT_TRUE(place_vertex(buffer, top));
+    EXPECT_FLOAT_EQ(buffer.vertex(top).pos[0], 0.05f);
+    EXPECT_FLOAT_EQ(buffer.vertex(top).pos[1], 0.0f);
+    EXPECT_FLOAT_EQ(buffer.vertex(top).pos[2], 0.9f);
+}
+
+TEST(Writing, SingularFallbackNeverTakesAWorseEnd) {
+    HalfEdgeBuffer buffer(64, 0);
+    add_indexed(buffer, octahedron_points(), octahedron_faces());
+    const uint32_t top = vertex_at(buffer, {0, 0, 1});
+    double rel[3];
+    buffer.position(top, rel);
+    const double o[3] = {0 - rel[0], 0 - rel[1], 1 - rel[2]};
+    // The plane z = 1 through the vertex itself: its old position already has error 0.
+    const double a[3] = {-o[0], -o[1], 1 - o[2]}, b[3] = {1 - o[0], -o[1], 1 - o[2]}, c[3] = {-o[0], 1 - o[1], 1 - o[2]};
+    buffer.quadric(top) = Quadric::from_triangle(a, b, c);
+    const float far_end[3] = {0.0f, 0.0f, 0.8f};
+    buffer.set_partner(top, far_end);
+    EXPECT_FALSE(place_vertex(buffer, top));
+    EXPECT_EQ(buffer.vertex(top).pos[2], 1.0f);
+}
+
 TEST(Writing, PassThroughFreezesInPlace) {
     HalfEdgeBuffer buffer(64, 0);
     const float tri[9] = {0, 0, 0, 1, 0, 0, 0, 0, 0};
