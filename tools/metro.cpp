@@ -475,6 +475,9 @@ EdgeCounter::EdgeCounter(uint64_t budget_bytes, std::string tmpdir) : impl_(std:
     // The spill partitions' write buffers (1 MiB each) come out of the same budget.
     uint64_t overhead = std::min(budget_bytes / 2, uint64_t{Impl::kPartitions} << 20);
     impl_->buffer_capacity = static_cast<size_t>(std::max<uint64_t>((budget_bytes - overhead) / sizeof(Impl::Key), 1024));
+    // Reserved once: growth by doubling would briefly hold twice the budget. Untouched pages
+    // of the reservation are not resident, so small meshes do not pay for it.
+    impl_->buffer.reserve(impl_->buffer_capacity);
 }
 
 EdgeCounter::~EdgeCounter() = default;
