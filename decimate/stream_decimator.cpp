@@ -61,13 +61,7 @@ void StreamDecimator::push(const io::TriangleChunk& in, const Emit& out) {
 
 void StreamDecimator::read_triangle(const float tri[9], const Emit& out) {
     if (buffer_.full() || buffer_.free_vertex_count() < 3) make_room(out);
-    if (options_.sorted_axis) {
-        const int axis = *options_.sorted_axis;
-        const float lo = std::min({tri[axis], tri[3 + axis], tri[6 + axis]});
-        const float hi = std::max({tri[axis], tri[3 + axis], tri[6 + axis]});
-        sweep_margin_ = std::max(sweep_margin_, double(hi) - double(lo));
-        sweep_front_ = std::max(sweep_front_, double(lo));
-    }
+    if (options_.sorted_axis) track_sweep(tri);
     const HalfEdgeBuffer::Added added = buffer_.add_triangle(tri);
     ++stats_.triangles_in;
     if (added.face == kNoIndex) {
@@ -92,20 +86,49 @@ void StreamDecimator::read_triangle(const float tri[9], const Emit& out) {
     }
 }
 
-void StreamDecimator::sweep(double front) {
+void StreamDecimator::track_sweep(const float tri[9]) {
+    const int axis = *options_.sorted_axis;
+    const double lo = std::min({tri[axis], tri[3 + axis], tri[6 + axis]});
+    const double hi = std::max({tri[axis], tri[3 + axis], tri[6 + axis]});
+    // A triangle reaching into the region already swept may weld to a vertex finalized too
+    // early (a crack): the input is not sorted as stated. Count it and stop sweeping.
+    if (swept_to_ && (stats_.sweep_direction > 0 ? lo < *swept_to_ : hi > *swept_to_)) {
+        ++stats_.sort_violations;
+        sweep_enabled_ = false;
+    }
+    if (!sweep_started_) {
+        first_lo_ = lo;
+        first_hi_ = hi;
+        sweep_started_ = true;
+    }
+    sweep_margin_ = std::max(sweep_margin_, hi - lo);
+    lo_max_ = std::max(lo_max_, lo);
+    hi_min_ = std::min(hi_min_, hi);
+    if (stats_.sweep_direction == 0) {
+        if (lo_max_ - first_hi_ > 2 * sweep_margin_) stats_.sweep_direction = 1;
+        else if (first_lo_ - hi_min_ > 2 * sweep_margin_) stats_.sweep_direction = -1;
+    }
+}
+
+void StreamDecimator::sweep() {
     // A future triangle has a sort key ≥ the front (every key lies within its triangle, and
     // the front is the largest triangle minimum read so far), so it can only reach vertices
     // within one triangle extent behind the front. Twice the largest extent seen leaves room
     // for somewhat larger triangles to come. Vertices further behind that are still open are
     // true boundary (holes): finalizing them lets their triangles be decimated and written.
-    const double threshold = front - 2 * sweep_margin_;
+    // Descending input is the mirror image (front = smallest triangle maximum).
+    const int direction = stats_.sweep_direction;
+    if (!sweep_enabled_ || direction == 0) return;
+    const double threshold = direction > 0 ? lo_max_ - 2 * sweep_margin_ : hi_min_ + 2 * sweep_margin_;
     while (sweep_size_ > 0) {
         const SweepEntry& e = sweep_queue_[sweep_head_];
-        if (!(double(e.coordinate) < threshold)) break;
+        const bool behind = direction > 0 ? double(e.coordinate) < threshold : double(e.coordinate) > threshold;
+        if (!behind) break;
         const Vertex& x = buffer_.vertex(e.vertex);
         if ((x.flags & (kAlive | kInHash)) == (kAlive | kInHash) && x.generation == e.generation) {
             buffer_.finalize_vertex(e.vertex);
             ++stats_.vertices_finalized_by_sweep;
+            swept_to_ = threshold;
         }
         sweep_head_ = (sweep_head_ + 1) % sweep_capacity_;
         --sweep_size_;
@@ -127,7 +150,7 @@ void StreamDecimator::write_one(const Emit& out, bool allow_forced) {
 }
 
 void StreamDecimator::make_room(const Emit& out) {
-    if (options_.sorted_axis) sweep(sweep_front_);
+    if (options_.sorted_axis) sweep();
     const RoomPlan plan = plan_full_buffer(buffer_.face_capacity(), ratio_, stats_.triangles_in,
                                            output_.triangle_count());
     int failures = 0;

@@ -31,7 +31,7 @@ struct Options {
     int candidates = 8;                 // multiple-choice sample size (1..64)
     uint64_t seed = 1;
     double weld_eps = 0;                // 0: exact welding; > 0: grid cell size (absolute)
-    std::optional<int> sorted_axis;     // 0,1,2 when the input is sorted ascending on it
+    std::optional<int> sorted_axis;     // 0,1,2 when the input is sorted on it (either direction)
     size_t output_chunk_triangles = io::TriangleChunk::kDefaultCapacity;
 };
 
@@ -49,6 +49,8 @@ struct Stats {
     uint64_t nonmanifold_edges = 0;      // half-edges frozen as non-manifold
     uint64_t vertices_merged = 0;        // vertices that absorbed other positions (--weld)
     uint64_t vertices_finalized_by_sweep = 0;
+    int sweep_direction = 0;             // sorted input: +1 ascending, −1 descending, 0 not yet seen
+    uint64_t sort_violations = 0;        // triangles reaching behind the sweep (sweep then stops)
     uint64_t orphans_evicted = 0;
     uint64_t vertices_moved = 0;         // moved to their quadric optimum when written
 };
@@ -77,7 +79,8 @@ private:
     void read_triangle(const float tri[9], const Emit& out);
     void make_room(const Emit& out);
     void write_one(const Emit& out, bool allow_forced);
-    void sweep(double front);
+    void sweep();
+    void track_sweep(const float tri[9]);
 
     Options options_;
     double ratio_;
@@ -95,7 +98,13 @@ private:
     };
     std::unique_ptr<SweepEntry[]> sweep_queue_;
     size_t sweep_capacity_ = 0, sweep_head_ = 0, sweep_size_ = 0;
-    double sweep_front_ = -INFINITY, sweep_margin_ = 0;
+    // Ascending input: the front is the largest triangle minimum read (lo_max_); descending:
+    // the smallest triangle maximum (hi_min_). The direction is decided once the front has
+    // left the first triangle by more than two margins.
+    double lo_max_ = -INFINITY, hi_min_ = INFINITY, sweep_margin_ = 0;
+    double first_lo_ = 0, first_hi_ = 0;
+    bool sweep_started_ = false, sweep_enabled_ = true;
+    std::optional<double> swept_to_;  // threshold of the last sweep that finalized vertices
 };
 
 }  // namespace meshstream::decimate

@@ -113,8 +113,10 @@ void run_decimate(const DecimateOptions& opt) {
         std::fprintf(stderr, "  weld %.6g: %llu vertices merged\n", options.weld_eps,
                      (unsigned long long)s.vertices_merged);
     if (options.sorted_axis)
-        std::fprintf(stderr, "  sorted along %c: %llu hole-boundary vertices finalized by the sweep\n",
-                     "xyz"[*options.sorted_axis], (unsigned long long)s.vertices_finalized_by_sweep);
+        std::fprintf(stderr, "  sorted along %c (%s): %llu hole-boundary vertices finalized by the sweep\n",
+                     "xyz"[*options.sorted_axis],
+                     s.sweep_direction > 0 ? "ascending" : s.sweep_direction < 0 ? "descending" : "direction not seen",
+                     (unsigned long long)s.vertices_finalized_by_sweep);
 
     Warnings warnings;
     if (s.forced_writes > 0)
@@ -123,6 +125,11 @@ void run_decimate(const DecimateOptions& opt) {
                      std::to_string(s.premature_writes) +
                      " written before reaching the target resolution); the input is not in streaming order: "
                      "run `meshstream sort` on it first, or raise --buffer");
+    if (s.sort_violations > 0)
+        warnings.add(std::string("the input is not sorted along ") + "xyz"[*options.sorted_axis] +
+                     " as stated: " + std::to_string(s.sort_violations) +
+                     " triangles reached behind the sweep, which was switched off at the first (boundary "
+                     "finalized before it may show as cracks); run `meshstream sort` on it first");
     if (s.nonmanifold_edges > 0)
         warnings.add("non-manifold, duplicate or mis-oriented edges frozen and passed through", s.nonmanifold_edges);
     if (s.degenerate_passed > 0)

@@ -143,6 +143,40 @@ TEST(StreamDecimator, SortedHolesAreFinalizedBySweep) {
     EXPECT_EQ(topology(sorted.ids).nonmanifold_edges, 0u);
 }
 
+TEST(StreamDecimator, DescendingSortedInputIsSweptToo) {
+    const std::vector<float> ascending = holey_grid(300, 40);
+    std::vector<float> soup;  // the same triangles, last first: sorted descending along x
+    for (size_t t = ascending.size() / 9; t-- > 0;) soup.insert(soup.end(), &ascending[9 * t], &ascending[9 * t + 9]);
+    Options options;
+    options.ratio = 0.3;
+    options.buffer_triangles = 1500;
+    options.sorted_axis = 0;
+    const Decimated d = run_decimator(soup, options);
+    EXPECT_EQ(d.stats.sweep_direction, -1);
+    EXPECT_EQ(d.stats.sort_violations, 0u);
+    EXPECT_EQ(d.stats.forced_writes, 0u);
+    EXPECT_GT(d.stats.vertices_finalized_by_sweep, 0u);
+    EXPECT_EQ(d.triangle_count(), static_cast<uint64_t>(std::llround(0.3 * double(soup.size() / 9))));
+    EXPECT_EQ(topology(d.ids).nonmanifold_edges, 0u);
+    const Decimated up = run_decimator(ascending, options);
+    EXPECT_EQ(up.stats.sweep_direction, 1);
+    EXPECT_EQ(up.stats.sort_violations, 0u);
+}
+
+TEST(StreamDecimator, WronglyClaimedSortOrderIsDetectedAndTheSweepStops) {
+    // The holey grid claimed sorted along y, but it is sorted along x: rows of y restart.
+    const std::vector<float> soup = holey_grid(300, 40);
+    Options options;
+    options.ratio = 0.3;
+    options.buffer_triangles = 1500;
+    options.sorted_axis = 1;
+    const Decimated d = run_decimator(soup, options);
+    EXPECT_GT(d.stats.sort_violations, 0u);
+    EXPECT_EQ(d.stats.triangles_in, soup.size() / 9);
+    EXPECT_TRUE(ids_consistent(d));
+    EXPECT_EQ(topology(d.ids).nonmanifold_edges, 0u);
+}
+
 TEST(StreamDecimator, ShuffledInputForceWritesButNeverBreaks) {
     std::vector<float> soup = bunny();
     // Shuffle triangles deterministically: no streaming order at all.
