@@ -103,9 +103,10 @@ size_t HalfEdgeBuffer::hash_slot(const float p[3]) const {
     }
     uint64_t k[3];
     for (int i = 0; i < 3; ++i)
+        // The cell index as the bits of the (integral) double: an int64 cast overflows for
+        // huge coordinates or tiny cells (fuzz finding, FuzzRegression.Issue7_WeldHugeCoordinate).
         k[i] = weld_eps_ == 0 ? float_key(p[i])
-                              : static_cast<uint64_t>(
-                                    static_cast<int64_t>(std::floor(double(p[i]) / weld_eps_)));
+                              : std::bit_cast<uint64_t>(std::floor(double(p[i]) / weld_eps_) + 0.0);
     return mix64(k[0] * 0x9e3779b97f4a7c15ull ^ mix64(k[1] + 0x632be59bd9b4e019ull) ^
                  (k[2] * 0xc2b2ae3d27d4eb4full)) &
            hash_mask_;
