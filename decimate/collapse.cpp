@@ -60,21 +60,6 @@ bool moves_keep_faces_valid(const HalfEdgeBuffer& buffer, uint32_t v, const doub
     return true;
 }
 
-bool collapse_eligible(const HalfEdgeBuffer& buffer, uint32_t h) {
-    const Vertex& p = buffer.vertex(buffer.corner_vertex(h));
-    if ((p.flags & (kInHash | kFrozen | kNonManifold)) != 0 || p.open_edges != 0) return false;
-    if (!is_half_edge(buffer.twin(h))) return false;
-    const Vertex& q = buffer.vertex(buffer.corner_vertex(next_in_face(h)));
-    return (q.flags & (kInHash | kNonManifold)) == 0;
-}
-
-double collapse_error(const HalfEdgeBuffer& buffer, uint32_t h) {
-    const uint32_t p = buffer.corner_vertex(h), q = buffer.corner_vertex(next_in_face(h));
-    double x[3];
-    buffer.position(q, x);
-    return (buffer.quadric(p) + buffer.quadric(q)).error(x);
-}
-
 bool collapse_valid(HalfEdgeBuffer& buffer, uint32_t h) {
     const uint32_t p = buffer.corner_vertex(h), q = buffer.corner_vertex(next_in_face(h));
     const uint32_t t = buffer.twin(h);

@@ -15,10 +15,22 @@ namespace meshstream::decimate {
 
 // Topological eligibility of half-edge h = p→q from flags alone (cheap, used for sampling):
 // p interior (closed fan, not on P_in/P_out, manifold), q manifold and not on P_in.
-bool collapse_eligible(const HalfEdgeBuffer& buffer, uint32_t h);
+// (Inline: it runs for every random draw.)
+inline bool collapse_eligible(const HalfEdgeBuffer& buffer, uint32_t h) {
+    const Vertex& p = buffer.vertex(buffer.corner_vertex(h));
+    if ((p.flags & (kInHash | kFrozen | kNonManifold)) != 0 || p.open_edges != 0) return false;
+    if (!is_half_edge(buffer.twin(h))) return false;
+    const Vertex& q = buffer.vertex(buffer.corner_vertex(next_in_face(h)));
+    return (q.flags & (kInHash | kNonManifold)) == 0;
+}
 
 // The quadric error of collapsing h = p→q: (Q_p + Q_q) evaluated at q.
-double collapse_error(const HalfEdgeBuffer& buffer, uint32_t h);
+inline double collapse_error(const HalfEdgeBuffer& buffer, uint32_t h) {
+    const uint32_t p = buffer.corner_vertex(h), q = buffer.corner_vertex(next_in_face(h));
+    double x[3];
+    buffer.position(q, x);
+    return (buffer.quadric(p) + buffer.quadric(q)).error(x);
+}
 
 // Full validity of an eligible collapse p→q: p's fan is a single closed (or, for a boundary
 // half-edge, a single open) fan; the link condition holds (the common neighbours of p and q

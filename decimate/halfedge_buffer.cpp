@@ -143,8 +143,7 @@ void HalfEdgeBuffer::free_vertex(uint32_t v) {
     --vertex_used_;
 }
 
-uint32_t HalfEdgeBuffer::weld(const float p[3]) {
-    size_t slot = hash_slot(p);
+uint32_t HalfEdgeBuffer::weld(const float p[3], size_t slot) {
     for (;;) {
         const uint32_t v = hash_[slot];
         if (v == kNoIndex) break;
@@ -239,10 +238,11 @@ void HalfEdgeBuffer::add_written_stub(uint32_t a, uint32_t b) {
     ++stub_count_;
 }
 
-HalfEdgeBuffer::Added HalfEdgeBuffer::add_triangle(const float tri[9]) {
+HalfEdgeBuffer::Added HalfEdgeBuffer::add_triangle(const float tri[9], const size_t slots[3]) {
     assert(!full() && free_vertex_count() >= 3);
     Added added;
-    for (int k = 0; k < 3; ++k) added.vertex[k] = weld(tri + 3 * k);
+    for (int k = 0; k < 3; ++k)
+        added.vertex[k] = weld(tri + 3 * k, slots ? slots[k] : hash_slot(tri + 3 * k));
     const uint32_t* v = added.vertex;
     if (!origin_set_) {
         for (int i = 0; i < 3; ++i) origin_[i] = tri[i];

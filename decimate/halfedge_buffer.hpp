@@ -149,7 +149,13 @@ public:
     // READ(1) of §4.2: welds the corners, accumulates quadrics, connects the new face to
     // its in-core neighbours. Preconditions: !full(), free_vertex_count() ≥ 3. A degenerate
     // triangle is not inserted (its vertices are, so the caller can pass it through).
-    Added add_triangle(const float tri[9]);
+    Added add_triangle(const float tri[9]) { return add_triangle(tri, nullptr); }
+    // The same with the corners' welding hash slots precomputed by weld_slots() (or null).
+    Added add_triangle(const float tri[9], const size_t slots[3]);
+    // The welding hash slots of a triangle's corners (a pure function of the positions).
+    void weld_slots(const float tri[9], size_t slots[3]) const {
+        for (int k = 0; k < 3; ++k) slots[k] = hash_slot(tri + 3 * k);
+    }
 
     // The vertex leaves P_in (no more input will reach it): removed from the hash table; a
     // vertex without faces is freed.
@@ -180,17 +186,16 @@ public:
         __builtin_prefetch(&slots_[v]);
         __builtin_prefetch(reinterpret_cast<const char*>(&slots_[v]) + 64);
     }
-    // Prefetch hints for reading a triangle soon: `stage` 0 fetches the corners' hash slots,
-    // stage 1 (a few triangles later, once the slots are cached) the vertices they name.
-    // Hints only: the table may change before the triangle is read.
-    void prefetch_triangle(const float tri[9], int stage) const {
+    // Prefetch hints for reading a triangle soon, given its weld_slots(): `stage` 0 fetches
+    // the hash slots, stage 1 (a few triangles later, once the slots are cached) the vertices
+    // they name. Hints only: the table may change before the triangle is read.
+    void prefetch_triangle(const size_t slots[3], int stage) const {
         for (int k = 0; k < 3; ++k) {
-            const size_t slot = hash_slot(tri + 3 * k);
             if (stage == 0) {
-                __builtin_prefetch(&hash_[slot]);
-            } else if (hash_[slot] != kNoIndex) {
-                __builtin_prefetch(&slots_[hash_[slot]]);
-                __builtin_prefetch(reinterpret_cast<const char*>(&slots_[hash_[slot]]) + 64);
+                __builtin_prefetch(&hash_[slots[k]]);
+            } else if (hash_[slots[k]] != kNoIndex) {
+                __builtin_prefetch(&slots_[hash_[slots[k]]]);
+                __builtin_prefetch(reinterpret_cast<const char*>(&slots_[hash_[slots[k]]]) + 64);
             }
         }
     }
@@ -244,7 +249,7 @@ public:
     size_t peak_vertices() const { return vertex_used_peak_; }
 
 private:
-    uint32_t weld(const float p[3]);
+    uint32_t weld(const float p[3], size_t slot);
     uint32_t alloc_vertex();
     void update_face_sets(uint32_t f);
     void hash_erase(uint32_t v);

@@ -49,20 +49,30 @@ void StreamDecimator::push(const io::TriangleChunk& in, const Emit& out) {
     assert(!finished_);
     const std::span<const float> xyz = in.xyz();
     // Welding reads a random hash slot and then a random vertex per corner; prefetching them
-    // a few triangles ahead overlaps those misses (hints only: results do not change).
-    constexpr size_t kSlotsAhead = 8, kVerticesAhead = 4;
+    // a few triangles ahead overlaps those misses (hints only: results do not change). Each
+    // corner's slot is hashed once, kept in a small ring until the triangle is read.
+    constexpr size_t kSlotsAhead = 8, kVerticesAhead = 4, kRing = 16;
+    size_t ring[kRing][3];
     const size_t n = in.size();
+    for (size_t i = 0; i < std::min(n, kSlotsAhead); ++i) {
+        buffer_.weld_slots(&xyz[9 * i], ring[i % kRing]);
+        buffer_.prefetch_triangle(ring[i % kRing], 0);
+    }
     for (size_t i = 0; i < n; ++i) {
-        if (i + kSlotsAhead < n) buffer_.prefetch_triangle(&xyz[9 * (i + kSlotsAhead)], 0);
-        if (i + kVerticesAhead < n) buffer_.prefetch_triangle(&xyz[9 * (i + kVerticesAhead)], 1);
-        read_triangle(&xyz[9 * i], out);
+        if (i + kSlotsAhead < n) {
+            size_t* slots = ring[(i + kSlotsAhead) % kRing];
+            buffer_.weld_slots(&xyz[9 * (i + kSlotsAhead)], slots);
+            buffer_.prefetch_triangle(slots, 0);
+        }
+        if (i + kVerticesAhead < n) buffer_.prefetch_triangle(ring[(i + kVerticesAhead) % kRing], 1);
+        read_triangle(&xyz[9 * i], ring[i % kRing], out);
     }
 }
 
-void StreamDecimator::read_triangle(const float tri[9], const Emit& out) {
+void StreamDecimator::read_triangle(const float tri[9], const size_t slots[3], const Emit& out) {
     if (buffer_.full() || buffer_.free_vertex_count() < 3) make_room(out);
     if (options_.sorted_axis) track_sweep(tri);
-    const HalfEdgeBuffer::Added added = buffer_.add_triangle(tri);
+    const HalfEdgeBuffer::Added added = buffer_.add_triangle(tri, slots);
     ++stats_.triangles_in;
     if (added.face == kNoIndex) {
         pass_through(buffer_, added.vertex, next_id_, output_, out);

@@ -76,7 +76,7 @@ public:
     double ratio() const { return ratio_; }
 
 private:
-    void read_triangle(const float tri[9], const Emit& out);
+    void read_triangle(const float tri[9], const size_t slots[3], const Emit& out);
     void make_room(const Emit& out);
     void write_one(const Emit& out, bool allow_forced);
     void sweep();
