@@ -40,7 +40,7 @@ bool boundary_eligible(const HalfEdgeBuffer& buffer, uint32_t h) {
 bool moves_keep_faces_valid(const HalfEdgeBuffer& buffer, uint32_t v, const double from[3],
                             const double to[3], uint32_t skip0, uint32_t skip1) {
     for (uint32_t c = buffer.vertex(v).first_corner; c != kNoIndex; c = buffer.next_corner(c)) {
-        const uint32_t f = c / 3;
+        const uint32_t f = face_of(c);
         if (f == skip0 || f == skip1) continue;
         double a[3], b[3];
         buffer.position(buffer.corner_vertex(next_in_face(c)), a);
@@ -145,7 +145,7 @@ bool collapse_valid(HalfEdgeBuffer& buffer, uint32_t h) {
     double from[3], to[3];
     buffer.position(p, from);
     buffer.position(q, to);
-    return moves_keep_faces_valid(buffer, p, from, to, h / 3, boundary ? kNoIndex : t / 3);
+    return moves_keep_faces_valid(buffer, p, from, to, face_of(h), boundary ? kNoIndex : face_of(t));
 }
 
 void apply_collapse(HalfEdgeBuffer& buffer, uint32_t h) {
@@ -185,9 +185,9 @@ void apply_collapse(HalfEdgeBuffer& buffer, uint32_t h) {
         u2 = buffer.twin(t2);
         drop_open(t1);
         drop_open(t2);
-        buffer.detach_face(t / 3);
+        buffer.detach_face(face_of(t));
     }
-    buffer.detach_face(h / 3);
+    buffer.detach_face(face_of(h));
     join(o1, o2);
     if (!boundary) join(u1, u2);
 
@@ -233,7 +233,7 @@ bool decimate_once(HalfEdgeBuffer& buffer, Rng& rng, int candidates) {
         for (int b = 0; b < batch; ++b) {
             const uint64_t bits = draw[b];
             const uint32_t f = live.at(static_cast<size_t>(((bits >> 32) * size) >> 32));
-            half_edges[b] = 3 * f + static_cast<uint32_t>((bits & 0xffff) % 3);
+            half_edges[b] = half_edge(f, static_cast<uint32_t>((bits & 0xffff) % 3));
             buffer.prefetch_face(f);
         }
         for (int b = 0; b < batch; ++b) {
@@ -274,7 +274,7 @@ bool collapse_one_boundary_edge(HalfEdgeBuffer& buffer) {
     const FaceSet& live = buffer.live_faces();
     for (size_t i = 0; i < live.size(); ++i) {
         for (uint32_t k = 0; k < 3; ++k) {
-            const uint32_t h = 3 * live.at(i) + k;
+            const uint32_t h = half_edge(live.at(i), k);
             if (!boundary_eligible(buffer, h)) continue;
             Candidate c{h, collapse_error(buffer, h)};
             if (found == kKeep && c.error >= best[kKeep - 1].error) continue;

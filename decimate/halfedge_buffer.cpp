@@ -68,7 +68,8 @@ HalfEdgeBuffer::HalfEdgeBuffer(size_t triangle_capacity, double weld_eps)
       frontier_(triangle_capacity, faces_.get(), 2),
       slots_(raw_array<VertexSlot>(vertex_capacity_)),
       free_vertices_(raw_array<uint32_t>(vertex_capacity_)) {
-    assert(triangle_capacity >= 4 && triangle_capacity < (size_t{1} << 30));
+    // Half-edge indices 4·f + k must stay below the twin markers.
+    assert(triangle_capacity >= 4 && triangle_capacity <= (size_t{1} << 30) - 1);
     const size_t slots = pow2_at_least(2 * vertex_capacity_);
     hash_ = raw_array<uint32_t>(slots);
     std::fill_n(hash_.get(), slots, kNoIndex);
@@ -274,8 +275,8 @@ HalfEdgeBuffer::Added HalfEdgeBuffer::add_triangle(const float tri[9], const siz
         const uint32_t to_next = v[k == 2 ? 0 : k + 1], to_prev = v[k == 0 ? 2 : k - 1];
         const uint32_t k_prev = k == 0 ? 2 : k - 1;
         for (uint32_t c = slots_[v[k]].vertex.first_corner; c != kNoIndex;) {
-            const Face& face = faces_[c / 3];
-            const uint32_t j = c % 3;
+            const Face& face = faces_[face_of(c)];
+            const uint32_t j = corner_of(c);
             const uint32_t w = face.vertex[j == 2 ? 0 : j + 1];
             if (w == to_next && same[k] == kNoIndex) same[k] = c;               // v[k]→v[k+1]
             if (w == to_prev && opposite[k_prev] == kNoIndex) opposite[k_prev] = c;  // v[k]→v[k−1]
@@ -283,7 +284,7 @@ HalfEdgeBuffer::Added HalfEdgeBuffer::add_triangle(const float tri[9], const siz
         }
     }
     for (uint32_t k = 0; k < 3; ++k) {
-        const uint32_t a = v[k], b = v[(k + 1) % 3], h = 3 * f + k;
+        const uint32_t a = v[k], b = v[(k + 1) % 3], h = half_edge(f, k);
         faces_[f].vertex[k] = a;
         if (same[k] == kNoIndex && opposite[k] != kNoIndex && twin(opposite[k]) == kOpenEdge) {
             faces_[f].twin[k] = opposite[k];
@@ -309,7 +310,7 @@ HalfEdgeBuffer::Added HalfEdgeBuffer::add_triangle(const float tri[9], const siz
     }
     bool out = false;
     for (uint32_t k = 0; k < 3; ++k) {
-        link_corner(v[k], 3 * f + k);
+        link_corner(v[k], half_edge(f, k));
         out |= (slots_[v[k]].vertex.flags & kFrozen) != 0;
     }
     // Every corner was found through (or entered into) the hash table, so all three are on
@@ -330,7 +331,7 @@ void HalfEdgeBuffer::finalize_vertex(uint32_t v) {
     hash_erase(v);
     x.flags &= ~kInHash;
     for (uint32_t c = x.first_corner; c != kNoIndex; c = next_corner(c)) {
-        const uint32_t f = c / 3;
+        const uint32_t f = face_of(c);
         --faces_[f].pin_count;
         update_face_sets(f);
     }
@@ -343,7 +344,7 @@ void HalfEdgeBuffer::freeze(uint32_t v, uint64_t id) {
     x.flags |= kFrozen;
     x.id = id;
     for (uint32_t c = x.first_corner; c != kNoIndex; c = next_corner(c)) {
-        const uint32_t f = c / 3;
+        const uint32_t f = face_of(c);
         if (!faces_[f].touches_out) {
             faces_[f].touches_out = 1;
             update_face_sets(f);
@@ -353,26 +354,26 @@ void HalfEdgeBuffer::freeze(uint32_t v, uint64_t id) {
 
 void HalfEdgeBuffer::link_corner(uint32_t v, uint32_t c) {
     Vertex& x = slots_[v].vertex;
-    Face& face = faces_[c / 3];
-    face.next[c % 3] = x.first_corner;
-    face.prev[c % 3] = kNoIndex;
-    if (x.first_corner != kNoIndex) faces_[x.first_corner / 3].prev[x.first_corner % 3] = c;
+    Face& face = faces_[face_of(c)];
+    face.next[corner_of(c)] = x.first_corner;
+    face.prev[corner_of(c)] = kNoIndex;
+    if (x.first_corner != kNoIndex) faces_[face_of(x.first_corner)].prev[corner_of(x.first_corner)] = c;
     x.first_corner = c;
     ++x.face_count;
 }
 
 void HalfEdgeBuffer::unlink_corner(uint32_t v, uint32_t c) {
     Vertex& x = slots_[v].vertex;
-    const Face& face = faces_[c / 3];
-    const uint32_t next = face.next[c % 3], prev = face.prev[c % 3];
+    const Face& face = faces_[face_of(c)];
+    const uint32_t next = face.next[corner_of(c)], prev = face.prev[corner_of(c)];
     if (prev == kNoIndex) x.first_corner = next;
-    else faces_[prev / 3].next[prev % 3] = next;
-    if (next != kNoIndex) faces_[next / 3].prev[next % 3] = prev;
+    else faces_[face_of(prev)].next[corner_of(prev)] = next;
+    if (next != kNoIndex) faces_[face_of(next)].prev[corner_of(next)] = prev;
     --x.face_count;
 }
 
 void HalfEdgeBuffer::detach_face(uint32_t f) {
-    for (uint32_t k = 0; k < 3; ++k) unlink_corner(faces_[f].vertex[k], 3 * f + k);
+    for (uint32_t k = 0; k < 3; ++k) unlink_corner(faces_[f].vertex[k], half_edge(f, k));
     live_.erase(f);
     interior_.erase(f);
     frontier_.erase(f);
@@ -385,9 +386,9 @@ void HalfEdgeBuffer::move_corners(uint32_t p, uint32_t q) {
     uint32_t c = from.first_corner;
     while (c != kNoIndex) {
         const uint32_t next = next_corner(c);
-        faces_[c / 3].vertex[c % 3] = q;
+        faces_[face_of(c)].vertex[corner_of(c)] = q;
         link_corner(q, c);  // at the head of q's list, in p's order reversed (as before)
-        const uint32_t f = c / 3;
+        const uint32_t f = face_of(c);
         if (q_frozen && !faces_[f].touches_out) {
             faces_[f].touches_out = 1;
             update_face_sets(f);

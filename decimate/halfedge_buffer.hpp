@@ -1,6 +1,7 @@
 // The in-core portion of the mesh (Wu & Kobbelt 2003, §4 and §4.2): a half-edge mesh over
 // fixed-capacity pools, allocated once for `--buffer N` triangles and reused for the whole
-// stream. Half-edge h = 3·f + k runs from corner k of face f to corner (k+1) mod 3; its twin
+// stream. Half-edge h = 4·f + k (k < 3; a power-of-two stride, so no division by 3 on every
+// access) runs from corner k of face f to corner (k+1) mod 3; its twin
 // is the opposite half-edge of the neighbouring face or one of three markers:
 //   kOpenEdge        no partner yet: the edge lies on P_in (towards unread input) or on a hole,
 //   kWrittenEdge     the partner was written (the edge lies on P_out),
@@ -46,8 +47,12 @@ inline constexpr uint32_t kWrittenEdge = 0xFFFFFFFEu;
 inline constexpr uint32_t kNonManifoldEdge = 0xFFFFFFFDu;
 // True when `twin` names a real half-edge rather than one of the markers.
 inline bool is_half_edge(uint32_t twin) { return twin < kNonManifoldEdge; }
-inline uint32_t next_in_face(uint32_t h) { return h % 3 == 2 ? h - 2 : h + 1; }
-inline uint32_t prev_in_face(uint32_t h) { return h % 3 == 0 ? h + 2 : h - 1; }
+// Half-edge / corner k (0..2) of face f, and back.
+inline uint32_t half_edge(uint32_t f, uint32_t k) { return 4 * f + k; }
+inline uint32_t face_of(uint32_t h) { return h >> 2; }
+inline uint32_t corner_of(uint32_t h) { return h & 3; }
+inline uint32_t next_in_face(uint32_t h) { return (h & 3) == 2 ? h - 2 : h + 1; }
+inline uint32_t prev_in_face(uint32_t h) { return (h & 3) == 0 ? h + 2 : h - 1; }
 
 // Vertex flags.
 inline constexpr uint8_t kInHash = 1;        // open towards unread input: on P_in
@@ -83,7 +88,7 @@ template <class T> RawArray<T> raw_array(size_t n) {
     return RawArray<T>(static_cast<T*>(allocate_pool(n * sizeof(T))));
 }
 
-// Everything about one face, in one cache line. Corner k of face f is corner 3·f + k, which is
+// Everything about one face, in one cache line. Corner k of face f is corner 4·f + k, which is
 // also the half-edge from corner k to corner (k+1) mod 3.
 struct alignas(64) Face {
     uint32_t vertex[3];     // corner → vertex
@@ -178,8 +183,8 @@ public:
     void finalize_all();
 
     // Accessors.
-    uint32_t corner_vertex(uint32_t h) const { return faces_[h / 3].vertex[h % 3]; }
-    uint32_t twin(uint32_t h) const { return faces_[h / 3].twin[h % 3]; }
+    uint32_t corner_vertex(uint32_t h) const { return faces_[face_of(h)].vertex[corner_of(h)]; }
+    uint32_t twin(uint32_t h) const { return faces_[face_of(h)].twin[corner_of(h)]; }
     // Cache prefetch hints for batched random sampling (no effect on results).
     void prefetch_face(uint32_t f) const { __builtin_prefetch(&faces_[f]); }
     void prefetch_vertex(uint32_t v) const {
@@ -199,8 +204,8 @@ public:
             }
         }
     }
-    void set_twin(uint32_t h, uint32_t t) { faces_[h / 3].twin[h % 3] = t; }
-    uint32_t next_corner(uint32_t c) const { return faces_[c / 3].next[c % 3]; }
+    void set_twin(uint32_t h, uint32_t t) { faces_[face_of(h)].twin[corner_of(h)] = t; }
+    uint32_t next_corner(uint32_t c) const { return faces_[face_of(c)].next[corner_of(c)]; }
     Vertex& vertex(uint32_t v) { return slots_[v].vertex; }
     const Vertex& vertex(uint32_t v) const { return slots_[v].vertex; }
     Quadric& quadric(uint32_t v) { return slots_[v].quadric; }

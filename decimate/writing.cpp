@@ -39,7 +39,7 @@ uint32_t pick_write(const HalfEdgeBuffer& buffer, Rng& rng, int candidates) {
         Quadric q;
         double centre[3] = {0, 0, 0};
         for (int k = 0; k < 3; ++k) {
-            const uint32_t v = buffer.corner_vertex(3 * f + k);
+            const uint32_t v = buffer.corner_vertex(half_edge(f, k));
             q += buffer.quadric(v);
             double x[3];
             buffer.position(v, x);
@@ -106,7 +106,7 @@ int write_face(HalfEdgeBuffer& buffer, uint32_t f, uint64_t& next_id, TriangleOu
     uint32_t v[3];
     int moved = 0;
     for (int k = 0; k < 3; ++k) {
-        v[k] = buffer.corner_vertex(3 * f + k);
+        v[k] = buffer.corner_vertex(half_edge(f, k));
         if ((buffer.vertex(v[k]).flags & kFrozen) == 0) {
             moved += place_vertex(buffer, v[k]) ? 1 : 0;
             buffer.freeze(v[k], next_id++);
@@ -119,7 +119,7 @@ int write_face(HalfEdgeBuffer& buffer, uint32_t f, uint64_t& next_id, TriangleOu
     }
     output.emit(xyz, ids, out);
     for (int k = 0; k < 3; ++k) {
-        const uint32_t h = 3 * f + k;
+        const uint32_t h = half_edge(f, k);
         const uint32_t t = buffer.twin(h);
         if (is_half_edge(t)) {
             buffer.set_twin(t, kWrittenEdge);  // the neighbour now borders P_out

@@ -52,7 +52,7 @@ TEST(Collapse, OctahedronCollapseRemovesTwoFacesAndStaysClosed) {
     EXPECT_TRUE(buffer_consistent(buffer));
     const FaceSet& live = buffer.live_faces();
     for (size_t i = 0; i < live.size(); ++i)
-        for (uint32_t k = 0; k < 3; ++k) EXPECT_TRUE(is_half_edge(buffer.twin(3 * live.at(i) + k)));
+        for (uint32_t k = 0; k < 3; ++k) EXPECT_TRUE(is_half_edge(buffer.twin(half_edge(live.at(i), k))));
     EXPECT_EQ(buffer.vertex(east).face_count, 4u);  // 4 - 2 removed + 2 inherited from top
 }
 
@@ -65,7 +65,7 @@ TEST(Collapse, LinkConditionRefusesPinches) {
     const FaceSet& live = buffer.live_faces();
     std::vector<uint32_t> half_edges;
     for (size_t i = 0; i < live.size(); ++i)
-        for (uint32_t k = 0; k < 3; ++k) half_edges.push_back(3 * live.at(i) + k);
+        for (uint32_t k = 0; k < 3; ++k) half_edges.push_back(half_edge(live.at(i), k));
     for (uint32_t h : half_edges) {
         const uint32_t p = buffer.corner_vertex(h), q = buffer.corner_vertex(next_in_face(h));
         const std::set<uint32_t> np = neighbours(buffer, p), nq = neighbours(buffer, q);
@@ -85,7 +85,7 @@ TEST(Collapse, TetrahedronNeverCollapses) {
     add_indexed(buffer, {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}}, {{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {0, 3, 2}});
     const FaceSet& live = buffer.live_faces();
     for (size_t i = 0; i < live.size(); ++i)
-        for (uint32_t k = 0; k < 3; ++k) EXPECT_FALSE(collapse_valid(buffer, 3 * live.at(i) + k));
+        for (uint32_t k = 0; k < 3; ++k) EXPECT_FALSE(collapse_valid(buffer, half_edge(live.at(i), k)));
 }
 
 TEST(Collapse, BoundaryRulesForPinAndPout) {

@@ -59,7 +59,7 @@ TEST(HalfEdgeBuffer, ThirdFaceOnAnEdgeIsFrozenAsNonManifold) {
     const uint32_t a = vertex_at(buffer, {0, 0, 0}), b = vertex_at(buffer, {1, 0, 0});
     EXPECT_TRUE(buffer.vertex(a).flags & kNonManifold);
     EXPECT_TRUE(buffer.vertex(b).flags & kNonManifold);
-    EXPECT_EQ(buffer.twin(3 * faces[2] + 0), kNonManifoldEdge);
+    EXPECT_EQ(buffer.twin(half_edge(faces[2], 0)), kNonManifoldEdge);
     EXPECT_TRUE(buffer_consistent(buffer));
 }
 

@@ -206,7 +206,7 @@ inline uint32_t vertex_at(const HalfEdgeBuffer& buffer, const std::array<float, 
     const FaceSet& live = buffer.live_faces();
     for (size_t i = 0; i < live.size(); ++i)
         for (uint32_t k = 0; k < 3; ++k) {
-            const uint32_t v = buffer.corner_vertex(3 * live.at(i) + k);
+            const uint32_t v = buffer.corner_vertex(decimate::half_edge(live.at(i), k));
             const float* x = buffer.vertex(v).pos;
             if (x[0] == p[0] && x[1] == p[1] && x[2] == p[2]) return v;
         }
@@ -225,7 +225,7 @@ inline bool buffer_consistent(const HalfEdgeBuffer& buffer) {
     const FaceSet& live = buffer.live_faces();
     for (size_t i = 0; i < live.size(); ++i)
         for (uint32_t k = 0; k < 3; ++k) {
-            const uint32_t h = 3 * live.at(i) + k;
+            const uint32_t h = decimate::half_edge(live.at(i), k);
             const uint32_t t = buffer.twin(h);
             if (!is_half_edge(t)) continue;
             if (buffer.twin(t) != h) return false;

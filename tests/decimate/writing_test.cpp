@@ -29,7 +29,7 @@ TEST(Writing, WriteFreezesVerticesAndOpensPout) {
     int written_edges = 0;
     const FaceSet& live = buffer.live_faces();
     for (size_t i = 0; i < live.size(); ++i)
-        for (uint32_t k = 0; k < 3; ++k) written_edges += buffer.twin(3 * live.at(i) + k) == kWrittenEdge;
+        for (uint32_t k = 0; k < 3; ++k) written_edges += buffer.twin(half_edge(live.at(i), k)) == kWrittenEdge;
     EXPECT_EQ(written_edges, 3);
     // The next write reuses the frozen ids of shared vertices.
     Rng rng(1);
