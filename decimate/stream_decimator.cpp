@@ -47,6 +47,8 @@ uint64_t StreamDecimator::expected_output(double ratio, uint64_t input_triangle_
 
 void StreamDecimator::push(const io::TriangleChunk& in, const Emit& out) {
     assert(!finished_);
+    assert(std::all_of(in.xyz().begin(), in.xyz().end(), [](float v) { return std::isfinite(v); }) &&
+           "StreamDecimator::push needs finite coordinates");
     const std::span<const float> xyz = in.xyz();
     // Welding reads a random hash slot and then a random vertex per corner; prefetching them
     // a few triangles ahead overlaps those misses (hints only: results do not change). Each
