@@ -75,8 +75,10 @@ void run_decimate(const DecimateOptions& opt) {
     decimate::StreamDecimator decimator(options, header.triangle_count);
 
     io::WriteOptions wo = opt.write.options(opt.read);
-    if (options.target) wo.triangle_count = options.target;
-    else if (header.triangle_count) wo.triangle_count = decimate::StreamDecimator::expected_output(options.ratio, *header.triangle_count);
+    // No output count is promised to the writer: the decimator lands on round(p·N_in) except
+    // when the in-core rest is closed and the target odd (collapses remove two faces; it
+    // then ends one over, with a warning), and skipped input triangles change N_in. Writers
+    // patch their header counts at finish() (or spool when the output cannot seek).
     io::Output out = io::open_output(opt.output, opt.write.to, wo, opt.write.gzip_level);
 
     const decimate::Emit emit = [&out](const io::TriangleChunk& chunk) { out.write(chunk); };
