@@ -145,6 +145,20 @@ void HalfEdgeBuffer::free_vertex(uint32_t v) {
 }
 
 uint32_t HalfEdgeBuffer::weld(const float p[3], size_t slot) {
+    if (weld_eps_ == 0) {
+        // Exact welding: vertices in the table keep the position they were entered with,
+        // stored with −0 made +0, so comparing raw bits against the normalized key is
+        // same_key() without re-normalizing every probed vertex.
+        const uint32_t key[3] = {float_key(p[0]), float_key(p[1]), float_key(p[2])};
+        for (;;) {
+            const uint32_t v = hash_[slot];
+            if (v == kNoIndex) break;
+            uint32_t stored[3];
+            std::memcpy(stored, slots_[v].vertex.pos, sizeof stored);
+            if (stored[0] == key[0] && stored[1] == key[1] && stored[2] == key[2]) return v;
+            slot = (slot + 1) & hash_mask_;
+        }
+    }
     for (;;) {
         const uint32_t v = hash_[slot];
         if (v == kNoIndex) break;
