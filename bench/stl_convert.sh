@@ -3,7 +3,7 @@
 # binary STL against `cat FILE > OUT` (the STL issue's target: at most 3x cat, aim 1.5x; peak
 # RSS under 64 MB), then ASCII -> binary and binary -> ASCII on a 1-million-triangle file.
 # The input is fixtures/bunny_from_draco.bin.stl's body repeated (real floats, no generator).
-# Each timing is the best of 3 runs; use a quiet machine, the outputs go to the work dir.
+# Each timing is the median of $RUNS (default 5) runs; use a quiet machine, the outputs go to the work dir.
 #
 # Usage: bench/stl_convert.sh [path/to/meshstream] [work dir (default: $TMPDIR or /tmp)]
 set -euo pipefail
@@ -27,22 +27,21 @@ make_stl() {
     rm "$work/body"
 }
 
-# best_of3 LABEL CMD...: prints "seconds peak_kb" of the fastest of 3 runs.
-best_of3() {
-    local best="" line
-    for _ in 1 2 3; do
+# median_of RUNS CMD...: prints "seconds peak_kb" of the median run (by time) of $RUNS runs
+# (default 5), interleaved by the caller with the reference so both see the same machine.
+median_of() {
+    local i
+    for i in $(seq "${RUNS:-5}"); do
         rm -f "$work"/out.*
         /usr/bin/time -f "%e %M" -o "$work/time" "$@" > /dev/null
-        line=$(tail -1 "$work/time")
-        if [ -z "$best" ] || awk -v a="${line% *}" -v b="${best% *}" 'BEGIN { exit !(a < b) }'; then best=$line; fi
-    done
-    echo "$best"
+        tail -1 "$work/time"
+    done | sort -n | awk '{ a[NR] = $0 } END { print a[int((NR + 1) / 2)] }'
 }
 
 make_stl 144 "$work/big.stl"  # 10,000,944 triangles, 500 MB
 cat "$work/big.stl" > /dev/null  # warm the page cache
-cat_run=$(best_of3 sh -c "cat '$work/big.stl' > '$work/out.cat'")
-bin_run=$(best_of3 "$meshstream" -q convert "$work/big.stl" "$work/out.stl")
+cat_run=$(median_of sh -c "cat '$work/big.stl' > '$work/out.cat'")
+bin_run=$(median_of "$meshstream" -q convert "$work/big.stl" "$work/out.stl")
 awk -v c="$cat_run" -v m="$bin_run" 'BEGIN {
     split(c, a, " "); split(m, b, " ");
     printf "binary->binary 10M triangles: cat %.2f s, meshstream %.2f s (%.2fx cat), peak RSS %.1f MB\n",
@@ -51,7 +50,7 @@ rm -f "$work/big.stl" "$work"/out.*
 
 make_stl 14 "$work/mid.stl"  # 972,314 triangles
 "$meshstream" -q convert "$work/mid.stl" "$work/mid.ascii.stl" --to stl-ascii
-to_ascii=$(best_of3 "$meshstream" -q convert "$work/mid.stl" "$work/out.ascii.stl" --to stl-ascii)
-from_ascii=$(best_of3 "$meshstream" -q convert "$work/mid.ascii.stl" "$work/out.stl")
+to_ascii=$(median_of "$meshstream" -q convert "$work/mid.stl" "$work/out.ascii.stl" --to stl-ascii)
+from_ascii=$(median_of "$meshstream" -q convert "$work/mid.ascii.stl" "$work/out.stl")
 echo "binary->ascii 972k triangles: ${to_ascii% *} s, peak RSS $(( ${to_ascii#* } / 1024 )) MB"
 echo "ascii->binary 972k triangles ($(( $(stat -c %s "$work/mid.ascii.stl") >> 20 )) MB of text): ${from_ascii% *} s, peak RSS $(( ${from_ascii#* } / 1024 )) MB"
