@@ -28,7 +28,7 @@ make_stl() {
 }
 
 # median_of RUNS CMD...: prints "seconds peak_kb" of the median run (by time) of $RUNS runs
-# (default 5), interleaved by the caller with the reference so both see the same machine.
+# (default 5); the cat reference runs in the same invocation, just before.
 median_of() {
     local i
     for i in $(seq "${RUNS:-5}"); do
