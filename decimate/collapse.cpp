@@ -60,7 +60,50 @@ bool moves_keep_faces_valid(const HalfEdgeBuffer& buffer, uint32_t v, const doub
     return true;
 }
 
+CollapsePlacement collapse_placement(const HalfEdgeBuffer& buffer, uint32_t h) {
+    const uint32_t p = buffer.corner_vertex(h), q = buffer.corner_vertex(next_in_face(h));
+    const Quadric sum = buffer.quadric(p) + buffer.quadric(q);
+    CollapsePlacement out;
+    buffer.position(q, out.target);
+    out.error = sum.error(out.target);
+    out.moves_target = false;
+    if (!collapse_target_free(buffer, h)) return out;
+    double x[3];
+    if (sum.minimum(x)) {
+        buffer.round_position(x);
+        const double e = sum.error(x);
+        // Round-off can put the rounded optimum a hair above an end point: keep the smaller.
+        if (e < out.error) {
+            for (int i = 0; i < 3; ++i) out.target[i] = x[i];
+            out.error = e;
+            out.moves_target = true;
+        }
+        return out;
+    }
+    // Singular (flat or cylindrical neighbourhood): the best of p, q and the midpoint, as
+    // Garland & Heckbert.
+    double a[3], mid[3];
+    buffer.position(p, a);
+    for (int i = 0; i < 3; ++i) mid[i] = 0.5 * (a[i] + out.target[i]);
+    buffer.round_position(mid);
+    for (const double* y : {static_cast<const double*>(a), static_cast<const double*>(mid)}) {
+        const double e = sum.error(y);
+        if (e < out.error) {
+            for (int i = 0; i < 3; ++i) out.target[i] = y[i];
+            out.error = e;
+            out.moves_target = true;
+        }
+    }
+    return out;
+}
+
 bool collapse_valid(HalfEdgeBuffer& buffer, uint32_t h) {
+    double to[3];
+    buffer.position(buffer.corner_vertex(next_in_face(h)), to);
+    return collapse_valid(buffer, h, to);
+}
+
+bool collapse_valid(HalfEdgeBuffer& buffer, uint32_t h, const double target[3]) {
     const uint32_t p = buffer.corner_vertex(h), q = buffer.corner_vertex(next_in_face(h));
     const uint32_t t = buffer.twin(h);
     const bool boundary = !is_half_edge(t);
@@ -142,10 +185,13 @@ bool collapse_valid(HalfEdgeBuffer& buffer, uint32_t h) {
         }
     }
 
-    double from[3], to[3];
-    buffer.position(p, from);
-    buffer.position(q, to);
-    return moves_keep_faces_valid(buffer, p, from, to, face_of(h), boundary ? kNoIndex : face_of(t));
+    double from_p[3], from_q[3];
+    buffer.position(p, from_p);
+    buffer.position(q, from_q);
+    const uint32_t skip1 = boundary ? kNoIndex : face_of(t);
+    if (!moves_keep_faces_valid(buffer, p, from_p, target, face_of(h), skip1)) return false;
+    if (from_q[0] == target[0] && from_q[1] == target[1] && from_q[2] == target[2]) return true;
+    return moves_keep_faces_valid(buffer, q, from_q, target, face_of(h), skip1);
 }
 
 void apply_collapse(HalfEdgeBuffer& buffer, uint32_t h) {
@@ -206,10 +252,17 @@ void apply_collapse(HalfEdgeBuffer& buffer, uint32_t h) {
     }
 }
 
+void apply_collapse(HalfEdgeBuffer& buffer, uint32_t h, const double target[3]) {
+    const uint32_t q = buffer.corner_vertex(next_in_face(h));
+    apply_collapse(buffer, h);
+    buffer.set_position(q, target);
+}
+
 bool decimate_once(HalfEdgeBuffer& buffer, Rng& rng, int candidates) {
     struct Candidate {
         uint32_t h;
         double error;
+        double target[3];
     };
     constexpr int kMaxCandidates = 64;
     const int wanted = std::clamp(candidates, 1, kMaxCandidates);
@@ -244,7 +297,8 @@ bool decimate_once(HalfEdgeBuffer& buffer, Rng& rng, int candidates) {
             ++tries;
             const uint32_t h = half_edges[b];
             if (!collapse_eligible(buffer, h)) continue;
-            Candidate c{h, collapse_error(buffer, h)};
+            const CollapsePlacement placement = collapse_placement(buffer, h);
+            Candidate c{h, placement.error, {placement.target[0], placement.target[1], placement.target[2]}};
             int i = found++;
             while (i > 0 && best[i - 1].error > c.error) {
                 best[i] = best[i - 1];
@@ -255,8 +309,8 @@ bool decimate_once(HalfEdgeBuffer& buffer, Rng& rng, int candidates) {
     }
     for (int i = 0; i < found; ++i) {
         if (i > 0 && best[i].h == best[i - 1].h) continue;
-        if (collapse_valid(buffer, best[i].h)) {
-            apply_collapse(buffer, best[i].h);
+        if (collapse_valid(buffer, best[i].h, best[i].target)) {
+            apply_collapse(buffer, best[i].h, best[i].target);
             return true;
         }
     }

@@ -4,6 +4,9 @@
 // of §4: half-edges from a boundary vertex (P_in, P_out, holes, non-manifold) never collapse;
 // half-edges into a P_in vertex never collapse (its quadric is incomplete); half-edges into a
 // P_out vertex may (q keeps its frozen position, so P_out does not move).
+// Beyond the paper: when q is free to move (not on P_in, P_out, a hole or a non-manifold
+// edge), the collapse is rated at, and q moved to, the minimum of Q_p + Q_q (Garland &
+// Heckbert's optimal placement); a constrained q keeps the half-edge collapse.
 #pragma once
 
 #include "decimate/halfedge_buffer.hpp"
@@ -16,10 +19,17 @@ namespace meshstream::decimate {
 // Topological eligibility of half-edge h = p→q from flags alone (cheap, used for sampling):
 // p interior (closed fan, not on P_in/P_out, manifold), q manifold and not on P_in.
 // (Inline: it runs for every random draw.)
+// Beyond the paper: a true-boundary p (a hole, off P_in and P_out, one open fan) may also
+// collapse along its outgoing boundary edge (twin kOpenEdge), as in Garland & Heckbert; its
+// quadric holds the boundary planes added when it left P_in, which keep the hole's outline.
 inline bool collapse_eligible(const HalfEdgeBuffer& buffer, uint32_t h) {
     const Vertex& p = buffer.vertex(buffer.corner_vertex(h));
-    if ((p.flags & (kInHash | kFrozen | kNonManifold)) != 0 || p.open_edges != 0) return false;
-    if (!is_half_edge(buffer.twin(h))) return false;
+    if ((p.flags & (kInHash | kFrozen | kNonManifold)) != 0) return false;
+    if (p.open_edges == 0) {
+        if (!is_half_edge(buffer.twin(h))) return false;
+    } else if (p.open_edges != 2 || buffer.twin(h) != kOpenEdge) {
+        return false;
+    }
     const Vertex& q = buffer.vertex(buffer.corner_vertex(next_in_face(h)));
     return (q.flags & (kInHash | kNonManifold)) == 0;
 }
@@ -32,16 +42,41 @@ inline double collapse_error(const HalfEdgeBuffer& buffer, uint32_t h) {
     return (buffer.quadric(p) + buffer.quadric(q)).error(x);
 }
 
+// True when the target q of an eligible h = p→q may move (beyond the paper, as Garland &
+// Heckbert's full edge collapse): q is not on P_in (its quadric is incomplete), not written
+// (P_out keeps its position), not on a hole or an open edge, and manifold.
+inline bool collapse_target_free(const HalfEdgeBuffer& buffer, uint32_t h) {
+    const Vertex& q = buffer.vertex(buffer.corner_vertex(next_in_face(h)));
+    return (q.flags & (kInHash | kFrozen | kNonManifold)) == 0 && q.open_edges == 0;
+}
+
+// Where an eligible collapse h = p→q puts the merged vertex, and its error. When q is free
+// (collapse_target_free): the minimum of Q_p + Q_q (rounded to stored float coordinates), or,
+// when that is singular, the best of p, q and their midpoint; otherwise q itself (the
+// half-edge collapse of §4.3). `target` is relative to the buffer's origin.
+struct CollapsePlacement {
+    double target[3];
+    double error;
+    bool moves_target;  // target differs from q's position
+};
+CollapsePlacement collapse_placement(const HalfEdgeBuffer& buffer, uint32_t h);
+
 // Full validity of an eligible collapse p→q: p's fan is a single closed (or, for a boundary
 // half-edge, a single open) fan; the link condition holds (the common neighbours of p and q
 // are exactly the vertices opposite the edge), no tetrahedron collapses; no remaining face
 // around p flips or folds (normal turns by more than ~84°) or becomes degenerate.
 bool collapse_valid(HalfEdgeBuffer& buffer, uint32_t h);
+// The same for merging p and q at `target` (relative coordinates): the remaining faces of
+// both p and q are checked against the new position.
+bool collapse_valid(HalfEdgeBuffer& buffer, uint32_t h, const double target[3]);
 
 // Performs the half-edge collapse p→q: removes the one or two faces on the edge, re-links
 // their outer neighbours, moves p's corners to q and adds Q_p to Q_q, frees p.
 // Precondition: collapse_valid(buffer, h).
 void apply_collapse(HalfEdgeBuffer& buffer, uint32_t h);
+// The same, then moves q to `target`. Precondition: collapse_valid(buffer, h, target) and q
+// free (collapse_target_free) unless target is q's position.
+void apply_collapse(HalfEdgeBuffer& buffer, uint32_t h, const double target[3]);
 
 // True when moving vertex v from `from` to `to` (relative coordinates) flips, folds or
 // degenerates none of its faces other than `skip0`/`skip1` (kNoIndex: none). Faces that were
@@ -50,7 +85,8 @@ bool moves_keep_faces_valid(const HalfEdgeBuffer& buffer, uint32_t v, const doub
                             const double to[3], uint32_t skip0, uint32_t skip1);
 
 // DECIMATE(1) of §4.3: draws up to `candidates` eligible half-edges (at most 8·candidates
-// random draws), collapses the valid one with the smallest error. Returns false when no
+// random draws), collapses the valid one with the smallest error, each rated and placed by
+// collapse_placement(). Returns false when no
 // candidate was found or none was valid (the caller decides whether that means "stalled").
 bool decimate_once(HalfEdgeBuffer& buffer, Rng& rng, int candidates);
 

@@ -342,6 +342,25 @@ HalfEdgeBuffer::Added HalfEdgeBuffer::add_triangle(const float tri[9], const siz
 void HalfEdgeBuffer::finalize_vertex(uint32_t v) {
     Vertex& x = slots_[v].vertex;
     if ((x.flags & kInHash) == 0) return;
+    // Its open edges are final now (no input reaches v any more): a true boundary. Add Garland
+    // & Heckbert's perpendicular boundary planes to both ends, once per edge: when the other
+    // end is still on P_in (it skips the edge when finalized later, v being off P_in then).
+    for (uint32_t c = x.first_corner; c != kNoIndex; c = next_corner(c)) {
+        const uint32_t e[2] = {c, prev_in_face(c)};  // v→next and prev→v
+        for (uint32_t h : e) {
+            if (twin(h) != kOpenEdge) continue;
+            const uint32_t a = corner_vertex(h), b = corner_vertex(next_in_face(h));
+            const uint32_t other = a == v ? b : a;
+            if (other == v || (slots_[other].vertex.flags & kInHash) == 0) continue;
+            double pa[3], pb[3], pc[3];
+            position(a, pa);
+            position(b, pb);
+            position(corner_vertex(prev_in_face(h)), pc);
+            const Quadric penalty = Quadric::from_boundary_edge(pa, pb, pc);
+            slots_[a].quadric += penalty;
+            slots_[b].quadric += penalty;
+        }
+    }
     hash_erase(v);
     x.flags &= ~kInHash;
     for (uint32_t c = x.first_corner; c != kNoIndex; c = next_corner(c)) {

@@ -235,6 +235,11 @@ public:
     void set_position(uint32_t v, const double rel[3]) {
         for (int i = 0; i < 3; ++i) slots_[v].vertex.pos[i] = float(rel[i] + origin_[i]);
     }
+    // Rounds a relative position to what set_position() would store (float coordinates), so
+    // that geometric checks see exactly the position a vertex will get.
+    void round_position(double rel[3]) const {
+        for (int i = 0; i < 3; ++i) rel[i] = double(float(rel[i] + origin_[i])) - origin_[i];
+    }
     const FaceSet& live_faces() const { return live_; }
     const FaceSet& interior_faces() const { return interior_; }  // no P_in vertex
     const FaceSet& frontier_faces() const { return frontier_; }  // interior and touching P_out

@@ -17,6 +17,12 @@ struct Quadric {
     // area) gives the zero quadric.
     static Quadric from_triangle(const double p0[3], const double p1[3], const double p2[3]);
 
+    // Garland & Heckbert's boundary constraint for the open edge (p0, p1) of triangle
+    // (p0, p1, p2): the plane through the edge perpendicular to the triangle, weighted by
+    // kBoundaryWeight · |p1 − p0|² (an area, like the face quadrics). Zero when degenerate.
+    static Quadric from_boundary_edge(const double p0[3], const double p1[3], const double p2[3]);
+    static constexpr double kBoundaryWeight = 1.0;
+
     Quadric& operator+=(const Quadric& o) {
         a00 += o.a00; a01 += o.a01; a02 += o.a02; a11 += o.a11; a12 += o.a12; a22 += o.a22;
         b0 += o.b0; b1 += o.b1; b2 += o.b2; c += o.c;

@@ -139,3 +139,91 @@ TEST(Collapse, DecimateOnceReducesAClosedMesh) {
     EXPECT_EQ(buffer.face_count(), 6u);
     EXPECT_TRUE(buffer_consistent(buffer));
 }
+
+TEST(Collapse, FreeInteriorCollapsePlacesTheVertexAtTheQuadricOptimum) {
+    HalfEdgeBuffer buffer(64, 0);
+    add_indexed(buffer, octahedron_points(), octahedron_faces());  // closed: every vertex free
+    const uint32_t top = vertex_at(buffer, {0, 0, 1}), east = vertex_at(buffer, {1, 0, 0});
+    const uint32_t h = half_edge(buffer, top, east);
+    ASSERT_TRUE(collapse_target_free(buffer, h));
+    const Quadric sum = buffer.quadric(top) + buffer.quadric(east);
+    double optimum[3];
+    ASSERT_TRUE(sum.minimum(optimum));
+    double at_east[3];
+    buffer.position(east, at_east);
+    const CollapsePlacement placement = collapse_placement(buffer, h);
+    ASSERT_TRUE(placement.moves_target);
+    for (int i = 0; i < 3; ++i) EXPECT_NEAR(placement.target[i], optimum[i], 1e-6);
+    // By symmetry the optimum lies on the plane y = 0 of the edge and on the plane bisecting
+    // it (positions are relative to the buffer's origin), and is strictly cheaper than keeping
+    // east where it is (the half-edge collapse).
+    double at_top[3];
+    buffer.position(top, at_top);
+    EXPECT_NEAR(optimum[1], at_top[1], 1e-9);
+    double along = 0;
+    for (int i = 0; i < 3; ++i) along += (optimum[i] - 0.5 * (at_top[i] + at_east[i])) * (at_east[i] - at_top[i]);
+    EXPECT_NEAR(along, 0, 1e-9);
+    EXPECT_LT(placement.error, sum.error(at_east) * 0.9);
+    ASSERT_TRUE(collapse_valid(buffer, h, placement.target));
+    apply_collapse(buffer, h, placement.target);
+    EXPECT_TRUE(buffer_consistent(buffer));
+    double moved[3];
+    buffer.position(east, moved);
+    for (int i = 0; i < 3; ++i) EXPECT_EQ(moved[i], placement.target[i]);
+    EXPECT_NEAR(buffer.quadric(east).error(moved), placement.error, 1e-12);
+}
+
+TEST(Collapse, ConstrainedTargetKeepsTheHalfEdgeCollapse) {
+    HalfEdgeBuffer buffer(64, 0);
+    add_grid(buffer);
+    const uint32_t inner = vertex_at(buffer, {1, 2, 0.1f});
+    const uint32_t rim = vertex_at(buffer, {0, 2, 0.4f});
+    const uint32_t centre = vertex_at(buffer, {2, 2, 0});
+    // The rim is on P_in: never a moving target (and not a target at all).
+    EXPECT_FALSE(collapse_target_free(buffer, half_edge(buffer, inner, rim)));
+    buffer.finalize_all();
+    // A hole's vertex (open edges) and a written vertex (P_out) do not move either.
+    EXPECT_FALSE(collapse_target_free(buffer, half_edge(buffer, inner, rim)));
+    const CollapsePlacement to_rim = collapse_placement(buffer, half_edge(buffer, inner, rim));
+    EXPECT_FALSE(to_rim.moves_target);
+    double at_rim[3];
+    buffer.position(rim, at_rim);
+    for (int i = 0; i < 3; ++i) EXPECT_EQ(to_rim.target[i], at_rim[i]);
+    EXPECT_TRUE(collapse_target_free(buffer, half_edge(buffer, inner, centre)));
+    buffer.freeze(centre, 0);
+    EXPECT_FALSE(collapse_target_free(buffer, half_edge(buffer, inner, centre)));
+    EXPECT_FALSE(collapse_placement(buffer, half_edge(buffer, inner, centre)).moves_target);
+}
+
+TEST(Collapse, HoleBoundaryCollapsesAlongItsEdgeAndBoundaryPlanesPriceCorners) {
+    // A flat 5×5 grid: face quadrics vanish on the plane, so every error comes from the
+    // boundary planes added when the rim left P_in.
+    HalfEdgeBuffer buffer(64, 0);
+    std::vector<std::array<float, 3>> points;
+    for (int y = 0; y < 5; ++y)
+        for (int x = 0; x < 5; ++x) points.push_back({float(x), float(y), 0});
+    std::vector<std::array<int, 3>> faces;
+    for (int y = 0; y < 4; ++y)
+        for (int x = 0; x < 4; ++x) {
+            const int a = 5 * y + x;
+            faces.push_back({a, a + 1, a + 6});
+            faces.push_back({a, a + 6, a + 5});
+        }
+    add_indexed(buffer, points, faces);
+    const uint32_t mid = vertex_at(buffer, {2, 0, 0}), right = vertex_at(buffer, {3, 0, 0});
+    const uint32_t corner = vertex_at(buffer, {0, 0, 0}), next = vertex_at(buffer, {1, 0, 0});
+    // On P_in, the rim never collapses.
+    EXPECT_FALSE(collapse_eligible(buffer, half_edge(buffer, mid, right)));
+    buffer.finalize_all();
+    // A true hole: along its outgoing boundary edge only.
+    EXPECT_TRUE(collapse_eligible(buffer, half_edge(buffer, mid, right)));
+    EXPECT_FALSE(collapse_eligible(buffer, half_edge(buffer, mid, vertex_at(buffer, {2, 1, 0}))));
+    // Along a straight stretch the outline does not change: free. At the corner it does.
+    EXPECT_NEAR(collapse_placement(buffer, half_edge(buffer, mid, right)).error, 0, 1e-12);
+    EXPECT_GT(collapse_placement(buffer, half_edge(buffer, corner, next)).error, 0.5);
+    ASSERT_TRUE(collapse_valid(buffer, half_edge(buffer, mid, right)));
+    apply_collapse(buffer, half_edge(buffer, mid, right));
+    EXPECT_TRUE(buffer_consistent(buffer));
+    EXPECT_EQ(buffer.face_count(), 31u);
+    EXPECT_EQ(buffer.vertex(right).open_edges, 2u);
+}
