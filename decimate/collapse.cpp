@@ -258,7 +258,7 @@ void apply_collapse(HalfEdgeBuffer& buffer, uint32_t h, const double target[3]) 
     buffer.set_position(q, target);
 }
 
-bool decimate_once(HalfEdgeBuffer& buffer, Rng& rng, int candidates) {
+bool decimate_once(HalfEdgeBuffer& buffer, Rng& rng, int candidates, CandidateMemory* memory) {
     struct Candidate {
         uint32_t h;
         double error;
@@ -266,18 +266,40 @@ bool decimate_once(HalfEdgeBuffer& buffer, Rng& rng, int candidates) {
     };
     constexpr int kMaxCandidates = 64;
     const int wanted = std::clamp(candidates, 1, kMaxCandidates);
-    Candidate best[kMaxCandidates];
+    Candidate best[2 * kMaxCandidates];
     int found = 0;
     const FaceSet& live = buffer.live_faces();
     const uint64_t size = live.size();
     if (size == 0) return false;
+    auto insert = [&](uint32_t h) {
+        const CollapsePlacement placement = collapse_placement(buffer, h);
+        Candidate c{h, placement.error, {placement.target[0], placement.target[1], placement.target[2]}};
+        int i = found++;
+        while (i > 0 && best[i - 1].error > c.error) {
+            best[i] = best[i - 1];
+            --i;
+        }
+        best[i] = c;
+    };
+    // Remembered runners-up whose face is still alive (a reused face slot is just another
+    // half-edge, rated afresh like a draw).
+    int remembered = 0;
+    if (memory != nullptr) {
+        for (int i = 0; i < memory->count && remembered < wanted; ++i) {
+            const uint32_t h = memory->h[i];
+            if (!live.contains(face_of(h)) || !collapse_eligible(buffer, h)) continue;
+            insert(h);
+            ++remembered;
+        }
+        memory->count = 0;
+    }
     // Draws go in batches whose memory accesses are prefetched stage by stage (set slot →
     // half-edge → vertices and quadrics), so the random reads overlap instead of queuing:
     // the buffer is far larger than the caches. Same draws, same order as one at a time.
     uint64_t draw[kMaxCandidates];
     uint32_t half_edges[kMaxCandidates];
-    for (int tries = 0; tries < 8 * wanted && found < wanted;) {
-        const int batch = std::min(wanted - found, 8 * wanted - tries);
+    for (int tries = 0; tries < 8 * wanted && found - remembered < wanted;) {
+        const int batch = std::min(wanted - (found - remembered), 8 * wanted - tries);
         for (int b = 0; b < batch; ++b) {
             const uint64_t bits = rng.next();
             draw[b] = bits;
@@ -297,20 +319,18 @@ bool decimate_once(HalfEdgeBuffer& buffer, Rng& rng, int candidates) {
             ++tries;
             const uint32_t h = half_edges[b];
             if (!collapse_eligible(buffer, h)) continue;
-            const CollapsePlacement placement = collapse_placement(buffer, h);
-            Candidate c{h, placement.error, {placement.target[0], placement.target[1], placement.target[2]}};
-            int i = found++;
-            while (i > 0 && best[i - 1].error > c.error) {
-                best[i] = best[i - 1];
-                --i;
-            }
-            best[i] = c;
+            insert(h);
         }
     }
     for (int i = 0; i < found; ++i) {
         if (i > 0 && best[i].h == best[i - 1].h) continue;
         if (collapse_valid(buffer, best[i].h, best[i].target)) {
             apply_collapse(buffer, best[i].h, best[i].target);
+            if (memory != nullptr) {
+                // The next candidates in order (not yet checked against the topology).
+                for (int j = i + 1; j < found && memory->count < CandidateMemory::kCapacity; ++j)
+                    if (best[j].h != best[j - 1].h) memory->h[memory->count++] = best[j].h;
+            }
             return true;
         }
     }

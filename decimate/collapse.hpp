@@ -88,7 +88,18 @@ bool moves_keep_faces_valid(const HalfEdgeBuffer& buffer, uint32_t v, const doub
 // random draws), collapses the valid one with the smallest error, each rated and placed by
 // collapse_placement(). Returns false when no
 // candidate was found or none was valid (the caller decides whether that means "stalled").
-bool decimate_once(HalfEdgeBuffer& buffer, Rng& rng, int candidates);
+//
+// Beyond the paper: with `memory`, the runners-up of one call (the valid-looking candidates
+// that were not collapsed) are re-rated and compete again in the next call next to the fresh
+// draws, so that cheap collapses found once are not forgotten. That brings the choice closer
+// to Garland & Heckbert's greedy order at the cost of re-rating a few half-edges; still
+// deterministic for a seed.
+struct CandidateMemory {
+    static constexpr int kCapacity = 64;
+    uint32_t h[kCapacity];
+    int count = 0;
+};
+bool decimate_once(HalfEdgeBuffer& buffer, Rng& rng, int candidates, CandidateMemory* memory = nullptr);
 
 // A boundary collapse removing exactly one face, used once at the end of input to land on an
 // odd target count: the valid collapse p→q along a true-boundary half-edge (no partner, p not

@@ -167,7 +167,7 @@ void StreamDecimator::make_room(const Emit& out) {
                                            output_.triangle_count());
     int failures = 0;
     while (buffer_.face_count() > plan.decimate_to) {
-        if (decimate_once(buffer_, rng_, options_.candidates)) {
+        if (decimate_once(buffer_, rng_, options_.candidates, &candidate_memory_)) {
             ++stats_.collapses;
             failures = 0;
         } else if (++failures >= kStallAttempts) {
@@ -195,7 +195,7 @@ void StreamDecimator::finish(const Emit& out) {
     const size_t budget = final_budget(target, output_.triangle_count());
     int failures = 0;
     while (buffer_.face_count() >= budget + 2) {
-        if (decimate_once(buffer_, rng_, options_.candidates)) {
+        if (decimate_once(buffer_, rng_, options_.candidates, &candidate_memory_)) {
             ++stats_.collapses;
             failures = 0;
         } else if (++failures >= kStallAttempts) {

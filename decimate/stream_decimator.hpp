@@ -88,6 +88,7 @@ private:
     double ratio_;
     HalfEdgeBuffer buffer_;
     Rng rng_;
+    CandidateMemory candidate_memory_;  // decimate_once's runners-up
     TriangleOutput output_;
     uint64_t next_id_ = 0;
     Stats stats_;
