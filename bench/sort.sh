@@ -9,13 +9,13 @@
 # Then decimates the
 # sorted file and the generator's original order and reports both (error and forced writes, from decimate --report).
 #
-# Usage: bench/sort.sh [BUILD_DIR]   (default: ../build-sort next to the repo)
+# Usage: bench/sort.sh [BUILD_DIR]   (default: build, as tools/bootstrap.sh makes it)
 # Env:   SIZES="10000000 50000000"  WORK=/tmp/meshstream-bench-sort  GNU_SORT_LINES=1000000
 #        KEEP=1 keeps the generated files.
 set -euo pipefail
 
 here="$(cd "$(dirname "$0")/.." && pwd)"
-build="${1:-$here/../build-sort}"
+build="${1:-$here/build}"
 ms="$build/tools/meshstream"
 gen="$build/tools/meshstream-gen"
 sizes="${SIZES:-10000000 50000000}"
