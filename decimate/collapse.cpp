@@ -125,6 +125,9 @@ bool collapse_valid(HalfEdgeBuffer& buffer, uint32_t h, const double target[3]) 
     uint32_t ring[2 * kMaxRing];
     uint32_t ring_size = 0;
     const bool use_ring = vq.face_count <= kMaxRing;
+    double from_q[3];
+    buffer.position(q, from_q);
+    const bool moving_q = from_q[0] != target[0] || from_q[1] != target[1] || from_q[2] != target[2];
     uint32_t count = 0;
     bool fan_done = false;
     uint32_t cur = h;
@@ -135,6 +138,7 @@ bool collapse_valid(HalfEdgeBuffer& buffer, uint32_t h, const double target[3]) 
             // previous corner of one with x→q whose twin is no half-edge: listing prev only
             // then keeps the ring free of duplicates on a manifold fan.
             ring[ring_size++] = buffer.corner_vertex(next_in_face(c));
+            if (moving_q) buffer.prefetch_vertex(ring[ring_size - 1]);  // for the check of q's faces
             if (!is_half_edge(buffer.twin(prev_in_face(c))))
                 ring[ring_size++] = buffer.corner_vertex(prev_in_face(c));
             c = buffer.next_corner(c);
@@ -185,13 +189,11 @@ bool collapse_valid(HalfEdgeBuffer& buffer, uint32_t h, const double target[3]) 
         }
     }
 
-    double from_p[3], from_q[3];
+    double from_p[3];
     buffer.position(p, from_p);
-    buffer.position(q, from_q);
     const uint32_t skip1 = boundary ? kNoIndex : face_of(t);
     if (!moves_keep_faces_valid(buffer, p, from_p, target, face_of(h), skip1)) return false;
-    if (from_q[0] == target[0] && from_q[1] == target[1] && from_q[2] == target[2]) return true;
-    return moves_keep_faces_valid(buffer, q, from_q, target, face_of(h), skip1);
+    return !moving_q || moves_keep_faces_valid(buffer, q, from_q, target, face_of(h), skip1);
 }
 
 void apply_collapse(HalfEdgeBuffer& buffer, uint32_t h) {
@@ -285,7 +287,7 @@ bool decimate_once(HalfEdgeBuffer& buffer, Rng& rng, int candidates, CandidateMe
     // half-edge, rated afresh like a draw).
     int remembered = 0;
     if (memory != nullptr) {
-        for (int i = 0; i < memory->count && remembered < wanted; ++i) {
+        for (int i = 0; i < memory->count && remembered < (wanted + 1) / 2; ++i) {
             const uint32_t h = memory->h[i];
             if (!live.contains(face_of(h)) || !collapse_eligible(buffer, h)) continue;
             insert(h);

@@ -4,6 +4,7 @@
 #include "decimate/stream_decimator.hpp"
 
 #include "mesh_util.hpp"
+#include "tools/metro.hpp"
 
 #include <gtest/gtest.h>
 
@@ -80,6 +81,30 @@ TEST_P(BunnyDecimation, ExactCountManifoldAndFaithful) {
 }
 
 INSTANTIATE_TEST_SUITE_P(TenAndOnePercent, BunnyDecimation, ::testing::Values(0.1, 0.01));
+
+TEST(StreamDecimator, BunnyAtTenPercentIsWithinAQuarterOfGarlandHeckbert) {
+    // Quality against in-core Garland–Heckbert: CGAL's edge_collapse with GH plane policies
+    // (bench/ref_cgal, --target 6945) gives a symmetric RMS of 0.0252 % of the bounding-box
+    // diagonal on this fixture at 10 % (meshstream compare, 10⁶ samples, seed 1; measured
+    // 2026-11, see docs/decimation.md). Demand at most 1.25× that. Measured here: 0.0291 %
+    // (1.16×) with optimal placement, boundary planes and candidate memory; the half-edge-only
+    // decimator gave 0.0366 % (1.45×) and fails this.
+    constexpr double kCgalRmsPercent = 0.0252;
+    Options options;
+    options.ratio = 0.1;
+    options.seed = 1;
+    const Decimated d = run_decimator(bunny(), options);
+    ASSERT_EQ(d.triangle_count(), 6945u);
+    meshstream::tools::CompareOptions compare;
+    compare.samples = 200000;  // fast; the figure moves by under 1 % against 10⁶ samples
+    compare.seed = 1;
+    const meshstream::tools::CompareResult r = meshstream::tools::compare_meshes(
+        meshstream::tools::memory_source("bunny", bunny()), meshstream::tools::memory_source("decimated", d.xyz),
+        compare);
+    const double rms_percent = 100.0 * r.rms() / r.diagonal;
+    EXPECT_GT(rms_percent, 0.0);
+    EXPECT_LE(rms_percent, 1.25 * kCgalRmsPercent);
+}
 
 TEST(StreamDecimator, SameSeedSameOutputWhateverTheChunking) {
     Options options;
