@@ -168,6 +168,10 @@ void unregister_temp_path(int slot) {
 
 void install_cleanup_handlers() {
     for (int sig : {SIGINT, SIGTERM, SIGHUP}) std::signal(sig, cleanup_and_reraise);
+    // Past a file-size limit (ulimit -f) the kernel sends SIGXFSZ, whose default action kills
+    // the process and leaves temporary files; ignored, write() fails with EFBIG instead and
+    // the writer throws an io::Error like for a full disk.
+    std::signal(SIGXFSZ, SIG_IGN);
 }
 
 std::string parent_dir(const std::string& path) {

@@ -152,7 +152,8 @@ private:
 // Registers a path to unlink if the process is interrupted; returns a slot for unregister.
 int register_temp_path(const std::string& path);
 void unregister_temp_path(int slot);
-// Installs SIGINT/SIGTERM/SIGHUP handlers that unlink every registered path, then re-raise.
+// Installs SIGINT/SIGTERM/SIGHUP handlers that unlink every registered path, then re-raise,
+// and ignores SIGXFSZ so a file-size limit surfaces as a write error (EFBIG).
 void install_cleanup_handlers();
 
 // Directory part of a path ("." when there is none).

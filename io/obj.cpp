@@ -7,6 +7,7 @@
 #include "io/vertex_table.hpp"
 #include "io/weld.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cstdlib>
 #include <cstring>
@@ -129,7 +130,13 @@ private:
                 read_face(rest);
                 return true;
             }
-            // vt vn vp g o s usemtl mtllib l p and anything else: not geometry we keep.
+            // vt vn vp g o s usemtl mtllib l p and anything else: not geometry we keep. Statement
+            // names are ASCII words ("c_interp", "curv2"); anything else is not OBJ text (random
+            // bytes under .obj used to read as zero triangles).
+            if (!std::all_of(key.begin(), key.end(), [](char c) {
+                    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_';
+                }))
+                fail("not an OBJ statement: " + quote_token(key));
         }
     }
 

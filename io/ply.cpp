@@ -114,7 +114,10 @@ public:
             if (chunk.full()) return true;
             // Elements after the faces carry nothing we use and are not read: real files get
             // them wrong (CGAL's colored_tetra.ply promises 3 properties per 'edge', writes 2).
-            if (face_ < 0 || item_ == elements_[static_cast<size_t>(face_)].count) return !chunk.empty();
+            if (face_ < 0 || item_ == elements_[static_cast<size_t>(face_)].count) {
+                if (chunk.empty()) reject_trailing_data();
+                return !chunk.empty();
+            }
             read_face();
         }
     }
@@ -547,6 +550,26 @@ private:
         ++item_;
     }
 
+    // When the faces are the last element, anything but blanks after them is data the header
+    // does not count: its face count is short (issue 7; it used to be ignored silently).
+    void reject_trailing_data() {
+        if (face_ < 0 || static_cast<size_t>(face_) + 1 != elements_.size()) return;
+        for (;;) {
+            auto w = src_.window();
+            if (w.empty()) return;
+            const char* p = reinterpret_cast<const char*>(w.data());
+            for (size_t i = 0; i < w.size(); ++i) {
+                if (p[i] == '\n') {
+                    ++line_;
+                } else if (!is_blank(p[i])) {
+                    src_.consume(i);
+                    item_fail(src_.offset(), "data after the last of the " + std::to_string(item_) +
+                                                 " faces the header promises");
+                }
+            }
+            src_.consume(w.size());
+        }
+    }
 
     ByteSource& src_;
     ReadOptions options_;

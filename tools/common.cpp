@@ -40,7 +40,8 @@ void add_read_flags(CLI::App* cmd, ReadFlags& flags) {
     cmd->add_option("--memory", flags.memory,
                     "Memory budget for tables, spills and sort runs, e.g. 64M, 1G (default 256M)");
     cmd->add_option("--tmpdir", flags.tmpdir, "Directory for temporary files (default: $TMPDIR or /tmp)");
-    cmd->add_flag("--strict", flags.strict, "Treat skippable input problems (NaN, degenerate faces) as errors");
+    cmd->add_flag("--strict", flags.strict, "Triangles with a NaN/inf coordinate or two corners at the same position are skipped with a "
+                   "counted warning; --strict makes them (and faces of fewer than 3 vertices) errors");
 }
 
 io::WriteOptions WriteFlags::options(const ReadFlags& read) const {

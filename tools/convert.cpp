@@ -3,6 +3,7 @@
 #include "io/error.hpp"
 #include "tools/commands.hpp"
 #include "tools/common.hpp"
+#include "tools/input_filter.hpp"
 
 #include <cstdio>
 #include <memory>
@@ -20,16 +21,21 @@ void run_convert(const ConvertOptions& opt) {
     io::Input in = io::open_input(opt.input, opt.read.from, opt.read.options());
     const io::MeshHeader& header = in.reader->header();
     io::WriteOptions wo = opt.write.options(opt.read);
-    wo.triangle_count = header.triangle_count;
+    // Skipped triangles (input_filter.hpp) make the input's count an upper bound: it is
+    // promised to the writer only where nothing can be skipped (--strict) or where the writer
+    // cannot patch its header later (stdout, where a difference is then an error).
+    if (opt.read.strict || opt.output == "-") wo.triangle_count = header.triangle_count;
     wo.sorted_axis = header.sorted_axis;
     io::Output out = io::open_output(opt.output, opt.write.to, wo, opt.write.gzip_level);
 
     io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, header.channels);
     uint64_t done = 0;
     Progress progress("converting", header.triangle_count);
+    TriangleFilter filter(in.source->name(), opt.read.strict);
     while (in.reader->next(chunk)) {
-        out.write(chunk);
         done += chunk.size();
+        filter.apply(chunk);
+        out.write(chunk);
         progress.update(done);
     }
     progress.done();
@@ -37,6 +43,9 @@ void run_convert(const ConvertOptions& opt) {
         throw io::Error(in.source->name(), "header promises " + std::to_string(*header.triangle_count) +
                                                " triangles, read " + std::to_string(done));
     out.finish();
+    Warnings warnings;
+    filter.report(warnings);
+    warnings.print();
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include "io/error.hpp"
 #include "tools/commands.hpp"
 #include "tools/common.hpp"
+#include "tools/input_filter.hpp"
 #include "tools/metro.hpp"
 
 #include <chrono>
@@ -85,9 +86,11 @@ void run_decimate(const DecimateOptions& opt) {
     io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, header.channels);
     uint64_t done = 0;
     Progress progress("decimating", header.triangle_count);
+    TriangleFilter filter(in.source->name(), opt.read.strict);
     while (in.reader->next(chunk)) {
-        decimator.push(chunk, emit);
         done += chunk.size();
+        filter.apply(chunk);
+        decimator.push(chunk, emit);
         progress.update(done);
     }
     if (header.triangle_count && done != *header.triangle_count)
@@ -121,6 +124,7 @@ void run_decimate(const DecimateOptions& opt) {
                      (unsigned long long)s.vertices_finalized_by_sweep);
 
     Warnings warnings;
+    filter.report(warnings);
     if (s.forced_writes > 0)
         warnings.add("buffer full of undecimatable triangles: " + std::to_string(s.forced_writes) +
                      " triangles force-written at full resolution (" +

@@ -6,6 +6,7 @@
 #include "sort/external_sort.hpp"
 #include "tools/commands.hpp"
 #include "tools/common.hpp"
+#include "tools/input_filter.hpp"
 
 #include <sys/stat.h>
 #include <unistd.h>
@@ -126,9 +127,11 @@ void run_sort(const SortOptions& opt) {
     sort::ExternalSorter sorter(so);
     io::TriangleChunk chunk(chunk_capacity, header.channels);
     uint64_t done = 0;
+    TriangleFilter filter(in.source->name(), opt.read.strict);
     while (in.reader->next(chunk)) {
-        sorter.add(chunk);
         progress.update(done += chunk.size());
+        filter.apply(chunk);
+        sorter.add(chunk);
     }
     if (header.triangle_count && done != *header.triangle_count)
         throw io::Error(in.source->name(), "header promises " + std::to_string(*header.triangle_count) +
@@ -152,6 +155,9 @@ void run_sort(const SortOptions& opt) {
     }
     out.finish();
     progress.done();
+    Warnings warnings;
+    filter.report(warnings);
+    warnings.print();
 
     if (opt.stats) {
         const sort::SortStats& s = sorter.stats();

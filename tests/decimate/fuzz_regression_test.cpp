@@ -70,3 +70,4 @@ TEST(FuzzRegression, Issue7_NonFiniteCoordinatesAreAPrecondition) {
     EXPECT_DEATH(run_decimator(soup, options), "finite coordinates");
 #endif
 }
+

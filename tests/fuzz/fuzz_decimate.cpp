@@ -3,7 +3,7 @@
 // float bits give NaN, ±inf, denormals, huge and tiny magnitudes:
 //   byte 0: buffer_triangles = 16 + 4·b     byte 1: ratio = (b + 1) / 256
 //   byte 2: candidates = 1 + b % 16         byte 3: weld_eps from a table (0, tiny, 1e-3, 1, huge, inf)
-//   byte 4: sorted axis (none, x, y, z)     byte 5: bit 0 = use --target (target = byte 1)
+//   byte 4: sorted axis (none, x, y, z)     byte 5: bit 0 = use --target (target = byte 1, ≥ 1)
 //                                                   bits 1..: input chunk capacity 1 + (b >> 1)
 //   byte 6: palette size P = 1 + b % 64, then P × 12 bytes of float xyz,
 //   then triangles as 3 palette index bytes each (mod P).
@@ -42,7 +42,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     pos += 12 * palette;
     const uint64_t triangles = (size - pos) / 3;
 
-    if (use_target) options.target = std::min<uint64_t>(data[1], triangles);
+    if (use_target) options.target = std::clamp<uint64_t>(data[1], 1, std::max<uint64_t>(triangles, 1));
     decimate::StreamDecimator decimator(options, triangles);
     uint64_t out_count = 0;
     auto emit = [&](const io::TriangleChunk& chunk) {

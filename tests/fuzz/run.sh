@@ -6,6 +6,7 @@
 #
 #   tests/fuzz/run.sh [seconds per target (600)] [targets... (all)]
 #   BUILD_DIR=/path/to/build-fuzz JOBS=2 tests/fuzz/run.sh 600 ply obj
+#   FUZZ_FLAGS="-fork=1 -ignore_crashes=1" tests/fuzz/run.sh 600 decimate   # keep going past findings
 #
 # Needs clang++ and libclang-rt-14-dev (libFuzzer's runtime). Exit status: non-zero when any
 # target found a crash, leak, timeout or out-of-memory; its reproducer is printed.
@@ -64,7 +65,7 @@ run_one() {
     mkdir -p "$dir"
     (cd "$dir" && "$BUILD_DIR/tests/fuzz/fuzz_$t" "$BUILD_DIR/fuzz-corpus/$t" \
         -max_total_time="$SECONDS_PER_TARGET" -max_len=65536 -timeout=20 -rss_limit_mb=2048 \
-        -malloc_limit_mb=1024 -print_final_stats=1 -artifact_prefix="$dir/" >"$dir/log.txt" 2>&1) && rc=0 || rc=$?
+        -malloc_limit_mb=1024 -print_final_stats=1 -artifact_prefix="$dir/" ${FUZZ_FLAGS:-} >"$dir/log.txt" 2>&1) && rc=0 || rc=$?
     {
         echo "== $t (exit $rc)"
         grep -E '^(stat::|INFO: Loaded|#[0-9]+ *DONE)' "$dir/log.txt" | tail -n 12 || true

@@ -1,0 +1,254 @@
+// The bad-input suite of issue 7 through the `meshstream` binary (MESHSTREAM_BINARY): bad files
+// give exit 1, a `meshstream: error: <file>...` line and no output file; NaN and degenerate
+// triangles are skipped with counted warnings (errors with --strict); Ctrl-C during convert,
+// sort and decimate leaves no temporary or partial file; a file-size limit (a full disk for
+// the process) gives a clear error instead of death by SIGXFSZ.
+#include <gtest/gtest.h>
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <limits>
+#include <random>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct TempDir {
+    fs::path path;
+    TempDir() {
+        std::string pattern = (fs::temp_directory_path() / "cli_bad_input-XXXXXX").string();
+        path = ::mkdtemp(pattern.data());
+    }
+    ~TempDir() { fs::remove_all(path); }
+    std::string operator/(const std::string& name) const { return (path / name).string(); }
+};
+
+std::vector<std::string> listing(const fs::path& dir) {
+    std::vector<std::string> names;
+    for (const auto& e : fs::directory_iterator(dir)) names.push_back(e.path().filename().string());
+    std::sort(names.begin(), names.end());
+    return names;
+}
+
+std::string slurp(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+struct CliRun {
+    int code;  // exit status; 128 + signal when killed
+    std::string err;
+};
+
+// Runs `prefix meshstream -q ARGS` through /bin/sh (prefix: e.g. "ulimit -f 64;"); stderr is
+// captured in a file outside `dir`, so `dir` holds exactly what the command left.
+CliRun run(const std::string& args, const std::string& prefix = "") {
+    char err_path[] = "/tmp/cli_bad_input_err-XXXXXX";
+    int fd = ::mkstemp(err_path);
+    ::close(fd);
+    std::string cmd = prefix + " " + MESHSTREAM_BINARY + " -q " + args + " 2> " + err_path;
+    int status = std::system(("exec >/dev/null; " + cmd).c_str());
+    CliRun r{WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status), slurp(err_path)};
+    ::unlink(err_path);
+    return r;
+}
+
+// A binary STL of `tris` (9 floats each), zero normals.
+std::string binary_stl(const std::vector<float>& tris) {
+    std::string s(80, ' ');
+    uint32_t n = static_cast<uint32_t>(tris.size() / 9);
+    s.append(reinterpret_cast<const char*>(&n), 4);
+    for (size_t t = 0; t < n; ++t) {
+        s.append(12, '\0');
+        s.append(reinterpret_cast<const char*>(&tris[9 * t]), 36);
+        s.append(2, '\0');
+    }
+    return s;
+}
+
+// A height-field grid of 2·k² triangles in row order (a stream the decimator can work on).
+std::vector<float> grid(int k) {
+    std::vector<float> tris;
+    tris.reserve(size_t(18) * k * k);
+    auto z = [](int x, int y) { return 0.01f * float((x * 7 + y * 13) % 11); };
+    for (int y = 0; y < k; ++y)
+        for (int x = 0; x < k; ++x) {
+            const float x0 = float(x), x1 = float(x + 1), y0 = float(y), y1 = float(y + 1);
+            tris.insert(tris.end(), {x0, y0, z(x, y), x1, y0, z(x + 1, y), x1, y1, z(x + 1, y + 1)});
+            tris.insert(tris.end(), {x0, y0, z(x, y), x1, y1, z(x + 1, y + 1), x0, y1, z(x, y + 1)});
+        }
+    return tris;
+}
+
+void write_file(const std::string& path, const std::string& bytes) {
+    std::ofstream(path, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+}
+
+}  // namespace
+
+TEST(CliBadInput, RandomBytesUnderEachExtensionExit1WithNoOutput) {
+    TempDir dir;
+    std::mt19937 rng(11);
+    std::string bytes(8192, '\0');
+    for (char& c : bytes) c = static_cast<char>(rng());
+    for (const char* ext : {"stl", "ply", "obj", "drc", "glb", "gltf", "stl.gz"}) {
+        const std::string in = dir / (std::string("random.") + ext);
+        write_file(in, bytes);
+        for (const char* cmd : {"convert", "sort --axis x", "decimate"}) {
+            CliRun r = run(std::string(cmd) + " " + in + " " + dir / "out.ply");
+            EXPECT_EQ(r.code, 1) << cmd << " " << ext << ": " << r.err;
+            EXPECT_EQ(r.err.rfind("meshstream: error: " + in, 0), 0u) << r.err;
+            EXPECT_EQ(listing(dir.path), std::vector<std::string>{fs::path(in).filename().string()}) << cmd << " " << ext;
+        }
+        fs::remove(in);
+    }
+}
+
+TEST(CliBadInput, TruncatedAndLyingFilesExit1WithNoOutput) {
+    TempDir dir;
+    std::string stl = binary_stl(grid(4));
+    write_file(dir / "cut.stl", stl.substr(0, stl.size() - 20));
+    std::string lie = stl;
+    lie[80] = char(lie[80] + 1);  // one triangle more than present
+    write_file(dir / "lie.stl", lie);
+    for (const char* in : {"cut.stl", "lie.stl"}) {
+        for (const char* cmd : {"convert", "sort --axis x", "decimate"}) {
+            CliRun r = run(std::string(cmd) + " " + dir / in + " " + dir / "out.obj");
+            EXPECT_EQ(r.code, 1) << cmd << " " << in;
+            EXPECT_NE(r.err.find(dir / in + ": byte 84: header promises"), std::string::npos) << r.err;
+            EXPECT_FALSE(fs::exists(dir / "out.obj"));
+        }
+    }
+    EXPECT_EQ(listing(dir.path).size(), 2u);
+}
+
+TEST(CliBadInput, NanAndDegenerateTrianglesAreSkippedWithCountedWarnings) {
+    TempDir dir;
+    const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+    std::vector<float> tris = grid(3);  // 18 good triangles
+    tris.insert(tris.end(), {0, 0, 0, 1, 0, 0, nan, 1, 0});
+    tris.insert(tris.end(), {0, 0, 0, inf, 0, 0, 0, 1, 0});
+    tris.insert(tris.end(), {0, 0, 0, 1, 0, 0, 1, 0, 0});  // two corners at one position
+    tris.insert(tris.end(), {-0.0f, 0, 0, 0, 0, 0, 5, 5, 5});  // -0 == +0: also degenerate
+    write_file(dir / "bad.stl", binary_stl(tris));
+
+    CliRun c = run("convert " + dir / "bad.stl" + " " + dir / "out.stl");
+    ASSERT_EQ(c.code, 0) << c.err;
+    EXPECT_NE(c.err.find("warning: triangles with a NaN or infinite coordinate skipped (2)"), std::string::npos) << c.err;
+    EXPECT_NE(c.err.find("warning: degenerate triangles (two corners at the same position) skipped (2)"),
+              std::string::npos) << c.err;
+    EXPECT_EQ(fs::file_size(dir / "out.stl"), 84u + 50u * 18u);  // header count patched to 18
+
+    CliRun s = run("sort --axis x " + dir / "bad.stl" + " " + dir / "sorted.stl");
+    ASSERT_EQ(s.code, 0) << s.err;
+    EXPECT_NE(s.err.find("skipped (2)"), std::string::npos) << s.err;
+    EXPECT_EQ(fs::file_size(dir / "sorted.stl"), 84u + 50u * 18u);
+
+    CliRun d = run("decimate --ratio 0.5 " + dir / "bad.stl" + " " + dir / "dec.stl");
+    ASSERT_EQ(d.code, 0) << d.err;
+    EXPECT_NE(d.err.find("warning: triangles with a NaN or infinite coordinate skipped (2)"), std::string::npos) << d.err;
+    EXPECT_NE(d.err.find("triangles in 18,"), std::string::npos) << d.err;
+
+    // --strict: the first one is an error naming the file and the triangle; nothing is written.
+    for (const char* cmd : {"convert", "sort --axis x", "decimate"}) {
+        CliRun r = run(std::string(cmd) + " --strict " + dir / "bad.stl" + " " + dir / "strict.stl");
+        EXPECT_EQ(r.code, 1) << cmd;
+        EXPECT_NE(r.err.find("meshstream: error: " + dir / "bad.stl" +
+                             ": triangle 19 has a NaN or infinite coordinate (--strict)"),
+                  std::string::npos) << r.err;
+        EXPECT_FALSE(fs::exists(dir / "strict.stl"));
+    }
+}
+
+TEST(CliBadInput, HelpDescribesTheSkipPolicy) {
+    for (const char* cmd : {"convert", "sort", "decimate"}) {
+        char out_path[] = "/tmp/cli_bad_input_help-XXXXXX";
+        ::close(::mkstemp(out_path));
+        std::system((std::string(MESHSTREAM_BINARY) + " " + cmd + " --help > " + out_path).c_str());
+        std::string help = slurp(out_path);
+        ::unlink(out_path);
+        // CLI11 wraps long descriptions; look for the key words.
+        EXPECT_NE(help.find("--strict"), std::string::npos) << cmd;
+        EXPECT_NE(help.find("NaN/inf"), std::string::npos) << cmd << help;
+        EXPECT_NE(help.find("skipped with a"), std::string::npos) << cmd;
+    }
+}
+
+// Ctrl-C while the command is mid-stream: the input comes through a pipe that the test holds
+// open, so the command is provably still running (blocked reading) when SIGINT arrives.
+TEST(CliBadInput, SigintDuringConvertSortDecimateLeavesNoFiles) {
+    const std::string stl = binary_stl(grid(200));  // 80000 triangles, 4 MB
+    for (const char* args : {"convert --from stl - OUT/out.ply", "sort --from stl --axis x --memory 1M --tmpdir OUT - OUT/out.stl",
+                             "decimate --from stl --ratio 0.2 - OUT/out.stl"}) {
+        TempDir dir;
+        std::string cmdline = args;
+        for (size_t at; (at = cmdline.find("OUT")) != std::string::npos;) cmdline.replace(at, 3, dir.path.string());
+        int fds[2];
+        ASSERT_EQ(::pipe(fds), 0);
+        pid_t pid = ::fork();
+        ASSERT_GE(pid, 0);
+        if (pid == 0) {
+            ::dup2(fds[0], 0);
+            ::close(fds[0]);
+            ::close(fds[1]);
+            int devnull = ::open("/dev/null", O_WRONLY);
+            ::dup2(devnull, 2);
+            std::string full = std::string("exec ") + MESHSTREAM_BINARY + " -q " + cmdline;
+            ::execl("/bin/sh", "sh", "-c", full.c_str(), static_cast<char*>(nullptr));
+            ::_exit(127);
+        }
+        ::close(fds[0]);
+        // Three quarters of the input, then wait until the command has created its files.
+        const size_t part = stl.size() * 3 / 4;
+        for (size_t done = 0; done < part;) {
+            ssize_t n = ::write(fds[1], stl.data() + done, part - done);
+            ASSERT_GT(n, 0);
+            done += size_t(n);
+        }
+        const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+        while (listing(dir.path).empty() && std::chrono::steady_clock::now() < deadline)
+            std::this_thread::sleep_for(std::chrono::milliseconds(10));
+        EXPECT_FALSE(listing(dir.path).empty()) << args << ": no temporary file appeared";
+        ::kill(pid, SIGINT);
+        int status = 0;
+        ::waitpid(pid, &status, 0);
+        ::close(fds[1]);
+        EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGINT) << args << ": status " << status;
+        EXPECT_EQ(listing(dir.path), std::vector<std::string>{}) << args;
+    }
+}
+
+// A file-size limit makes write() fail as on a full disk. SIGXFSZ would kill the process and
+// leave the temporary file; meshstream ignores it, so write() returns EFBIG and the command
+// reports it.
+TEST(CliBadInput, FileSizeLimitGivesAClearErrorAndNoFiles) {
+    TempDir dir;
+    write_file(dir / "in.stl", binary_stl(grid(100)));  // 20000 triangles, 1 MB
+    for (const char* args : {"convert IN OUT/out.ply", "convert IN OUT/out.stl", "sort --axis x IN OUT/out.stl",
+                             "decimate --ratio 0.9 IN OUT/out.stl"}) {
+        std::string cmdline = args;
+        fs::create_directory(dir / "o");
+        cmdline.replace(cmdline.find("IN"), 2, dir / "in.stl");
+        cmdline.replace(cmdline.find("OUT"), 3, dir / "o");
+        CliRun r = run(cmdline, "ulimit -f 256;");  // 128 KiB (dash counts 512-byte blocks)
+        EXPECT_EQ(r.code, 1) << args << ": " << r.err;
+        EXPECT_NE(r.err.find("meshstream: error: "), std::string::npos) << r.err;
+        EXPECT_NE(r.err.find("File too large"), std::string::npos) << args << ": " << r.err;
+        EXPECT_EQ(listing(dir / "o"), std::vector<std::string>{}) << args;
+        fs::remove_all(dir / "o");
+    }
+}
