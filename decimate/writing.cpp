@@ -46,7 +46,9 @@ uint32_t pick_write(const HalfEdgeBuffer& buffer, Rng& rng, int candidates) {
             for (int j = 0; j < 3; ++j) centre[j] += x[j] / 3;
         }
         const double error = q.error(centre);
-        if (error > best_error) {
+        // `best == kNoIndex`: a NaN error (inf·0 from extreme coordinates) must not leave the
+        // pick empty (issue 7, FuzzRegression.Issue7_NanQuadricErrorStillPicksAFaceToWrite).
+        if (error > best_error || best == kNoIndex) {
             best_error = error;
             best = f;
         }
