@@ -10,6 +10,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <limits>
 #include <memory>
 
@@ -80,7 +81,10 @@ void run_info(const InfoOptions& opt) {
             progress.update(stats.triangles);
         }
     }
-    std::optional<uint64_t> file_size = in.source->gzip() ? std::nullopt : in.source->size();
+    // The size on disk (compressed for gzip input, whose decoded size is reported beside it).
+    std::error_code size_error;
+    const uint64_t file_size = opt.input == "-" ? 0 : std::filesystem::file_size(opt.input, size_error);
+    const bool has_file_size = opt.input != "-" && !size_error;
     uint64_t decoded_bytes = in.source->offset();
     bool has_box = stats.triangles > stats.non_finite;
     static const char* kAxes[] = {"x", "y", "z"};
@@ -91,7 +95,7 @@ void run_info(const InfoOptions& opt) {
         j["format"] = std::string(in.format->name);
         if (!header.variant.empty()) j["variant"] = header.variant;
         j["gzip"] = in.source->gzip();
-        if (file_size) j["file_bytes"] = *file_size;
+        if (has_file_size) j["file_bytes"] = file_size;
         if (in.source->gzip()) j["decoded_bytes"] = decoded_bytes;
         j["triangles"] = stats.triangles;
         if (header.vertex_count) j["vertices"] = *header.vertex_count;
@@ -135,7 +139,7 @@ void run_info(const InfoOptions& opt) {
     std::printf("format:      %s%s%s%s\n", std::string(in.format->name).c_str(),
                 header.variant.empty() ? "" : " (", header.variant.c_str(), header.variant.empty() ? "" : ")");
     if (in.source->gzip()) std::printf("compression: gzip (%llu bytes decoded)\n", (unsigned long long)decoded_bytes);
-    if (file_size) std::printf("file size:   %llu bytes\n", (unsigned long long)*file_size);
+    if (has_file_size) std::printf("file size:   %llu bytes\n", (unsigned long long)file_size);
     std::printf("triangles:   %llu\n", (unsigned long long)stats.triangles);
     if (header.vertex_count) std::printf("vertices:    %llu\n", (unsigned long long)*header.vertex_count);
     std::printf("degenerate:  %llu (zero area)\n", (unsigned long long)stats.degenerate);

@@ -231,8 +231,10 @@ TEST(BadInput, TruncationAtEveryByteOfEachBinaryFormatThrowsWithFileName) {
             const std::string name = std::string("cut.") + c.ext;
             io::Error e = error_of([&] { read_with(format, full.substr(0, cut), name); });
             EXPECT_EQ(e.file(), name) << c.format << " cut at " << cut;
-            if (std::string_view(c.format) != "glb" && std::string_view(c.format) != "draco")
+            // Draco's decoder does not say where it stopped, so those errors name only the file.
+            if (std::string_view(c.format) != "glb" && std::string_view(c.format) != "draco") {
                 EXPECT_TRUE(has_position(e)) << c.format << " cut at " << cut << ": " << e.what();
+            }
         }
     }
 }
