@@ -3,6 +3,8 @@
 // triangles are skipped with counted warnings (errors with --strict); Ctrl-C during convert,
 // sort and decimate leaves no temporary or partial file; a file-size limit (a full disk for
 // the process) gives a clear error instead of death by SIGXFSZ.
+#include "tools/cli_util.hpp"
+
 #include <gtest/gtest.h>
 
 #include <fcntl.h>
@@ -27,45 +29,11 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct TempDir {
-    fs::path path;
-    TempDir() {
-        std::string pattern = (fs::temp_directory_path() / "cli_bad_input-XXXXXX").string();
-        path = ::mkdtemp(pattern.data());
-    }
-    ~TempDir() { fs::remove_all(path); }
-    std::string operator/(const std::string& name) const { return (path / name).string(); }
-};
-
-std::vector<std::string> listing(const fs::path& dir) {
-    std::vector<std::string> names;
-    for (const auto& e : fs::directory_iterator(dir)) names.push_back(e.path().filename().string());
-    std::sort(names.begin(), names.end());
-    return names;
-}
-
-std::string slurp(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
-struct CliRun {
-    int code;  // exit status; 128 + signal when killed
-    std::string err;
-};
-
-// Runs `prefix meshstream -q ARGS` through /bin/sh (prefix: e.g. "ulimit -f 64;"); stderr is
-// captured in a file outside `dir`, so `dir` holds exactly what the command left.
-CliRun run(const std::string& args, const std::string& prefix = "") {
-    char err_path[] = "/tmp/cli_bad_input_err-XXXXXX";
-    int fd = ::mkstemp(err_path);
-    ::close(fd);
-    std::string cmd = prefix + " " + MESHSTREAM_BINARY + " -q " + args + " 2> " + err_path;
-    int status = std::system(("exec >/dev/null; " + cmd).c_str());
-    CliRun r{WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status), slurp(err_path)};
-    ::unlink(err_path);
-    return r;
-}
+using cli_test::CliRun;
+using cli_test::listing;
+using cli_test::run;
+using cli_test::slurp;
+using cli_test::TempDir;
 
 // A binary STL of `tris` (9 floats each), zero normals.
 std::string binary_stl(const std::vector<float>& tris) {

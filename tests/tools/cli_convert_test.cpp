@@ -1,0 +1,109 @@
+// `meshstream info` and `convert` through the built binary: the foundation issue's pipe
+// acceptance (binary STL -> ASCII on stdout -> stdin -> gzip, then info agrees with the
+// original), errors that name the file and position with exit 1 and no output left, exit 2 for
+// a bad command line, and --help on every command.
+#include "tools/cli_util.hpp"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <cstdio>
+#include <string>
+
+namespace {
+
+using cli_test::listing;
+using cli_test::run;
+using cli_test::slurp;
+using cli_test::TempDir;
+
+const std::string kBunny = std::string(MESHSTREAM_FIXTURES_DIR) + "/bunny_from_draco.bin.stl";
+
+nlohmann::json info_json(const std::string& path) {
+    std::string out_path = path + ".info.json";
+    auto r = run("info --json " + path + " > " + out_path);
+    EXPECT_EQ(r.code, 0) << r.err;
+    nlohmann::json j = nlohmann::json::parse(slurp(out_path));
+    std::remove(out_path.c_str());
+    return j;
+}
+
+void write_file(const std::string& path, const std::string& bytes) {
+    std::FILE* f = std::fopen(path.c_str(), "wb");
+    ASSERT_NE(f, nullptr);
+    std::fwrite(bytes.data(), 1, bytes.size(), f);
+    std::fclose(f);
+}
+
+TEST(CliConvert, PipeThroughAsciiOnStdoutIntoGzipKeepsCountAndBox) {
+    TempDir dir;
+    const std::string gz = dir / "out.stl.gz";
+    // The first command's stdout feeds the second's stdin, as in the README's pipe example.
+    auto r = run("convert " + kBunny + " - --to stl-ascii | " + MESHSTREAM_BINARY + " -q convert - " + gz);
+    ASSERT_EQ(r.code, 0) << r.err;
+    nlohmann::json a = info_json(kBunny), b = info_json(gz);
+    EXPECT_EQ(a["triangles"], 69451);
+    EXPECT_EQ(b["triangles"], a["triangles"]);
+    EXPECT_EQ(b["bbox_min"], a["bbox_min"]);
+    EXPECT_EQ(b["bbox_max"], a["bbox_max"]);
+    EXPECT_EQ(b["gzip"], true);
+    EXPECT_EQ(b["decoded_bytes"], 84 + 50 * 69451);  // binary STL, by the extension
+    EXPECT_EQ(listing(dir.path), (std::vector<std::string>{"out.stl.gz"}));
+}
+
+TEST(CliInfo, ReportsDegenerateTrianglesAndFileSize) {
+    // Spider_binary.stl has 56 facets with a repeated corner (corpus MANIFEST).
+    nlohmann::json j = info_json(std::string(MESHSTREAM_FIXTURES_DIR) + "/Spider_binary.stl");
+    EXPECT_EQ(j["format"], "stl");
+    EXPECT_EQ(j["triangles"], 1368);
+    EXPECT_EQ(j["degenerate_triangles"], 56);
+    EXPECT_EQ(j["file_bytes"], 68484);
+}
+
+TEST(CliConvert, TruncatedBinaryStlNamesFileAndByteAndLeavesNothing) {
+    TempDir dir;
+    const std::string in = dir / "cut.stl";
+    std::string bytes = slurp(kBunny);
+    write_file(in, bytes.substr(0, 84 + 50 * 1000 + 17));
+    auto r = run("convert " + in + " " + (dir / "out.ply"));
+    EXPECT_EQ(r.code, 1);
+    EXPECT_NE(r.err.find("meshstream: error: " + in + ": byte 84: header promises 69451 triangles, file holds 1000"),
+              std::string::npos)
+        << r.err;
+    EXPECT_EQ(listing(dir.path), (std::vector<std::string>{"cut.stl"}));
+}
+
+TEST(CliConvert, AsciiStlMissingEndloopNamesLine) {
+    TempDir dir;
+    const std::string in = dir / "bad.stl";
+    write_file(in,
+               "solid t\n facet normal 0 0 1\n  outer loop\n   vertex 0 0 0\n   vertex 1 0 0\n   vertex 0 1 0\n"
+               " endfacet\nendsolid t\n");
+    auto r = run("convert " + in + " " + (dir / "out.stl"));
+    EXPECT_EQ(r.code, 1);
+    EXPECT_NE(r.err.find(in + ":7: expected 'endloop', found 'endfacet'"), std::string::npos) << r.err;
+    EXPECT_EQ(listing(dir.path), (std::vector<std::string>{"bad.stl"}));
+}
+
+TEST(CliConvert, BadCommandLineExits2) {
+    EXPECT_EQ(run("convert only-one-argument").code, 2);
+    EXPECT_EQ(run("no-such-command").code, 2);
+    EXPECT_EQ(run("convert " + kBunny + " out.stl --gzip-level 12").code, 2);
+}
+
+TEST(CliConvert, UnknownOutputExtensionIsAnErrorNamingTheFile) {
+    TempDir dir;
+    auto r = run("convert " + kBunny + " " + (dir / "out.xyz"));
+    EXPECT_EQ(r.code, 1);
+    EXPECT_NE(r.err.find("out.xyz: cannot tell the output format"), std::string::npos) << r.err;
+    EXPECT_TRUE(listing(dir.path).empty());
+}
+
+TEST(CliConvert, EveryCommandHasHelp) {
+    for (const char* cmd : {"", "info", "convert", "decimate", "sort", "compare"}) {
+        auto r = run(std::string(cmd) + " --help > /dev/null");
+        EXPECT_EQ(r.code, 0) << cmd << ": " << r.err;
+    }
+}
+
+}  // namespace
