@@ -8,6 +8,7 @@
 #include "sort/radix.hpp"
 
 #include <fcntl.h>
+#include <sys/mman.h>
 
 #include <algorithm>
 #include <cassert>
@@ -20,6 +21,35 @@ constexpr size_t kStagingBytes = size_t{1} << 20;      // >= TempFile's buffer: 
 constexpr uint64_t kMinReadBytes = uint64_t{64} << 10;  // smallest per-run read buffer
 constexpr uint64_t kMaxReadBytes = uint64_t{16} << 20;  // larger reads gain nothing
 constexpr uint64_t kMinRunTriangles = 1024;
+// Gathering records in key order is a random walk over the run buffer: prefetching the record
+// this many items ahead hides most of the cache and TLB misses (2-3x faster gathers).
+constexpr size_t kPrefetchDistance = 16;
+
+// Asks for transparent huge pages on the run buffers (Linux, THP in "madvise" mode): a
+// gather in key order touches a new page for almost every record, and with 4 KiB pages a
+// 500 MB run costs ~130 000 page faults and a TLB miss per record. Advisory: ignored where
+// unsupported. RSS still grows only as the buffer fills (in 2 MiB steps).
+void advise_huge_pages(void* p, size_t bytes) {
+#ifdef MADV_HUGEPAGE
+    constexpr uintptr_t kHuge = uintptr_t{2} << 20;
+    const uintptr_t begin = (reinterpret_cast<uintptr_t>(p) + kHuge - 1) & ~(kHuge - 1);
+    const uintptr_t end = (reinterpret_cast<uintptr_t>(p) + bytes) & ~(kHuge - 1);
+    if (end > begin) ::madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
+#else
+    (void)p, (void)bytes;
+#endif
+}
+
+// Prefetches the record of the item `ahead` positions further in `sorted` (both cache lines
+// a record may straddle).
+inline void prefetch_record(const std::byte* records, size_t record_bytes, std::span<const uint64_t> sorted,
+                            size_t i) {
+    if (i + kPrefetchDistance < sorted.size()) {
+        const std::byte* r = records + (sorted[i + kPrefetchDistance] & 0xFFFFFFFFu) * record_bytes;
+        __builtin_prefetch(r);
+        __builtin_prefetch(r + record_bytes - 1);
+    }
+}
 
 }  // namespace
 
@@ -170,6 +200,8 @@ void ExternalSorter::add(const io::TriangleChunk& chunk) {
         // Uninitialised: pages are touched (and count toward RSS) only as the run fills.
         records_.reset(new std::byte[capacity * record_bytes_]);
         items_.reset(new uint64_t[capacity]);
+        advise_huge_pages(records_.get(), capacity * record_bytes_);
+        advise_huge_pages(items_.get(), capacity * sizeof(uint64_t));
     }
     auto xyz = chunk.xyz();
     for (size_t i = 0; i < chunk.size(); ++i) {
@@ -186,7 +218,10 @@ void ExternalSorter::sort_run() {
         sorted_ = {};
         return;
     }
-    if (!scratch_) scratch_.reset(new uint64_t[stats_.run_capacity]);
+    if (!scratch_) {
+        scratch_.reset(new uint64_t[stats_.run_capacity]);
+        advise_huge_pages(scratch_.get(), stats_.run_capacity * sizeof(uint64_t));
+    }
     sorted_ = radix_sort_by_key({items_.get(), run_size_}, {scratch_.get(), run_size_});
 }
 
@@ -220,11 +255,13 @@ void ExternalSorter::spill_run() {
     if (staging_.empty()) staging_.resize(kStagingBytes);
     const uint64_t start = runs_file_->size();
     size_t fill = 0;
-    for (uint64_t item : sorted_) {
+    for (size_t i = 0; i < sorted_.size(); ++i) {
         if (fill + record_bytes_ > staging_.size()) {
             write_temp(*runs_file_, staging_.data(), fill);
             fill = 0;
         }
+        prefetch_record(records_.get(), record_bytes_, sorted_, i);
+        const uint64_t item = sorted_[i];
         std::memcpy(staging_.data() + fill, records_.get() + (item & 0xFFFFFFFFu) * record_bytes_, record_bytes_);
         fill += record_bytes_;
     }
@@ -306,6 +343,7 @@ bool ExternalSorter::next(io::TriangleChunk& chunk) {
     if (!final_) {
         // In-memory result.
         while (!chunk.full() && emit_pos_ < sorted_.size()) {
+            prefetch_record(records_.get(), record_bytes_, sorted_, emit_pos_);
             uint64_t item = sorted_[emit_pos_++];
             decode(records_.get() + (item & 0xFFFFFFFFu) * record_bytes_, chunk);
         }

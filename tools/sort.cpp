@@ -2,6 +2,8 @@
 // the stream decimator (sort/external_sort.hpp does the sorting; docs/sorting.md explains the
 // method and the memory bound). This file chooses the axis, splits --memory between the
 // reader/writer and the sorter, drives the progress bar and records the axis in the output.
+// Reading and writing run on their own threads (a ChunkPipe each), overlapping parsing and
+// file I/O with the sorting on the main thread.
 #include "io/error.hpp"
 #include "sort/external_sort.hpp"
 #include "tools/commands.hpp"
@@ -12,11 +14,18 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <cstdio>
+#include <deque>
+#include <exception>
 #include <limits>
 #include <memory>
+#include <mutex>
+#include <thread>
+#include <vector>
 
 namespace meshstream::tools {
 namespace {
@@ -30,6 +39,101 @@ struct SortOptions {
 };
 
 const char* const kAxisNames[] = {"x", "y", "z"};
+
+// Chunks circulating between the two threads of a ChunkPipe: one being filled, one being
+// consumed, two in flight to absorb jitter. Part of the sorter's memory share.
+constexpr size_t kPipeSlots = 4;
+
+// A bounded, ordered hand-over of chunks from one producer thread to one consumer thread:
+// kPipeSlots chunks, allocated once, move between a free list and a full list. An error on
+// either side is recorded with fail() and rethrown on the other side at its next call.
+class ChunkPipe {
+public:
+    ChunkPipe(size_t capacity, io::Channels channels) {
+        for (size_t i = 0; i < kPipeSlots; ++i) {
+            storage_.push_back(std::make_unique<io::TriangleChunk>(capacity, channels));
+            free_.push_back(storage_.back().get());
+        }
+    }
+
+    // Producer: an empty chunk to fill; null once stop() was called. Rethrows a failure.
+    io::TriangleChunk* get_free() { return take(free_); }
+    // Producer: hands a filled chunk over (in order).
+    void put_full(io::TriangleChunk* chunk) { give(full_, chunk); }
+    // Producer: the stream ended normally; get_full() returns null after the last chunk.
+    void close() {
+        std::lock_guard lock(mutex_);
+        closed_ = true;
+        changed_.notify_all();
+    }
+    // Consumer: the next filled chunk, or null at the end or once stop() was called.
+    // Rethrows a failure.
+    io::TriangleChunk* get_full() { return take(full_); }
+    // Consumer: returns a consumed chunk for refilling.
+    void put_free(io::TriangleChunk* chunk) { give(free_, chunk); }
+
+    // Either side: records the first error (rethrown to the other side) and wakes it.
+    void fail(std::exception_ptr error) {
+        std::lock_guard lock(mutex_);
+        if (!error_) error_ = error;
+        changed_.notify_all();
+    }
+    // Makes both sides' get_*() return null (the owner unwinds and joins the worker).
+    void stop() {
+        std::lock_guard lock(mutex_);
+        stopped_ = true;
+        changed_.notify_all();
+    }
+
+private:
+    io::TriangleChunk* take(std::deque<io::TriangleChunk*>& list) {
+        std::unique_lock lock(mutex_);
+        const bool full_side = &list == &full_;
+        changed_.wait(lock, [&] { return !list.empty() || stopped_ || error_ || (full_side && closed_); });
+        if (stopped_) return nullptr;
+        if (error_) std::rethrow_exception(error_);
+        if (list.empty()) return nullptr;  // closed and drained
+        io::TriangleChunk* chunk = list.front();
+        list.pop_front();
+        return chunk;
+    }
+    void give(std::deque<io::TriangleChunk*>& list, io::TriangleChunk* chunk) {
+        std::lock_guard lock(mutex_);
+        list.push_back(chunk);
+        changed_.notify_all();
+    }
+
+    std::vector<std::unique_ptr<io::TriangleChunk>> storage_;
+    std::mutex mutex_;
+    std::condition_variable changed_;
+    std::deque<io::TriangleChunk*> free_, full_;
+    bool closed_ = false, stopped_ = false;
+    std::exception_ptr error_;
+};
+
+// Runs `body` on a thread that is stopped (pipe.stop()) and joined when this goes out of
+// scope, so an exception on the main thread never leaves the worker running. `body` must
+// catch its own exceptions (into pipe.fail()).
+class PipeWorker {
+public:
+    template <class F>
+    PipeWorker(ChunkPipe& pipe, F&& body) : pipe_(pipe), thread_(std::forward<F>(body)) {}
+    ~PipeWorker() {
+        pipe_.stop();
+        join();
+    }
+    void join() {
+        if (thread_.joinable()) thread_.join();
+    }
+
+private:
+    ChunkPipe& pipe_;
+    std::thread thread_;
+};
+
+double seconds_since(std::chrono::steady_clock::time_point t) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
 
 // The longest axis of the input's bounding box, from the header when it states the bounds,
 // else from a first reading pass. Precondition: the input can be opened twice.
@@ -109,10 +213,10 @@ void run_sort(const SortOptions& opt) {
     so.tmpdir = tmpdir;
     so.channels = header.channels;
     const size_t record_bytes = sort::ExternalSorter::record_bytes_for(so.channels);
-    // The chunk is part of the sorter's share: at most 1/16 of the budget.
+    // The pipe's chunks are part of the sorter's share: each at most 1/64 of the budget.
     const size_t chunk_capacity =
-        std::clamp<size_t>(budget / 16 / (record_bytes + 36), 256, io::TriangleChunk::kDefaultCapacity);
-    so.memory_budget_bytes = budget - budget / 4 - chunk_capacity * (record_bytes + 36);
+        std::clamp<size_t>(budget / 64 / (record_bytes + 36), 256, io::TriangleChunk::kDefaultCapacity);
+    so.memory_budget_bytes = budget - budget / 4 - kPipeSlots * chunk_capacity * (record_bytes + 36);
 
     Progress progress("run generation", header.triangle_count);
     int shown_pass = 0;
@@ -125,19 +229,39 @@ void run_sort(const SortOptions& opt) {
         progress.update(merged);
     };
     sort::ExternalSorter sorter(so);
-    io::TriangleChunk chunk(chunk_capacity, header.channels);
-    uint64_t done = 0;
     TriangleFilter filter(in.source->name(), opt.read.strict);
-    while (in.reader->next(chunk)) {
-        progress.update(done += chunk.size());
-        filter.apply(chunk);
-        sorter.add(chunk);
+    {
+        // Input thread: reads, parses and filters chunks; this thread adds them to the runs
+        // (and sorts and spills each full run).
+        ChunkPipe pipe(chunk_capacity, header.channels);
+        std::atomic<uint64_t> read{0};
+        PipeWorker reader(pipe, [&] {
+            try {
+                uint64_t done = 0;
+                while (io::TriangleChunk* chunk = pipe.get_free()) {
+                    if (!in.reader->next(*chunk)) break;
+                    read.store(done += chunk->size(), std::memory_order_relaxed);
+                    filter.apply(*chunk);
+                    pipe.put_full(chunk);
+                }
+                if (header.triangle_count && done != *header.triangle_count)
+                    throw io::Error(in.source->name(), "header promises " + std::to_string(*header.triangle_count) +
+                                                           " triangles, read " + std::to_string(done));
+                pipe.close();
+            } catch (...) {
+                pipe.fail(std::current_exception());
+            }
+        });
+        while (io::TriangleChunk* chunk = pipe.get_full()) {
+            sorter.add(*chunk);
+            pipe.put_free(chunk);
+            progress.update(read.load(std::memory_order_relaxed));
+        }
     }
-    if (header.triangle_count && done != *header.triangle_count)
-        throw io::Error(in.source->name(), "header promises " + std::to_string(*header.triangle_count) +
-                                               " triangles, read " + std::to_string(done));
     in = {};  // the reader's buffers and tables are not needed while merging
+    const double input_seconds = seconds_since(t0);
     sorter.finish_input();
+    const double sort_seconds = seconds_since(t0) - input_seconds;
     const uint64_t total = sorter.triangle_count();
 
     io::WriteOptions wo = opt.write.options(opt.read);
@@ -148,10 +272,29 @@ void run_sort(const SortOptions& opt) {
     io::Output out = io::open_output(opt.output, opt.write.to, wo, opt.write.gzip_level);
     const int passes = sorter.stats().merge_passes;
     progress.phase(passes == 0 ? "writing" : "merge " + std::to_string(passes) + "/" + std::to_string(passes), total);
-    done = 0;
-    while (sorter.next(chunk)) {
-        out.write(chunk);
-        progress.update(done += chunk.size());
+    {
+        // Output thread: formats and writes chunks; this thread merges (or gathers) them.
+        ChunkPipe pipe(chunk_capacity, header.channels);
+        PipeWorker writer(pipe, [&] {
+            try {
+                while (io::TriangleChunk* chunk = pipe.get_full()) {
+                    out.write(*chunk);
+                    pipe.put_free(chunk);
+                }
+            } catch (...) {
+                pipe.fail(std::current_exception());
+            }
+        });
+        uint64_t done = 0;
+        while (true) {
+            io::TriangleChunk* chunk = pipe.get_free();  // rethrows the writer's error
+            if (!sorter.next(*chunk)) break;
+            pipe.put_full(chunk);
+            progress.update(done += chunk->size());
+        }
+        pipe.close();
+        writer.join();
+        pipe.get_free();  // rethrows an error of the last writes
     }
     out.finish();
     progress.done();
@@ -161,12 +304,14 @@ void run_sort(const SortOptions& opt) {
 
     if (opt.stats) {
         const sort::SortStats& s = sorter.stats();
-        double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        const double seconds = seconds_since(t0);
         std::fprintf(stderr,
-                     "sorted %llu triangles along %s in %.2f s (%s triangles/s): %llu runs of up to %llu, "
+                     "sorted %llu triangles along %s in %.2f s (%s triangles/s; input and runs %.2f s, "
+                     "last run sort and merge passes %.2f s, final merge and output %.2f s): %llu runs of up to %llu, "
                      "%d merge passes, %s temporary written, peak temporary disk %s, peak RSS %s\n",
-                     (unsigned long long)s.triangles, kAxisNames[axis], seconds,
-                     human_count(seconds > 0 ? double(s.triangles) / seconds : 0).c_str(), (unsigned long long)s.runs,
+                     (unsigned long long)s.triangles, kAxisNames[axis], seconds, 
+                     human_count(seconds > 0 ? double(s.triangles) / seconds : 0).c_str(), input_seconds, sort_seconds,
+                     seconds - input_seconds - sort_seconds, (unsigned long long)s.runs,
                      (unsigned long long)s.run_capacity, s.merge_passes, human_bytes(double(s.temp_bytes_written)).c_str(),
                      human_bytes(double(s.peak_temp_bytes)).c_str(), human_bytes(double(peak_rss_bytes())).c_str());
     }
