@@ -32,8 +32,10 @@ private:
     uint64_t triangle_count_ = 0;
 };
 
-// The face to write next, or kNoIndex when every in-core face touches P_in (the caller must
-// then force a write or read no further).
+// The face to write next (§4.4's multiple choice among `candidates` random faces next to
+// P_out, or interior ones when none is): the one with the most corners already written,
+// among those the one with the largest quadric error at its centre. kNoIndex when every
+// in-core face touches P_in (the caller must then force a write or read no further).
 uint32_t pick_write(const HalfEdgeBuffer& buffer, Rng& rng, int candidates);
 
 // Moves vertex v to its quadric minimum when its quadric is complete (not on P_in, manifold,

@@ -41,6 +41,27 @@ TEST(Writing, WriteFreezesVerticesAndOpensPout) {
     EXPECT_TRUE(buffer_consistent(buffer));
 }
 
+TEST(Writing, PrefersFacesWhoseCornersAreAlreadyWritten) {
+    // After one octahedron face is written, three faces share an edge with it (two corners
+    // on P_out) and three only a corner. Writing one of the former extends P_out by one
+    // vertex instead of two: every pick must be one of them, whatever the errors say.
+    for (uint64_t seed = 1; seed <= 20; ++seed) {
+        HalfEdgeBuffer buffer(64, 0);
+        const auto faces = add_indexed(buffer, octahedron_points(), octahedron_faces());
+        TriangleOutput output(4);
+        const Emit emit = [](const meshstream::io::TriangleChunk&) {};
+        uint64_t next_id = 0;
+        write_face(buffer, faces[0], next_id, output, emit);
+        Rng rng(seed);
+        const uint32_t f = pick_write(buffer, rng, 16);
+        ASSERT_NE(f, kNoIndex);
+        int frozen = 0;
+        for (uint32_t k = 0; k < 3; ++k)
+            frozen += (buffer.vertex(buffer.corner_vertex(half_edge(f, k))).flags & kFrozen) != 0;
+        EXPECT_EQ(frozen, 2) << "seed " << seed;
+    }
+}
+
 TEST(Writing, VertexMovesToItsQuadricMinimumOnce) {
     HalfEdgeBuffer buffer(64, 0);
     add_indexed(buffer, octahedron_points(), octahedron_faces());
