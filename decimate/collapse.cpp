@@ -261,11 +261,7 @@ void apply_collapse(HalfEdgeBuffer& buffer, uint32_t h, const double target[3]) 
 }
 
 bool decimate_once(HalfEdgeBuffer& buffer, Rng& rng, int candidates, CandidateMemory* memory) {
-    struct Candidate {
-        uint32_t h;
-        double error;
-        double target[3];
-    };
+    using Candidate = CandidateMemory::Entry;
     constexpr int kMaxCandidates = 64;
     const int wanted = std::clamp(candidates, 1, kMaxCandidates);
     Candidate best[2 * kMaxCandidates];
@@ -273,9 +269,7 @@ bool decimate_once(HalfEdgeBuffer& buffer, Rng& rng, int candidates, CandidateMe
     const FaceSet& live = buffer.live_faces();
     const uint64_t size = live.size();
     if (size == 0) return false;
-    auto insert = [&](uint32_t h) {
-        const CollapsePlacement placement = collapse_placement(buffer, h);
-        Candidate c{h, placement.error, {placement.target[0], placement.target[1], placement.target[2]}};
+    auto insert = [&](const Candidate& c) {
         int i = found++;
         while (i > 0 && best[i - 1].error > c.error) {
             best[i] = best[i - 1];
@@ -283,14 +277,29 @@ bool decimate_once(HalfEdgeBuffer& buffer, Rng& rng, int candidates, CandidateMe
         }
         best[i] = c;
     };
+    auto rate = [&](uint32_t h) {
+        const CollapsePlacement placement = collapse_placement(buffer, h);
+        insert(Candidate{h, buffer.corner_vertex(h), buffer.corner_vertex(next_in_face(h)), placement.error,
+                         {placement.target[0], placement.target[1], placement.target[2]}});
+    };
     // Remembered runners-up whose face is still alive (a reused face slot is just another
     // half-edge, rated afresh like a draw).
     int remembered = 0;
     if (memory != nullptr) {
+        const bool ratings_kept = memory->edits == buffer.edits();
+        auto changed = [&](uint32_t v) {
+            return v == memory->touched[0] || v == memory->touched[1] || v == memory->touched[2] ||
+                   v == memory->touched[3];
+        };
         for (int i = 0; i < memory->count && remembered < (wanted + 1) / 2; ++i) {
-            const uint32_t h = memory->h[i];
-            if (!live.contains(face_of(h)) || !collapse_eligible(buffer, h)) continue;
-            insert(h);
+            const Candidate& c = memory->entry[i];
+            if (!live.contains(face_of(c.h)) || !collapse_eligible(buffer, c.h)) continue;
+            if (ratings_kept && buffer.corner_vertex(c.h) == c.p &&
+                buffer.corner_vertex(next_in_face(c.h)) == c.q && !changed(c.p) && !changed(c.q)) {
+                insert(c);
+            } else {
+                rate(c.h);
+            }
             ++remembered;
         }
         memory->count = 0;
@@ -321,17 +330,24 @@ bool decimate_once(HalfEdgeBuffer& buffer, Rng& rng, int candidates, CandidateMe
             ++tries;
             const uint32_t h = half_edges[b];
             if (!collapse_eligible(buffer, h)) continue;
-            insert(h);
+            rate(h);
         }
     }
     for (int i = 0; i < found; ++i) {
         if (i > 0 && best[i].h == best[i - 1].h) continue;
-        if (collapse_valid(buffer, best[i].h, best[i].target)) {
-            apply_collapse(buffer, best[i].h, best[i].target);
+        const uint32_t h = best[i].h;
+        if (collapse_valid(buffer, h, best[i].target)) {
+            const uint32_t t = buffer.twin(h);
+            const uint32_t r = buffer.corner_vertex(prev_in_face(h));
+            const uint32_t s = is_half_edge(t) ? buffer.corner_vertex(prev_in_face(t)) : kNoIndex;
+            apply_collapse(buffer, h, best[i].target);
             if (memory != nullptr) {
                 // The next candidates in order (not yet checked against the topology).
                 for (int j = i + 1; j < found && memory->count < CandidateMemory::kCapacity; ++j)
-                    if (best[j].h != best[j - 1].h) memory->h[memory->count++] = best[j].h;
+                    if (best[j].h != best[j - 1].h) memory->entry[memory->count++] = best[j];
+                memory->edits = buffer.edits();
+                const uint32_t touched[4] = {best[i].p, best[i].q, r, s};
+                std::copy(touched, touched + 4, memory->touched);
             }
             return true;
         }

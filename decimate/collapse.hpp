@@ -90,14 +90,23 @@ bool moves_keep_faces_valid(const HalfEdgeBuffer& buffer, uint32_t v, const doub
 // candidate was found or none was valid (the caller decides whether that means "stalled").
 //
 // Beyond the paper: with `memory`, the runners-up of one call (the valid-looking candidates
-// that were not collapsed) are re-rated and compete again in the next call next to the fresh
-// draws, so that cheap collapses found once are not forgotten. That brings the choice closer
-// to Garland & Heckbert's greedy order at the cost of re-rating a few half-edges; still
-// deterministic for a seed.
+// that were not collapsed) compete again in the next call next to the fresh draws, so that
+// cheap collapses found once are not forgotten. That brings the choice closer to Garland &
+// Heckbert's greedy order; still deterministic for a seed. Their ratings are kept: when
+// nothing but the last collapse changed the buffer since (HalfEdgeBuffer::edits()), a
+// runner-up touching none of the vertices that collapse changed (p, q and the two opposite
+// corners) still has exactly the rating it had and is not re-rated; others are.
 struct CandidateMemory {
     static constexpr int kCapacity = 64;
-    uint32_t h[kCapacity];
+    struct Entry {
+        uint32_t h, p, q;
+        double error;
+        double target[3];
+    };
+    Entry entry[kCapacity];
     int count = 0;
+    uint64_t edits = 0;        // buffer.edits() right after the last collapse
+    uint32_t touched[4] = {};  // the vertices that collapse changed
 };
 bool decimate_once(HalfEdgeBuffer& buffer, Rng& rng, int candidates, CandidateMemory* memory = nullptr);
 

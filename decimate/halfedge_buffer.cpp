@@ -136,6 +136,7 @@ uint32_t HalfEdgeBuffer::alloc_vertex() {
 }
 
 void HalfEdgeBuffer::free_vertex(uint32_t v) {
+    ++edits_;
     Vertex& x = slots_[v].vertex;
     assert(x.face_count == 0 && (x.flags & kInHash) == 0);
     x.flags = 0;
@@ -254,6 +255,7 @@ void HalfEdgeBuffer::add_written_stub(uint32_t a, uint32_t b) {
 }
 
 HalfEdgeBuffer::Added HalfEdgeBuffer::add_triangle(const float tri[9], const size_t slots[3]) {
+    ++edits_;
     assert(!full() && free_vertex_count() >= 3);
     Added added;
     for (int k = 0; k < 3; ++k)
@@ -340,6 +342,7 @@ HalfEdgeBuffer::Added HalfEdgeBuffer::add_triangle(const float tri[9], const siz
 }
 
 void HalfEdgeBuffer::finalize_vertex(uint32_t v) {
+    ++edits_;
     Vertex& x = slots_[v].vertex;
     if ((x.flags & kInHash) == 0) return;
     // Its open edges are final now (no input reaches v any more): a true boundary. Add Garland
@@ -372,6 +375,7 @@ void HalfEdgeBuffer::finalize_vertex(uint32_t v) {
 }
 
 void HalfEdgeBuffer::freeze(uint32_t v, uint64_t id) {
+    ++edits_;
     Vertex& x = slots_[v].vertex;
     assert((x.flags & kFrozen) == 0);
     x.flags |= kFrozen;
@@ -406,6 +410,7 @@ void HalfEdgeBuffer::unlink_corner(uint32_t v, uint32_t c) {
 }
 
 void HalfEdgeBuffer::detach_face(uint32_t f) {
+    ++edits_;
     for (uint32_t k = 0; k < 3; ++k) unlink_corner(faces_[f].vertex[k], half_edge(f, k));
     live_.erase(f);
     interior_.erase(f);
@@ -414,6 +419,7 @@ void HalfEdgeBuffer::detach_face(uint32_t f) {
 }
 
 void HalfEdgeBuffer::move_corners(uint32_t p, uint32_t q) {
+    ++edits_;
     Vertex& from = slots_[p].vertex;
     const bool q_frozen = (slots_[q].vertex.flags & kFrozen) != 0;
     uint32_t c = from.first_corner;

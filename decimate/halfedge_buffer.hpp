@@ -233,6 +233,7 @@ public:
         slot.vertex.flags |= kHasPartner;
     }
     void set_position(uint32_t v, const double rel[3]) {
+        ++edits_;
         for (int i = 0; i < 3; ++i) slots_[v].vertex.pos[i] = float(rel[i] + origin_[i]);
     }
     // Rounds a relative position to what set_position() would store (float coordinates), so
@@ -252,6 +253,10 @@ public:
         return stamp_counter_;
     }
     uint32_t& stamp(uint32_t v) { return slots_[v].stamp; }
+
+    // Counts structural edits (reads, finalizations, writes, face removals, moves): equal
+    // counts mean nothing changed in between, so ratings computed then are still exact.
+    uint64_t edits() const { return edits_; }
 
     // Running counts for Stats.
     uint64_t vertices_merged() const { return vertices_merged_; }
@@ -305,6 +310,7 @@ private:
     size_t stub_mask_, stub_count_ = 0;
 
     uint64_t vertices_merged_ = 0, nonmanifold_edges_ = 0;
+    uint64_t edits_ = 0;
 };
 
 }  // namespace meshstream::decimate
