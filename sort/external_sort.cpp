@@ -1,6 +1,6 @@
 // External merge sort of triangle records (see external_sort.hpp for the contract). Runs live
 // as consecutive segments of one temporary file; a merge pass reads them through per-run
-// buffers that share the budget, picks the smallest (key, run number) with a binary heap, and
+// buffers that share the budget, picks the smallest (key, run number) with a loser tree, and
 // either fills output chunks (final pass) or appends to the next temporary file.
 #include "sort/external_sort.hpp"
 
@@ -61,7 +61,6 @@ struct ExternalSorter::Cursor {
     size_t capacity = 0;  // bytes, a multiple of the record size
     size_t pos = 0, len = 0;
     uint64_t block_offset = 0;  // file range of the buffered block, released once consumed
-    uint32_t key = 0;
     uint32_t run = 0;  // position among the merged runs: breaks key ties (stability)
 };
 
@@ -70,10 +69,12 @@ public:
     Merger(ExternalSorter& owner, io::TempFile& file, std::span<const Segment> segments, uint64_t buffer_budget)
         : owner_(owner), file_(file) {
         const size_t rb = owner.record_bytes_;
-        uint64_t per_run = std::min(kMaxReadBytes, buffer_budget / std::max<size_t>(1, segments.size()));
+        const size_t k = std::max<size_t>(1, segments.size());
+        uint64_t per_run = std::min(kMaxReadBytes, buffer_budget / k);
         size_t capacity = std::max<size_t>(1, per_run / rb) * rb;
         storage_.reset(new std::byte[capacity * segments.size()]);
-        cursors_.resize(segments.size());
+        cursors_.resize(k);
+        order_.assign(k, kExhausted);
         for (size_t i = 0; i < segments.size(); ++i) {
             Cursor& c = cursors_[i];
             c.next_offset = segments[i].offset;
@@ -81,40 +82,49 @@ public:
             c.buf = storage_.get() + i * capacity;
             c.capacity = capacity;
             c.run = static_cast<uint32_t>(i);
-            if (refill(c)) heap_.push_back(static_cast<uint32_t>(i));
+            if (refill(c)) order_[i] = rank(c);
         }
-        std::make_heap(heap_.begin(), heap_.end(), Greater{this});
+        // Loser tree (Knuth, TAOCP vol. 3, §5.4.1): leaf i sits at node k + i, node p's children
+        // are 2p and 2p + 1; each inner node keeps the loser of its match, tree_[0] the winner.
+        tree_.assign(k, 0);
+        std::vector<uint32_t> winner(2 * k);
+        for (size_t i = 0; i < k; ++i) winner[k + i] = static_cast<uint32_t>(i);
+        for (size_t p = k - 1; p >= 1; --p) {
+            uint32_t a = winner[2 * p], b = winner[2 * p + 1];
+            const bool a_wins = order_[a] < order_[b];
+            winner[p] = a_wins ? a : b;
+            tree_[p] = a_wins ? b : a;
+        }
+        tree_[0] = winner[1];
     }
 
     // The smallest remaining record (owner's record size), or null when all runs are consumed.
     const std::byte* top() const {
-        if (heap_.empty()) return nullptr;
-        const Cursor& c = cursors_[heap_.front()];
+        const uint32_t w = tree_[0];
+        if (order_[w] == kExhausted) return nullptr;
+        const Cursor& c = cursors_[w];
         return c.buf + c.pos;
     }
 
-    // Consumes top().
+    // Consumes top(): advances its run and replays the matches on the way to the root (one
+    // comparison per level, log2(k) in all, against a binary heap's ~2·log2(k)).
     void pop() {
-        std::pop_heap(heap_.begin(), heap_.end(), Greater{this});
-        Cursor& c = cursors_[heap_.back()];
+        uint32_t w = tree_[0];
+        Cursor& c = cursors_[w];
         c.pos += owner_.record_bytes_;
-        if (c.pos < c.len || refill(c)) {
-            c.key = key_at(c);
-            std::push_heap(heap_.begin(), heap_.end(), Greater{this});
-        } else {
-            heap_.pop_back();
+        order_[w] = (c.pos < c.len || refill(c)) ? rank(c) : kExhausted;
+        const size_t k = cursors_.size();
+        for (size_t p = (w + k) / 2; p >= 1; p /= 2) {
+            if (order_[tree_[p]] < order_[w]) std::swap(tree_[p], w);
         }
+        tree_[0] = w;
     }
 
 private:
-    struct Greater {
-        const Merger* m;
-        bool operator()(uint32_t a, uint32_t b) const {
-            const Cursor& x = m->cursors_[a];
-            const Cursor& y = m->cursors_[b];
-            return x.key != y.key ? x.key > y.key : x.run > y.run;
-        }
-    };
+    // A cursor's place in the merge order: its current key, ties broken by run number
+    // (stability). All real ranks are below kExhausted.
+    static constexpr uint64_t kExhausted = ~uint64_t{0};
+    uint64_t rank(const Cursor& c) const { return uint64_t{key_at(c)} << 32 | c.run; }
 
     uint32_t key_at(const Cursor& c) const {
         float xyz[9];
@@ -132,7 +142,6 @@ private:
         c.block_offset = c.next_offset;
         c.next_offset += n;
         c.len = n;
-        c.key = key_at(c);
         return true;
     }
 
@@ -140,7 +149,8 @@ private:
     io::TempFile& file_;
     std::unique_ptr<std::byte[]> storage_;
     std::vector<Cursor> cursors_;
-    std::vector<uint32_t> heap_;  // cursor indices; front = smallest (key, run)
+    std::vector<uint64_t> order_;  // rank of each cursor's current record, kExhausted when done
+    std::vector<uint32_t> tree_;   // loser tree over cursor indices; [0] = the winner
 };
 
 size_t ExternalSorter::record_bytes_for(const io::Channels& channels) {

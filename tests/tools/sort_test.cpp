@@ -296,3 +296,26 @@ TEST(SortCommand, FullDiskIsAClearErrorAndLeavesNothing) {
     EXPECT_EQ(left, 0u);
     EXPECT_FALSE(fs::exists(dir / "out.stl"));
 }
+
+// The output is written on its own thread: a write error there (here the output's disk is
+// full, runs on a disk with room) must stop the sort with the error and leave no output.
+TEST(SortCommand, FullOutputDiskIsAClearErrorAndLeavesNothing) {
+    TempDir dir;
+    write_stl(dir / "in.stl", random_triangles(100000, 9));  // 5 MB of binary STL out
+    fs::create_directory(dir / "small");
+    fs::create_directory(dir / "tmp");
+    if (std::system(("mount -t tmpfs -o size=1M tmpfs " + dir / "small" + " 2>/dev/null").c_str()) != 0)
+        GTEST_SKIP() << "cannot mount a small tmpfs here";
+    // --memory 1M: runs on disk and a multi-pass merge before the output fails; 64M: in memory.
+    for (const char* memory : {"1M", "64M"}) {
+        CliRun r = run(std::string("sort --axis z --memory ") + memory + " --tmpdir " + dir / "tmp" + " " +
+                           dir / "in.stl" + " " + dir / "small/out.stl",
+                       dir);
+        EXPECT_EQ(r.code, 1) << memory;
+        EXPECT_NE(r.err.find("out.stl"), std::string::npos) << r.err;
+        EXPECT_NE(r.err.find("No space left on device"), std::string::npos) << r.err;
+        EXPECT_EQ(file_count(dir / "small"), 0u) << memory;
+        EXPECT_EQ(file_count(dir / "tmp"), 0u) << memory;
+    }
+    std::system(("umount " + dir / "small").c_str());
+}
