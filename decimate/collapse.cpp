@@ -55,7 +55,9 @@ bool moves_keep_faces_valid(const HalfEdgeBuffer& buffer, uint32_t v, const doub
         const bool was_degenerate = old_len2 <= kMinShapeQuality * edges2 * edges2 || old_len2 == 0;
         if (was_degenerate) continue;  // nothing to preserve; do not let it block the mesh
         if (new_len2 <= kMinShapeQuality * edges2 * edges2) return false;
-        if (dot(n_old, n_new) <= kMinNormalCos * std::sqrt(old_len2 * new_len2)) return false;
+        // cos(turn) ≤ kMinNormalCos, without a square root.
+        const double d = dot(n_old, n_new);
+        if (d <= 0 || d * d <= kMinNormalCos * kMinNormalCos * old_len2 * new_len2) return false;
     }
     return true;
 }
@@ -262,20 +264,24 @@ void apply_collapse(HalfEdgeBuffer& buffer, uint32_t h, const double target[3]) 
 
 bool decimate_once(HalfEdgeBuffer& buffer, Rng& rng, int candidates, CandidateMemory* memory) {
     using Candidate = CandidateMemory::Entry;
-    constexpr int kMaxCandidates = 64;
+    constexpr int kMaxCandidates = CandidateMemory::kCapacity;
     const int wanted = std::clamp(candidates, 1, kMaxCandidates);
-    Candidate best[2 * kMaxCandidates];
-    int found = 0;
     const FaceSet& live = buffer.live_faces();
     const uint64_t size = live.size();
     if (size == 0) return false;
+    // Ratings go into a table; `order` sorts them by error (stable: ties keep rating order).
+    Candidate local[2 * kMaxCandidates];
+    Candidate* rated = memory != nullptr ? memory->table[memory->current ^ 1] : local;
+    uint8_t order[2 * kMaxCandidates];
+    int found = 0;
     auto insert = [&](const Candidate& c) {
-        int i = found++;
-        while (i > 0 && best[i - 1].error > c.error) {
-            best[i] = best[i - 1];
+        rated[found] = c;
+        int i = found;
+        while (i > 0 && rated[order[i - 1]].error > c.error) {
+            order[i] = order[i - 1];
             --i;
         }
-        best[i] = c;
+        order[i] = static_cast<uint8_t>(found++);
     };
     auto rate = [&](uint32_t h) {
         const CollapsePlacement placement = collapse_placement(buffer, h);
@@ -291,8 +297,9 @@ bool decimate_once(HalfEdgeBuffer& buffer, Rng& rng, int candidates, CandidateMe
             return v == memory->touched[0] || v == memory->touched[1] || v == memory->touched[2] ||
                    v == memory->touched[3];
         };
+        const Candidate* previous = memory->table[memory->current];
         for (int i = 0; i < memory->count && remembered < (wanted + 1) / 2; ++i) {
-            const Candidate& c = memory->entry[i];
+            const Candidate& c = previous[memory->runner_up[i]];
             if (!live.contains(face_of(c.h)) || !collapse_eligible(buffer, c.h)) continue;
             if (ratings_kept && buffer.corner_vertex(c.h) == c.p &&
                 buffer.corner_vertex(next_in_face(c.h)) == c.q && !changed(c.p) && !changed(c.q)) {
@@ -334,19 +341,20 @@ bool decimate_once(HalfEdgeBuffer& buffer, Rng& rng, int candidates, CandidateMe
         }
     }
     for (int i = 0; i < found; ++i) {
-        if (i > 0 && best[i].h == best[i - 1].h) continue;
-        const uint32_t h = best[i].h;
-        if (collapse_valid(buffer, h, best[i].target)) {
-            const uint32_t t = buffer.twin(h);
-            const uint32_t r = buffer.corner_vertex(prev_in_face(h));
+        const Candidate& c = rated[order[i]];
+        if (i > 0 && c.h == rated[order[i - 1]].h) continue;
+        if (collapse_valid(buffer, c.h, c.target)) {
+            const uint32_t t = buffer.twin(c.h);
+            const uint32_t r = buffer.corner_vertex(prev_in_face(c.h));
             const uint32_t s = is_half_edge(t) ? buffer.corner_vertex(prev_in_face(t)) : kNoIndex;
-            apply_collapse(buffer, h, best[i].target);
+            apply_collapse(buffer, c.h, c.target);
             if (memory != nullptr) {
                 // The next candidates in order (not yet checked against the topology).
+                memory->current ^= 1;
                 for (int j = i + 1; j < found && memory->count < CandidateMemory::kCapacity; ++j)
-                    if (best[j].h != best[j - 1].h) memory->entry[memory->count++] = best[j];
+                    if (rated[order[j]].h != rated[order[j - 1]].h) memory->runner_up[memory->count++] = order[j];
                 memory->edits = buffer.edits();
-                const uint32_t touched[4] = {best[i].p, best[i].q, r, s};
+                const uint32_t touched[4] = {c.p, c.q, r, s};
                 std::copy(touched, touched + 4, memory->touched);
             }
             return true;

@@ -103,7 +103,11 @@ struct CandidateMemory {
         double error;
         double target[3];
     };
-    Entry entry[kCapacity];
+    // Two rating tables used in turn: a call rates into one while the previous call's
+    // runners-up are read from the other (no copying).
+    Entry table[2][2 * kCapacity];
+    int current = 0;                // the table the last call rated into
+    uint8_t runner_up[kCapacity];   // its runners-up, best first
     int count = 0;
     uint64_t edits = 0;        // buffer.edits() right after the last collapse
     uint32_t touched[4] = {};  // the vertices that collapse changed
