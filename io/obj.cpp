@@ -4,6 +4,7 @@
 #include "io/obj.hpp"
 
 #include "io/error.hpp"
+#include "io/text_number.hpp"
 #include "io/vertex_table.hpp"
 #include "io/weld.hpp"
 
@@ -242,11 +243,6 @@ public:
     }
 
 private:
-    template <class N>
-    static void append_number(std::string& out, N v) {
-        char buf[32];
-        out.append(buf, std::to_chars(buf, buf + sizeof buf, v).ptr);  // shortest round-trip form
-    }
     void flush(std::string& out) {
         sink_.write(out);
         out.clear();

@@ -7,6 +7,7 @@
 #include "io/ply.hpp"
 
 #include "io/error.hpp"
+#include "io/text_number.hpp"
 #include "io/vertex_table.hpp"
 #include "io/weld.hpp"
 
@@ -672,11 +673,6 @@ public:
     }
 
 private:
-    template <class N>
-    static void append_number(std::string& out, N v) {
-        char buf[32];
-        out.append(buf, std::to_chars(buf, buf + sizeof buf, v).ptr);  // shortest round-trip form
-    }
     static void store_le(char* p, uint32_t v) {
         for (int i = 0; i < 4; ++i) p[i] = static_cast<char>((v >> (8 * i)) & 0xff);
     }
