@@ -2,6 +2,7 @@
 #include "io/mesh_index.hpp"
 
 #include "io/error.hpp"
+#include "io/hash.hpp"
 
 #include <cmath>
 #include <cstring>
@@ -12,16 +13,6 @@ namespace {
 
 constexpr uint32_t kEmpty = ~uint32_t{0};
 constexpr uint64_t kMaxIndexCount = 0xFFFFFFFFull;  // glTF/Draco: 32-bit index counts and values
-
-// Murmur3's 64-bit finaliser: spreads every input bit over the table index.
-inline uint64_t mix64(uint64_t h) {
-    h ^= h >> 33;
-    h *= 0xff51afd7ed558ccdull;
-    h ^= h >> 33;
-    h *= 0xc4ceb9fe1a85ec53ull;
-    h ^= h >> 33;
-    return h;
-}
 
 // Bits of a coordinate for welding; -0 and +0 weld (x + 0.0f turns -0 into +0).
 inline uint32_t weld_bits(float x) {

@@ -4,6 +4,7 @@
 
 #include "io/byte_stream.hpp"
 #include "io/error.hpp"
+#include "io/hash.hpp"
 #include "io/record_sort.hpp"
 
 #include <algorithm>
@@ -14,15 +15,6 @@
 
 namespace meshstream::io {
 namespace {
-
-uint64_t mix64(uint64_t h) {  // MurmurHash3's fmix64
-    h ^= h >> 33;
-    h *= 0xff51afd7ed558ccdULL;
-    h ^= h >> 33;
-    h *= 0xc4ceb9fe1a85ec53ULL;
-    h ^= h >> 33;
-    return h;
-}
 
 uint32_t position_bits(float f) {
     uint32_t b = std::bit_cast<uint32_t>(f);
