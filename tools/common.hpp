@@ -81,8 +81,10 @@ private:
     std::map<std::string, uint64_t> counts_;
 };
 
-// "1.23 M" style numbers and "12.3 MB" sizes for summaries.
-std::string human_count(double n);
+// "1.23 M" style numbers and "12.3 MB" sizes for summaries. human_count prints n below 10^4
+// as an integer, above it scaled to k, M or G with a fixed number of decimals ("12.3 k",
+// "1.23 M"), or, when `significant_digits` > 0, with that many significant digits ("500 k").
+std::string human_count(double n, int significant_digits = 0);
 std::string human_bytes(double bytes);
 // Peak resident set size of this process in bytes (from /proc/self/status VmHWM).
 uint64_t peak_rss_bytes();

@@ -6,6 +6,7 @@
 
 #include "io/error.hpp"
 #include "sort/radix.hpp"
+#include "tools/common.hpp"
 
 #include <algorithm>
 #include <cassert>
@@ -35,15 +36,6 @@ uint32_t canonical_bits(float f) {
     uint32_t u;
     std::memcpy(&u, &f, sizeof u);
     return u;
-}
-
-std::string short_count(double n) {
-    char buf[32];
-    if (n >= 1e9) std::snprintf(buf, sizeof buf, "%.3g G", n / 1e9);
-    else if (n >= 1e6) std::snprintf(buf, sizeof buf, "%.3g M", n / 1e6);
-    else if (n >= 1e4) std::snprintf(buf, sizeof buf, "%.3g k", n / 1e3);
-    else std::snprintf(buf, sizeof buf, "%.0f", n);
-    return buf;
 }
 
 const char* const kAxisNames[] = {"x", "y", "z"};
@@ -255,7 +247,7 @@ std::optional<OrderReport> measure_file_order(const std::string& path, std::stri
 std::optional<std::string> sorting_hint(const OrderReport& report, uint64_t buffer_triangles) {
     if (buffer_verdict(report, buffer_triangles) == BufferVerdict::kSuffices) return std::nullopt;
     const int axis = report.best_axis();
-    std::string width = short_count(static_cast<double>(report.width)) + " triangles";
+    std::string width = human_count(static_cast<double>(report.width), 3) + " triangles";
     if (report.descents[axis] == 0)
         return "the input is already sorted along " + std::string(kAxisNames[axis]) + " but its width is " + width +
                "; a --buffer of at least that would avoid forced writes";
