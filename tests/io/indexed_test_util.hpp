@@ -68,6 +68,17 @@ inline Soup read_soup(const std::string& path, size_t capacity = io::TriangleChu
     return s;
 }
 
+// The io::Error that reading `path` throws; a test failure (and a placeholder error) if none.
+inline io::Error read_error(const std::string& path) {
+    try {
+        read_soup(path);
+    } catch (const io::Error& e) {
+        return e;
+    }
+    ADD_FAILURE() << path << ": no io::Error";
+    return io::Error(path, "no error");
+}
+
 // Writes `xyz` (9 floats a triangle), in chunks of `capacity`, as format `to` (empty: by name).
 inline void write_soup(const std::string& path, const std::vector<float>& xyz, std::string_view to = {},
                        io::WriteOptions options = {}, size_t capacity = 1000) {

@@ -9,22 +9,9 @@
 
 using namespace meshstream;
 using test::fixture;
+using test::read_error;
 using test::read_soup;
 using test::TempDir;
-
-namespace {
-
-io::Error read_error(const std::string& path) {
-    try {
-        read_soup(path);
-    } catch (const io::Error& e) {
-        return e;
-    }
-    ADD_FAILURE() << path << ": no io::Error";
-    return io::Error(path, "no error");
-}
-
-}  // namespace
 
 TEST(ObjReader, ReadsCorpusFixturesWithManifestCounts) {
     const std::pair<const char*, size_t> cases[] = {

@@ -12,6 +12,7 @@
 
 using namespace meshstream;
 using test::fixture;
+using test::read_error;
 using test::read_soup;
 using test::TempDir;
 
@@ -39,16 +40,6 @@ std::string to_big_endian(const std::string& le) {
         for (int k = 0; k < 3; ++k) swap4(p + 1 + 4 * k);
     EXPECT_EQ(p, body.size());
     return header + body;
-}
-
-io::Error read_error(const std::string& path) {
-    try {
-        read_soup(path);
-    } catch (const io::Error& e) {
-        return e;
-    }
-    ADD_FAILURE() << path << ": no io::Error";
-    return io::Error(path, "no error");
 }
 
 }  // namespace
