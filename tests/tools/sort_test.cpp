@@ -3,6 +3,7 @@
 // stdin→stdout, multi-pass merging, and temporary files gone after success, failure and SIGINT.
 #include "io/format.hpp"
 #include "sort/radix.hpp"
+#include "tools/cli_util.hpp"
 
 #include <gtest/gtest.h>
 
@@ -27,15 +28,8 @@ using Tri = std::array<float, 9>;
 
 namespace {
 
-struct TempDir {
-    fs::path path;
-    TempDir() {
-        std::string pattern = (fs::temp_directory_path() / "sort_cli_test-XXXXXX").string();
-        path = ::mkdtemp(pattern.data());
-    }
-    ~TempDir() { fs::remove_all(path); }
-    std::string operator/(const std::string& name) const { return (path / name).string(); }
-};
+using cli_test::slurp;
+using cli_test::TempDir;
 
 size_t file_count(const std::string& dir) {
     return static_cast<size_t>(std::distance(fs::directory_iterator(dir), {}));
@@ -50,10 +44,6 @@ struct CliRun {
 CliRun run(const std::string& args, const TempDir& dir) {
     std::string cmd = std::string(MESHSTREAM_BINARY) + " -q " + args + " > " + dir / "stdout.txt" + " 2> " + dir / "stderr.txt";
     int status = std::system(cmd.c_str());
-    auto slurp = [](const std::string& p) {
-        std::ifstream in(p, std::ios::binary);
-        return std::string((std::istreambuf_iterator<char>(in)), {});
-    };
     CliRun r{WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(dir / "stdout.txt"), slurp(dir / "stderr.txt")};
     fs::remove(dir / "stdout.txt");
     fs::remove(dir / "stderr.txt");
