@@ -16,7 +16,7 @@
 # Env:   SIZES="10000000 50000000"  WORK=/tmp/meshstream-bench-sort  GNU_SORT_LINES=1000000
 #        REPEAT=3: runs of cat and of each meshstream sort; the row shows the run with the median
 #        wall time (its CPU, RSS and temp disk beside it).
-#        KEEP=1 keeps the generated files.
+#        KEEP=1 keeps the generated files.  DECIMATE=0 skips the decimation comparison.
 set -euo pipefail
 
 here="$(cd "$(dirname "$0")/.." && pwd)"
@@ -117,7 +117,7 @@ PY
 
     "$ms" -q info --order "$work/shuffled.stl" | grep -E "width|buffer" | sed 's/^/           shuffled /'
     "$ms" -q info --order "$work/sorted.stl" | grep -E "width|buffer" | sed 's/^/           sorted   /'
-    if "$ms" decimate --help > /dev/null 2>&1; then
+    if [[ "${DECIMATE:-1}" != 0 ]] && "$ms" decimate --help > /dev/null 2>&1; then
         for f in orig sorted; do
             echo "           decimate 10% of $f.stl:"
             "$ms" -q decimate --ratio 0.1 --report "$work/$f.stl" "$work/dec.stl" 2>&1 | sed 's/^/             /' || true
