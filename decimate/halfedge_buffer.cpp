@@ -2,6 +2,8 @@
 // and the bookkeeping of the boundary polygons P_in and P_out (§4).
 #include "decimate/halfedge_buffer.hpp"
 
+#include "io/hash.hpp"
+
 #include <bit>
 #include <cassert>
 #include <cmath>
@@ -37,14 +39,7 @@ namespace {
 
 size_t pow2_at_least(size_t n) { return std::bit_ceil(n < 16 ? size_t{16} : n); }
 
-uint64_t mix64(uint64_t x) {
-    x ^= x >> 33;
-    x *= 0xff51afd7ed558ccdull;
-    x ^= x >> 33;
-    x *= 0xc4ceb9fe1a85ec53ull;
-    x ^= x >> 33;
-    return x;
-}
+using io::mix64;
 
 uint32_t float_key(float x) {
     if (x == 0.0f) x = 0.0f;  // −0 welds with +0
