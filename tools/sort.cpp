@@ -113,7 +113,8 @@ private:
 
 // Runs `body` on a thread that is stopped (pipe.stop()) and joined when this goes out of
 // scope, so an exception on the main thread never leaves the worker running. `body` must
-// catch its own exceptions (into pipe.fail()).
+// catch its own exceptions (into pipe.fail()). A worker blocked in a read (a quiet stdin)
+// is joined once that read returns; SIGINT ends the process at once as before.
 class PipeWorker {
 public:
     template <class F>
