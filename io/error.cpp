@@ -9,9 +9,17 @@ namespace {
 std::string format_what(const std::string& file, uint64_t byte_offset, uint64_t line,
                         const std::string& message) {
     std::string out = file.empty() ? std::string("<input>") : file;
-    if (line != 0) out += ":" + std::to_string(line);
-    if (byte_offset != Error::kNoOffset) out += ": byte " + std::to_string(byte_offset);
-    out += ": " + message;
+    // Appended piece by piece: `"literal" + std::string` trips GCC 12's -Wrestrict here.
+    if (line != 0) {
+        out += ':';
+        out += std::to_string(line);
+    }
+    if (byte_offset != Error::kNoOffset) {
+        out += ": byte ";
+        out += std::to_string(byte_offset);
+    }
+    out += ": ";
+    out += message;
     return out;
 }
 
