@@ -70,16 +70,20 @@ CollapsePlacement collapse_placement(const HalfEdgeBuffer& buffer, uint32_t h) {
     out.error = sum.error(out.target);
     out.moves_target = false;
     if (!collapse_target_free(buffer, h)) return out;
-    double x[3];
-    if (sum.minimum(x)) {
-        buffer.round_position(x);
-        const double e = sum.error(x);
-        // Round-off can put the rounded optimum a hair above an end point: keep the smaller.
+    // Takes y when its error is below the best so far (round-off can put the rounded optimum
+    // a hair above an end point: the smaller wins).
+    auto consider = [&](const double y[3]) {
+        const double e = sum.error(y);
         if (e < out.error) {
-            for (int i = 0; i < 3; ++i) out.target[i] = x[i];
+            for (int i = 0; i < 3; ++i) out.target[i] = y[i];
             out.error = e;
             out.moves_target = true;
         }
+    };
+    double x[3];
+    if (sum.minimum(x)) {
+        buffer.round_position(x);
+        consider(x);
         return out;
     }
     // Singular (flat or cylindrical neighbourhood): the best of p, q and the midpoint, as
@@ -88,14 +92,8 @@ CollapsePlacement collapse_placement(const HalfEdgeBuffer& buffer, uint32_t h) {
     buffer.position(p, a);
     for (int i = 0; i < 3; ++i) mid[i] = 0.5 * (a[i] + out.target[i]);
     buffer.round_position(mid);
-    for (const double* y : {static_cast<const double*>(a), static_cast<const double*>(mid)}) {
-        const double e = sum.error(y);
-        if (e < out.error) {
-            for (int i = 0; i < 3; ++i) out.target[i] = y[i];
-            out.error = e;
-            out.moves_target = true;
-        }
-    }
+    consider(a);
+    consider(mid);
     return out;
 }
 
