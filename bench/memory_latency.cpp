@@ -1,0 +1,86 @@
+// Random-access cost of this machine's memory, for reading the decimator's profile: the
+// in-core buffer (about 60 MB at the default 400 000 triangles) is read at random, so what a
+// cache line costs there decides how fast a collapse can be. For each working-set size, a
+// pointer chase through randomly ordered 64-byte lines (each load waits for the one before:
+// the latency) and eight independent chases in lockstep (the loads overlap: the cost per line
+// when misses are issued together, as the decimator's batched prefetches do).
+//
+//   memory_latency [MiB...]        default sizes: 1 2 4 16 64 256
+#include <algorithm>
+#include <chrono>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <numeric>
+#include <random>
+#include <vector>
+
+#ifdef __linux__
+#include <sys/mman.h>
+#endif
+
+namespace {
+
+struct alignas(64) Line {
+    uint64_t next;
+    char pad[56];
+};
+
+double ns_per_step(std::chrono::steady_clock::time_point t0, size_t steps) {
+    return std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - t0).count() /
+           double(steps);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    std::vector<size_t> sizes;
+    for (int i = 1; i < argc; ++i) {
+        char* end = nullptr;
+        const unsigned long mib = std::strtoul(argv[i], &end, 10);
+        if (end == argv[i] || *end != '\0' || mib == 0 || mib > 65536) {
+            std::fprintf(stderr, "memory_latency: '%s' is not a size in MiB (1..65536)\n", argv[i]);
+            return 2;
+        }
+        sizes.push_back(mib);
+    }
+    if (sizes.empty()) sizes = {1, 2, 4, 16, 64, 256};
+    std::printf("working set   dependent loads   8 chains in lockstep\n");
+    for (const size_t mib : sizes) {
+        const size_t n = mib * (size_t{1} << 20) / sizeof(Line);
+        // 2 MiB aligned and advised as huge pages, like the decimator's pools (so that TLB
+        // misses do not count twice).
+        constexpr size_t kHuge = size_t{2} << 20;
+        const size_t bytes = (n * sizeof(Line) + kHuge - 1) / kHuge * kHuge;
+        auto* lines = static_cast<Line*>(std::aligned_alloc(kHuge, bytes));
+        if (lines == nullptr) {
+            std::fprintf(stderr, "memory_latency: cannot allocate %zu MiB\n", mib);
+            return 1;
+        }
+#ifdef __linux__
+        madvise(lines, bytes, MADV_HUGEPAGE);
+#endif
+        std::vector<uint64_t> order(n);
+        std::iota(order.begin(), order.end(), uint64_t{0});
+        std::shuffle(order.begin(), order.end(), std::mt19937_64(1));
+        for (size_t i = 0; i < n; ++i) lines[order[i]].next = order[(i + 1) % n];
+
+        const size_t steps = 20'000'000;
+        uint64_t p = order[0];
+        auto t0 = std::chrono::steady_clock::now();
+        for (size_t i = 0; i < steps; ++i) p = lines[p].next;
+        const double dependent = ns_per_step(t0, steps);
+
+        uint64_t q[8];
+        for (int k = 0; k < 8; ++k) q[k] = order[(k * n) / 8];
+        t0 = std::chrono::steady_clock::now();
+        for (size_t i = 0; i < steps / 8; ++i)
+            for (int k = 0; k < 8; ++k) q[k] = lines[q[k]].next;
+        const double parallel = ns_per_step(t0, steps);
+        // Printing the end points keeps the chases from being optimized away.
+        std::printf("%6zu MiB     %7.1f ns         %7.1f ns per line   (%llu)\n", mib, dependent, parallel,
+                    static_cast<unsigned long long>((p ^ q[0] ^ q[7]) & 1));
+        std::free(lines);
+    }
+    return 0;
+}
