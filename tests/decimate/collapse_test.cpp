@@ -22,12 +22,13 @@ std::set<uint32_t> neighbours(const HalfEdgeBuffer& buffer, uint32_t v) {
     return n;
 }
 
-// A 5×5 vertex grid (32 triangles) on a gentle bump, rows in reading order.
-void add_grid(HalfEdgeBuffer& buffer) {
+// A 5×5 vertex grid (32 triangles) on a bump of height `bump` at the rim (0: flat), rows in
+// reading order.
+void add_grid(HalfEdgeBuffer& buffer, float bump = 0.1f) {
     std::vector<std::array<float, 3>> points;
     for (int y = 0; y < 5; ++y)
         for (int x = 0; x < 5; ++x)
-            points.push_back({float(x), float(y), 0.1f * float((x - 2) * (x - 2) + (y - 2) * (y - 2))});
+            points.push_back({float(x), float(y), bump * float((x - 2) * (x - 2) + (y - 2) * (y - 2))});
     std::vector<std::array<int, 3>> faces;
     for (int y = 0; y < 4; ++y)
         for (int x = 0; x < 4; ++x) {
@@ -199,17 +200,7 @@ TEST(Collapse, HoleBoundaryCollapsesAlongItsEdgeAndBoundaryPlanesPriceCorners) {
     // A flat 5×5 grid: face quadrics vanish on the plane, so every error comes from the
     // boundary planes added when the rim left P_in.
     HalfEdgeBuffer buffer(64, 0);
-    std::vector<std::array<float, 3>> points;
-    for (int y = 0; y < 5; ++y)
-        for (int x = 0; x < 5; ++x) points.push_back({float(x), float(y), 0});
-    std::vector<std::array<int, 3>> faces;
-    for (int y = 0; y < 4; ++y)
-        for (int x = 0; x < 4; ++x) {
-            const int a = 5 * y + x;
-            faces.push_back({a, a + 1, a + 6});
-            faces.push_back({a, a + 6, a + 5});
-        }
-    add_indexed(buffer, points, faces);
+    add_grid(buffer, 0.0f);
     const uint32_t mid = vertex_at(buffer, {2, 0, 0}), right = vertex_at(buffer, {3, 0, 0});
     const uint32_t corner = vertex_at(buffer, {0, 0, 0}), next = vertex_at(buffer, {1, 0, 0});
     // On P_in, the rim never collapses.

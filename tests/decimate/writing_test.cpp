@@ -6,8 +6,37 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
+
 using namespace meshstream::decimate;
 using namespace meshstream::decimate::test;
+
+namespace {
+
+// The octahedron in a buffer, and its top vertex (0, 0, 1).
+struct Octahedron {
+    HalfEdgeBuffer buffer{64, 0};
+    uint32_t top;
+    Octahedron() {
+        add_indexed(buffer, octahedron_points(), octahedron_faces());
+        top = vertex_at(buffer, {0, 0, 1});
+    }
+    // The quadric of the plane through three points, in the coordinates the buffer keeps
+    // quadrics in (relative to its origin, the first vertex read).
+    Quadric plane(std::array<double, 3> a, std::array<double, 3> b, std::array<double, 3> c) const {
+        double rel[3];
+        buffer.position(top, rel);
+        for (int i = 0; i < 3; ++i) {
+            const double origin = double(buffer.vertex(top).pos[i]) - rel[i];
+            a[i] -= origin;
+            b[i] -= origin;
+            c[i] -= origin;
+        }
+        return Quadric::from_triangle(a.data(), b.data(), c.data());
+    }
+};
+
+}  // namespace
 
 TEST(Writing, WriteFreezesVerticesAndOpensPout) {
     HalfEdgeBuffer buffer(64, 0);
@@ -63,19 +92,13 @@ TEST(Writing, PrefersFacesWhoseCornersAreAlreadyWritten) {
 }
 
 TEST(Writing, VertexMovesToItsQuadricMinimumOnce) {
-    HalfEdgeBuffer buffer(64, 0);
-    add_indexed(buffer, octahedron_points(), octahedron_faces());
-    const uint32_t top = vertex_at(buffer, {0, 0, 1});
-    // Quadrics live in coordinates relative to the buffer's origin (the first vertex read).
-    double rel[3];
-    buffer.position(top, rel);
-    const double o[3] = {0 - rel[0], 0 - rel[1], 1 - rel[2]};
+    Octahedron oct;
+    HalfEdgeBuffer& buffer = oct.buffer;
+    const uint32_t top = oct.top;
     // Give the top vertex a quadric whose minimum is (0.1, -0.1, 0.9): three planes.
-    const double a[3] = {0.1 - o[0], -o[1], -o[2]}, b[3] = {0.1 - o[0], 1 - o[1], -o[2]}, c[3] = {0.1 - o[0], -o[1], 1 - o[2]};
-    const double d[3] = {-o[0], -0.1 - o[1], -o[2]}, e[3] = {-o[0], -0.1 - o[1], 1 - o[2]}, f[3] = {1 - o[0], -0.1 - o[1], -o[2]};
-    const double g[3] = {-o[0], -o[1], 0.9 - o[2]}, h[3] = {1 - o[0], -o[1], 0.9 - o[2]}, i[3] = {-o[0], 1 - o[1], 0.9 - o[2]};
-    buffer.quadric(top) = Quadric::from_triangle(a, b, c) + Quadric::from_triangle(d, e, f) +
-                          Quadric::from_triangle(g, h, i);
+    buffer.quadric(top) = oct.plane({0.1, 0, 0}, {0.1, 1, 0}, {0.1, 0, 1}) +
+                          oct.plane({0, -0.1, 0}, {0, -0.1, 1}, {1, -0.1, 0}) +
+                          oct.plane({0, 0, 0.9}, {1, 0, 0.9}, {0, 1, 0.9});
     ASSERT_TRUE(place_vertex(buffer, top));
     EXPECT_FLOAT_EQ(buffer.vertex(top).pos[0], 0.1f);
     EXPECT_FLOAT_EQ(buffer.vertex(top).pos[1], -0.1f);
@@ -85,9 +108,9 @@ TEST(Writing, VertexMovesToItsQuadricMinimumOnce) {
 }
 
 TEST(Writing, FarOrSingularOptimumKeepsThePosition) {
-    HalfEdgeBuffer buffer(64, 0);
-    add_indexed(buffer, octahedron_points(), octahedron_faces());
-    const uint32_t top = vertex_at(buffer, {0, 0, 1});
+    Octahedron oct;
+    HalfEdgeBuffer& buffer = oct.buffer;
+    const uint32_t top = oct.top;
     const double a[3] = {0, 0, 9}, b[3] = {1, 0, 9}, c[3] = {0, 1, 9};  // only the plane z = 9
     buffer.quadric(top) = Quadric::from_triangle(a, b, c);
     EXPECT_FALSE(place_vertex(buffer, top));  // singular
@@ -99,15 +122,11 @@ TEST(Writing, FarOrSingularOptimumKeepsThePosition) {
 }
 
 TEST(Writing, SingularQuadricFallsBackToTheBestEndOfTheCollapsedEdge) {
-    HalfEdgeBuffer buffer(64, 0);
-    add_indexed(buffer, octahedron_points(), octahedron_faces());
-    const uint32_t top = vertex_at(buffer, {0, 0, 1});
-    double rel[3];
-    buffer.position(top, rel);
-    const double o[3] = {0 - rel[0], 0 - rel[1], 1 - rel[2]};
+    Octahedron oct;
+    HalfEdgeBuffer& buffer = oct.buffer;
+    const uint32_t top = oct.top;
     // Only the plane z = 0.9: singular (no unique minimum).
-    const double a[3] = {-o[0], -o[1], 0.9 - o[2]}, b[3] = {1 - o[0], -o[1], 0.9 - o[2]}, c[3] = {-o[0], 1 - o[1], 0.9 - o[2]};
-    buffer.quadric(top) = Quadric::from_triangle(a, b, c);
+    buffer.quadric(top) = oct.plane({0, 0, 0.9}, {1, 0, 0.9}, {0, 1, 0.9});
     // Nothing collapsed into it: no fallback, it stays.
     EXPECT_FALSE(place_vertex(buffer, top));
     // As if p = (0.05, 0, 0.9) had been collapsed into it: p lies on the plane (error 0),
@@ -121,15 +140,11 @@ TEST(Writing, SingularQuadricFallsBackToTheBestEndOfTheCollapsedEdge) {
 }
 
 TEST(Writing, SingularFallbackNeverTakesAWorseEnd) {
-    HalfEdgeBuffer buffer(64, 0);
-    add_indexed(buffer, octahedron_points(), octahedron_faces());
-    const uint32_t top = vertex_at(buffer, {0, 0, 1});
-    double rel[3];
-    buffer.position(top, rel);
-    const double o[3] = {0 - rel[0], 0 - rel[1], 1 - rel[2]};
+    Octahedron oct;
+    HalfEdgeBuffer& buffer = oct.buffer;
+    const uint32_t top = oct.top;
     // The plane z = 1 through the vertex itself: its old position already has error 0.
-    const double a[3] = {-o[0], -o[1], 1 - o[2]}, b[3] = {1 - o[0], -o[1], 1 - o[2]}, c[3] = {-o[0], 1 - o[1], 1 - o[2]};
-    buffer.quadric(top) = Quadric::from_triangle(a, b, c);
+    buffer.quadric(top) = oct.plane({0, 0, 1}, {1, 0, 1}, {0, 1, 1});
     const float far_end[3] = {0.0f, 0.0f, 0.8f};
     buffer.set_partner(top, far_end);
     EXPECT_FALSE(place_vertex(buffer, top));
