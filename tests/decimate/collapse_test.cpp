@@ -22,7 +22,7 @@ std::set<uint32_t> neighbours(const HalfEdgeBuffer& buffer, uint32_t v) {
     return n;
 }
 
-// A 5×5 vertex grid (32 triangles) on a bump of height `bump` at the rim (0: flat), rows in
+// A 5×5 vertex grid (32 triangles) on the bowl z = bump·((x−2)² + (y−2)²) (0: flat), rows in
 // reading order.
 void add_grid(HalfEdgeBuffer& buffer, float bump = 0.1f) {
     std::vector<std::array<float, 3>> points;
