@@ -5,6 +5,7 @@
 #include "tools/order.hpp"
 
 #include "io/error.hpp"
+#include "io/hash.hpp"
 #include "sort/radix.hpp"
 #include "tools/common.hpp"
 
@@ -19,14 +20,7 @@ namespace {
 
 constexpr uint64_t kMinBudgetBytes = uint64_t{1} << 20;
 
-uint64_t mix64(uint64_t x) {  // splitmix64's finaliser
-    x ^= x >> 30;
-    x *= 0xBF58476D1CE4E5B9ull;
-    x ^= x >> 27;
-    x *= 0x94D049BB133111EBull;
-    x ^= x >> 31;
-    return x;
-}
+using io::mix64;
 
 // Position bits with -0 folded into +0 and every NaN into one pattern, so equal positions
 // (as floats) are one vertex.
