@@ -108,11 +108,14 @@ private:
 constexpr int kMaxTempPaths = 128;
 constexpr size_t kMaxPathBytes = 1024;
 char g_temp_paths[kMaxTempPaths][kMaxPathBytes];
-std::atomic<bool> g_temp_used[kMaxTempPaths];
+// A slot is claimed (kTempClaimed) before its path is copied in and published (kTempReady)
+// after, so neither a second thread nor the signal handler ever sees a half-written path.
+enum : uint8_t { kTempFree, kTempClaimed, kTempReady };
+std::atomic<uint8_t> g_temp_state[kMaxTempPaths];
 
 extern "C" void cleanup_and_reraise(int sig) {
     for (int i = 0; i < kMaxTempPaths; ++i)
-        if (g_temp_used[i].load()) ::unlink(g_temp_paths[i]);
+        if (g_temp_state[i].load() == kTempReady) ::unlink(g_temp_paths[i]);
     std::signal(sig, SIG_DFL);
     std::raise(sig);
 }
@@ -153,17 +156,18 @@ std::string make_temp(std::string pattern, int* fd, const std::string& what) {
 int register_temp_path(const std::string& path) {
     if (path.size() >= kMaxPathBytes) return -1;
     for (int i = 0; i < kMaxTempPaths; ++i) {
-        bool expected = false;
-        if (!g_temp_used[i].load() ) {
+        uint8_t expected = kTempFree;
+        if (g_temp_state[i].compare_exchange_strong(expected, kTempClaimed)) {
             std::memcpy(g_temp_paths[i], path.c_str(), path.size() + 1);
-            if (g_temp_used[i].compare_exchange_strong(expected, true)) return i;
+            g_temp_state[i].store(kTempReady);
+            return i;
         }
     }
     return -1;  // table full: the file is still removed by its destructor
 }
 
 void unregister_temp_path(int slot) {
-    if (slot >= 0) g_temp_used[slot].store(false);
+    if (slot >= 0) g_temp_state[slot].store(kTempFree);
 }
 
 void install_cleanup_handlers() {
@@ -319,7 +323,7 @@ std::unique_ptr<ByteSink> ByteSink::open(const std::string& path, const SinkOpti
         if (::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode)) throw Error(path, "is a directory");
         sink->temp_path_ = make_temp(path + ".tmp-XXXXXX", &sink->fd_, path);
         ::fchmod(sink->fd_, default_file_mode());
-        register_temp_path(sink->temp_path_);
+        sink->temp_slot_ = register_temp_path(sink->temp_path_);
     }
     if (options.gzip_level >= 0) {
         sink->gz_ = std::make_unique<Gzip>();
@@ -336,8 +340,7 @@ ByteSink::~ByteSink() {
     if (!temp_path_.empty()) {
         if (fd_ >= 0) ::close(fd_);
         if (!committed_) ::unlink(temp_path_.c_str());
-        for (int i = 0; i < kMaxTempPaths; ++i)
-            if (g_temp_used[i].load() && temp_path_ == g_temp_paths[i]) unregister_temp_path(i);
+        unregister_temp_path(temp_slot_);
     }
 }
 
@@ -430,15 +433,14 @@ TempFile::TempFile(const std::string& dir, const std::string& stem) {
         d = env && *env ? env : "/tmp";
     }
     path_ = make_temp(d + "/" + stem + "-XXXXXX", &fd_, d);
-    register_temp_path(path_);
+    slot_ = register_temp_path(path_);
     buf_.reserve(size_t{1} << 20);
 }
 
 TempFile::~TempFile() {
     if (fd_ >= 0) ::close(fd_);
     ::unlink(path_.c_str());
-    for (int i = 0; i < kMaxTempPaths; ++i)
-        if (g_temp_used[i].load() && path_ == g_temp_paths[i]) unregister_temp_path(i);
+    unregister_temp_path(slot_);
 }
 
 void TempFile::write(const void* data, size_t n) {

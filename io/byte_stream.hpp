@@ -115,6 +115,7 @@ private:
 
     std::string name_;       // the target path as given
     std::string temp_path_;  // empty for stdout
+    int temp_slot_ = -1;     // register_temp_path() slot
     int fd_ = -1;
     bool committed_ = false;
     struct Gzip;
@@ -144,12 +145,14 @@ public:
 
 private:
     std::string path_;
+    int slot_ = -1;  // register_temp_path() slot
     int fd_ = -1;
     uint64_t offset_ = 0;
     std::vector<std::byte> buf_;
 };
 
-// Registers a path to unlink if the process is interrupted; returns a slot for unregister.
+// Registers a path to unlink if the process is interrupted; returns a slot for unregister
+// (-1 when the table is full or the path too long). Thread-safe.
 int register_temp_path(const std::string& path);
 void unregister_temp_path(int slot);
 // Installs SIGINT/SIGTERM/SIGHUP handlers that unlink every registered path, then re-raise,

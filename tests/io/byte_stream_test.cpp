@@ -9,11 +9,18 @@
 
 #include <gtest/gtest.h>
 
+#include <csignal>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <limits>
+#include <memory>
+#include <thread>
+#include <vector>
+
+#include <sys/wait.h>
+#include <unistd.h>
 
 namespace io = meshstream::io;
 namespace fs = std::filesystem;
@@ -297,6 +304,38 @@ TEST_F(ByteStreamTest, TempFileWritesReadsAndRemovesItself) {
         EXPECT_THROW(temp.read_at(data.size(), back.data(), 50), io::Error);
     }
     EXPECT_FALSE(fs::exists(file_path));
+}
+
+// Temporary files created from several threads at once are all registered under their own
+// path: an interrupt removes every one of them (the signal handler unlinks the registered
+// paths, then dies of the signal).
+TEST_F(ByteStreamTest, InterruptRemovesTempFilesCreatedConcurrently) {
+    constexpr int kThreads = 4, kFilesPerThread = 24;
+    const pid_t pid = ::fork();
+    ASSERT_GE(pid, 0);
+    if (pid == 0) {
+        io::install_cleanup_handlers();
+        std::vector<std::unique_ptr<io::TempFile>> files[kThreads];
+        std::vector<std::thread> threads;
+        for (int t = 0; t < kThreads; ++t)
+            threads.emplace_back([&, t] {
+                for (int i = 0; i < kFilesPerThread; ++i)
+                    files[t].push_back(std::make_unique<io::TempFile>(dir_.string(), "spill"));
+            });
+        for (std::thread& t : threads) t.join();
+        std::raise(SIGTERM);
+        std::_Exit(3);  // not reached: SIGTERM's default action ends the process
+    }
+    int status = 0;
+    ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+    ASSERT_TRUE(WIFSIGNALED(status)) << "child exited with status " << WEXITSTATUS(status);
+    EXPECT_EQ(WTERMSIG(status), SIGTERM);
+    int left = 0;
+    for (const auto& entry : fs::directory_iterator(dir_)) {
+        ADD_FAILURE() << "left behind: " << entry.path();
+        ++left;
+    }
+    EXPECT_EQ(left, 0);
 }
 
 // A binary STL of `count` synthetic facets that is never stored: bytes are computed from their
