@@ -4,8 +4,11 @@
 // simplifier and Garland & Heckbert's implementation.
 #include "decimate/collapse.hpp"
 
+#include "decimate/phase_timers.hpp"
+
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 namespace meshstream::decimate {
 namespace {
@@ -63,6 +66,7 @@ bool moves_keep_faces_valid(const HalfEdgeBuffer& buffer, uint32_t v, const doub
 }
 
 CollapsePlacement collapse_placement(const HalfEdgeBuffer& buffer, uint32_t h) {
+    const PhaseTimer timer(Phase::kRate);
     const uint32_t p = buffer.corner_vertex(h), q = buffer.corner_vertex(next_in_face(h));
     const Quadric sum = buffer.quadric(p) + buffer.quadric(q);
     CollapsePlacement out;
@@ -104,6 +108,7 @@ bool collapse_valid(HalfEdgeBuffer& buffer, uint32_t h) {
 }
 
 bool collapse_valid(HalfEdgeBuffer& buffer, uint32_t h, const double target[3]) {
+    const PhaseTimer timer(Phase::kValidate);
     const uint32_t p = buffer.corner_vertex(h), q = buffer.corner_vertex(next_in_face(h));
     const uint32_t t = buffer.twin(h);
     const bool boundary = !is_half_edge(t);
@@ -197,6 +202,7 @@ bool collapse_valid(HalfEdgeBuffer& buffer, uint32_t h, const double target[3]) 
 }
 
 void apply_collapse(HalfEdgeBuffer& buffer, uint32_t h) {
+    const PhaseTimer timer(Phase::kApply);
     const uint32_t p = buffer.corner_vertex(h), q = buffer.corner_vertex(next_in_face(h));
     const uint32_t t = buffer.twin(h);
     const bool boundary = !is_half_edge(t);
@@ -286,6 +292,7 @@ bool decimate_once(HalfEdgeBuffer& buffer, Rng& rng, int candidates, CandidateMe
         insert(Candidate{h, buffer.corner_vertex(h), buffer.corner_vertex(next_in_face(h)), placement.error,
                          {placement.target[0], placement.target[1], placement.target[2]}});
     };
+    std::optional<PhaseTimer> draw_timer(std::in_place, Phase::kDraw);
     // Remembered runners-up whose face is still alive (a reused face slot is just another
     // half-edge, rated afresh like a draw).
     int remembered = 0;
@@ -338,6 +345,7 @@ bool decimate_once(HalfEdgeBuffer& buffer, Rng& rng, int candidates, CandidateMe
             rate(h);
         }
     }
+    draw_timer.reset();
     for (int i = 0; i < found; ++i) {
         const Candidate& c = rated[order[i]];
         if (i > 0 && c.h == rated[order[i - 1]].h) continue;

@@ -3,6 +3,7 @@
 // the sorted-sweep finalization of hole boundaries and forced writes for stuck buffers.
 #include "decimate/stream_decimator.hpp"
 
+#include "decimate/phase_timers.hpp"
 #include "decimate/schedule.hpp"
 
 #include <algorithm>
@@ -74,7 +75,10 @@ void StreamDecimator::push(const io::TriangleChunk& in, const Emit& out) {
 void StreamDecimator::read_triangle(const float tri[9], const size_t slots[3], const Emit& out) {
     if (buffer_.full() || buffer_.free_vertex_count() < 3) make_room(out);
     if (options_.sorted_axis) track_sweep(tri);
-    const HalfEdgeBuffer::Added added = buffer_.add_triangle(tri, slots);
+    const HalfEdgeBuffer::Added added = [&] {
+        const PhaseTimer timer(Phase::kRead);
+        return buffer_.add_triangle(tri, slots);
+    }();
     ++stats_.triangles_in;
     if (added.face == kNoIndex) {
         pass_through(buffer_, added.vertex, next_id_, output_, out);
@@ -148,6 +152,7 @@ void StreamDecimator::sweep() {
 }
 
 void StreamDecimator::write_one(const Emit& out, bool allow_forced) {
+    const PhaseTimer timer(Phase::kWrite);
     uint32_t f = pick_write(buffer_, rng_, options_.candidates);
     if (f == kNoIndex) {
         // Every in-core triangle touches P_in: the input is not in a streaming-friendly order

@@ -1,6 +1,7 @@
 // `meshstream decimate IN OUT --ratio p`: the Wu & Kobbelt stream decimator (decimate/) between
 // any reader and writer of the registry. Memory: the decimator's fixed buffer (--buffer) plus
 // what the two formats need; the output streams while the input is still being read.
+#include "decimate/phase_timers.hpp"
 #include "decimate/stream_decimator.hpp"
 #include "io/error.hpp"
 #include "tools/commands.hpp"
@@ -122,6 +123,7 @@ void run_decimate(const DecimateOptions& opt) {
                      "xyz"[*options.sorted_axis],
                      s.sweep_direction > 0 ? "ascending" : s.sweep_direction < 0 ? "descending" : "direction not seen",
                      (unsigned long long)s.vertices_finalized_by_sweep);
+    decimate::print_phase_report(stderr);  // only in builds with MESHSTREAM_PHASE_TIMERS
 
     Warnings warnings;
     filter.report(warnings);
