@@ -2,8 +2,8 @@
 // in-core buffer (about 60 MB at the default 400 000 triangles) is read at random, so what a
 // cache line costs there decides how fast a collapse can be. For each working-set size, a
 // pointer chase through randomly ordered 64-byte lines (each load waits for the one before:
-// the latency) and eight independent chases in lockstep (the loads overlap: the cost per line
-// when misses are issued together, as the decimator's batched prefetches do).
+// the latency) and 8, 16 and 32 independent chases in lockstep (the loads overlap: the cost per
+// line when that many misses are in flight together, as with the decimator's batched prefetches).
 //
 //   memory_latency [MiB...]        default sizes: 1 2 4 16 64 256
 #include <algorithm>
@@ -31,6 +31,20 @@ double ns_per_step(std::chrono::steady_clock::time_point t0, size_t steps) {
            double(steps);
 }
 
+// K chases in lockstep through the same ring, started K equal steps apart: ns per line.
+template <int K>
+double chases(const Line* lines, const std::vector<uint64_t>& order, size_t steps, uint64_t& sink) {
+    const size_t n = order.size();
+    uint64_t q[K];
+    for (int k = 0; k < K; ++k) q[k] = order[(k * n) / K];
+    const auto t0 = std::chrono::steady_clock::now();
+    for (size_t i = 0; i < steps / K; ++i)
+        for (int k = 0; k < K; ++k) q[k] = lines[q[k]].next;
+    const double ns = ns_per_step(t0, steps);
+    for (int k = 0; k < K; ++k) sink ^= q[k];
+    return ns;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -45,7 +59,7 @@ int main(int argc, char** argv) {
         sizes.push_back(mib);
     }
     if (sizes.empty()) sizes = {1, 2, 4, 16, 64, 256};
-    std::printf("working set   dependent loads   8 chains in lockstep\n");
+    std::printf("working set   dependent   per line with 8, 16 and 32 chases in lockstep\n");
     for (const size_t mib : sizes) {
         const size_t n = mib * (size_t{1} << 20) / sizeof(Line);
         // 2 MiB aligned and advised as huge pages, like the decimator's pools (so that TLB
@@ -71,15 +85,13 @@ int main(int argc, char** argv) {
         for (size_t i = 0; i < steps; ++i) p = lines[p].next;
         const double dependent = ns_per_step(t0, steps);
 
-        uint64_t q[8];
-        for (int k = 0; k < 8; ++k) q[k] = order[(k * n) / 8];
-        t0 = std::chrono::steady_clock::now();
-        for (size_t i = 0; i < steps / 8; ++i)
-            for (int k = 0; k < 8; ++k) q[k] = lines[q[k]].next;
-        const double parallel = ns_per_step(t0, steps);
+        uint64_t sink = p;
+        const double c8 = chases<8>(lines, order, steps, sink);
+        const double c16 = chases<16>(lines, order, steps, sink);
+        const double c32 = chases<32>(lines, order, steps, sink);
         // Printing the end points keeps the chases from being optimized away.
-        std::printf("%6zu MiB     %7.1f ns         %7.1f ns per line   (%llu)\n", mib, dependent, parallel,
-                    static_cast<unsigned long long>((p ^ q[0] ^ q[7]) & 1));
+        std::printf("%6zu MiB     %7.1f ns   %7.1f ns   %7.1f ns   %7.1f ns   (%llu)\n", mib, dependent, c8, c16, c32,
+                    static_cast<unsigned long long>(sink & 1));
         std::free(lines);
     }
     return 0;
