@@ -122,10 +122,12 @@ bool collapse_valid(HalfEdgeBuffer& buffer, uint32_t h, const double target[3]) 
 
     // p's faces must form one fan reachable from h (a closed one for an interior edge, an
     // open one starting at h for a boundary edge): a vertex where two fans touch is not a
-    // manifold vertex and must not move. The fan walk and the walk of q's corner list are two
-    // chains of dependent cache misses; advancing them in lockstep overlaps them. q's
-    // neighbours are gathered from the face records alone (no vertex reads) for the link
-    // condition below; p's neighbours are prefetched for the geometric check.
+    // manifold vertex and must not move. Each step of a fan walk waits for the face record
+    // the step before named (a cache miss: the buffer is far larger than the caches), so the
+    // fans of p and q are walked both ways round at once, four chains of about half a fan
+    // each, in lockstep. q's neighbours are gathered from the face records alone (no vertex
+    // reads) for the link condition below; p's neighbours (and q's, when q moves) are
+    // prefetched for the geometric checks.
     constexpr uint32_t kMaxRing = 48;
     uint32_t ring[2 * kMaxRing];
     uint32_t ring_size = 0;
@@ -133,38 +135,87 @@ bool collapse_valid(HalfEdgeBuffer& buffer, uint32_t h, const double target[3]) 
     double from_q[3];
     buffer.position(q, from_q);
     const bool moving_q = from_q[0] != target[0] || from_q[1] != target[1] || from_q[2] != target[2];
-    uint32_t count = 0;
-    bool fan_done = false;
-    uint32_t cur = h;
-    uint32_t c = use_ring ? vq.first_corner : kNoIndex;
-    while (!fan_done || c != kNoIndex) {
-        if (c != kNoIndex) {
-            // Every neighbour x of q is the next corner of a face with q→x, or else the
-            // previous corner of one with x→q whose twin is no half-edge: listing prev only
-            // then keeps the ring free of duplicates on a manifold fan.
-            ring[ring_size++] = buffer.corner_vertex(next_in_face(c));
-            if (moving_q) buffer.prefetch_vertex(ring[ring_size - 1]);  // for the check of q's faces
-            if (!is_half_edge(buffer.twin(prev_in_face(c))))
-                ring[ring_size++] = buffer.corner_vertex(prev_in_face(c));
-            c = buffer.next_corner(c);
-        }
-        if (!fan_done) {
-            if (++count > vp.face_count) return false;
-            buffer.prefetch_vertex(buffer.corner_vertex(prev_in_face(cur)));
-            const uint32_t around = buffer.twin(prev_in_face(cur));
-            if (!is_half_edge(around)) {
+    // Every neighbour x of q is the next corner of a face with q→x, or else the previous
+    // corner of one with x→q whose twin is no half-edge: listing prev only then keeps the ring
+    // free of duplicates on a manifold fan. c is q's corner of a face.
+    auto add_to_ring = [&](uint32_t c) {
+        ring[ring_size++] = buffer.corner_vertex(next_in_face(c));
+        if (moving_q) buffer.prefetch_vertex(ring[ring_size - 1]);  // for the check of q's faces
+        if (!is_half_edge(buffer.twin(prev_in_face(c)))) ring[ring_size++] = buffer.corner_vertex(prev_in_face(c));
+    };
+    // Outgoing half-edges of p (and of q) reached turning one way (a: e → twin(prev(e))) and
+    // the other (b: e → next(twin(e))) from h's face; a walk ends at an edge without partner
+    // or where it meets the other.
+    uint32_t pa = h, pb = h;
+    bool pa_on = true, pb_on = !boundary;  // a boundary h is one end of p's open fan
+    uint32_t count = 1;
+    buffer.prefetch_vertex(buffer.corner_vertex(prev_in_face(h)));
+    uint32_t qa = next_in_face(h), qb = qa;
+    bool qa_on = use_ring, qb_on = use_ring;
+    uint32_t q_count = 1;
+    if (use_ring) add_to_ring(qa);
+    while (pa_on || pb_on || qa_on || qb_on) {
+        if (pa_on) {
+            const uint32_t next = buffer.twin(prev_in_face(pa));
+            if (!is_half_edge(next)) {
                 if (!boundary) return false;
-                fan_done = true;
+                pa_on = false;
+            } else if (next == pb) {
+                if (boundary) return false;
+                pa_on = pb_on = false;
             } else {
-                cur = around;
-                if (cur == h) {
-                    if (boundary) return false;
-                    fan_done = true;
-                }
+                pa = next;
+                if (++count > vp.face_count) return false;
+                buffer.prefetch_vertex(buffer.corner_vertex(prev_in_face(pa)));
+            }
+        }
+        if (pb_on) {
+            const uint32_t back = buffer.twin(pb);
+            if (!is_half_edge(back)) return false;  // an interior p has no edge without partner
+            const uint32_t next = next_in_face(back);
+            if (next == pa) {
+                pa_on = pb_on = false;
+            } else {
+                pb = next;
+                if (++count > vp.face_count) return false;
+                buffer.prefetch_vertex(buffer.corner_vertex(prev_in_face(pb)));
+            }
+        }
+        if (qa_on) {
+            const uint32_t next = buffer.twin(prev_in_face(qa));
+            if (!is_half_edge(next)) {
+                qa_on = false;
+            } else if (next == qb) {
+                qa_on = qb_on = false;
+            } else if (++q_count > vq.face_count) {
+                qa_on = qb_on = false;  // not one fan: the corner list below decides
+            } else {
+                qa = next;
+                add_to_ring(qa);
+            }
+        }
+        if (qb_on) {
+            const uint32_t back = buffer.twin(qb);
+            const uint32_t next = is_half_edge(back) ? next_in_face(back) : kNoIndex;
+            if (next == kNoIndex) {
+                qb_on = false;
+            } else if (next == qa) {
+                qa_on = qb_on = false;
+            } else if (++q_count > vq.face_count) {
+                qa_on = qb_on = false;
+            } else {
+                qb = next;
+                add_to_ring(qb);
             }
         }
     }
     if (count != vp.face_count) return false;
+    if (use_ring && q_count != vq.face_count) {
+        // q's faces are not all in the fan around h's face (q joins two fans, which is rare):
+        // gather its neighbours from its corner list instead.
+        ring_size = 0;
+        for (uint32_t c = vq.first_corner; c != kNoIndex; c = buffer.next_corner(c)) add_to_ring(c);
+    }
 
     // Link condition: the common neighbours of p and q are exactly r (and s).
     auto shared = [&](uint32_t x) {

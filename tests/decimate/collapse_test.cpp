@@ -118,6 +118,54 @@ TEST(Collapse, BoundaryRulesForPinAndPout) {
     EXPECT_EQ(buffer.face_count(), 30u);
 }
 
+// Vertices that join two fans (a second triangle touching only at the vertex): the fan walks
+// of collapse_valid cover the fan around the edge, and must still see the other one.
+TEST(Collapse, SecondFanAtEitherEndIsSeen) {
+    const float centre_at[3] = {2, 2, 0}, inner_at[3] = {1, 2, 0.1f}, east_at[3] = {3, 2, 0.1f};
+    const float far_east_at[3] = {4, 2, 0.4f}, apex[3] = {2, 2, 3};
+    // The extra triangle comes first: a vertex whose grid fan has closed has left P_in, and a
+    // later triangle would get a new vertex at the same position.
+    auto build = [&](HalfEdgeBuffer& buffer, const float* extra_a, const float* extra_b) {
+        if (extra_a != nullptr) {
+            const float tri[9] = {extra_a[0], extra_a[1], extra_a[2], extra_b[0], extra_b[1], extra_b[2],
+                                  apex[0],    apex[1],    apex[2]};
+            ASSERT_NE(buffer.add_triangle(tri).face, kNoIndex);
+        }
+        add_grid(buffer);
+        buffer.finalize_all();
+    };
+    {
+        // Control: on the plain grid, centre → inner is a valid collapse.
+        HalfEdgeBuffer buffer(64, 0);
+        build(buffer, nullptr, nullptr);
+        const uint32_t centre = vertex_at(buffer, {2, 2, 0}), inner = vertex_at(buffer, {1, 2, 0.1f});
+        EXPECT_TRUE(collapse_valid(buffer, half_edge(buffer, centre, inner)));
+    }
+    {
+        // q = inner gets a second fan reaching east, a neighbour of p = centre but not of q in
+        // the grid: merging them would pinch the surface at east (link condition).
+        HalfEdgeBuffer buffer(64, 0);
+        build(buffer, inner_at, east_at);
+        const uint32_t centre = vertex_at(buffer, {2, 2, 0}), inner = vertex_at(buffer, {1, 2, 0.1f});
+        const uint32_t h = half_edge(buffer, centre, inner);
+        ASSERT_EQ(buffer.vertex(inner).face_count, 7u);
+        ASSERT_TRUE(collapse_eligible(buffer, h));
+        EXPECT_FALSE(collapse_valid(buffer, h));
+    }
+    {
+        // p = centre gets the second fan, reaching the rim: its open edge is eligible (two open
+        // edges), but p is no manifold vertex and must not move.
+        HalfEdgeBuffer buffer(64, 0);
+        build(buffer, centre_at, far_east_at);
+        const uint32_t centre = vertex_at(buffer, {2, 2, 0}), far_east = vertex_at(buffer, {4, 2, 0.4f});
+        const uint32_t h = half_edge(buffer, centre, far_east);
+        ASSERT_EQ(buffer.vertex(centre).face_count, 7u);
+        ASSERT_EQ(buffer.twin(h), kOpenEdge);
+        ASSERT_TRUE(collapse_eligible(buffer, h));
+        EXPECT_FALSE(collapse_valid(buffer, h));
+    }
+}
+
 TEST(Collapse, FlipIsRefused) {
     HalfEdgeBuffer buffer(64, 0);
     // A fan around (0,0,0) on the plane z = 0 with one far outlier neighbour: collapsing the
