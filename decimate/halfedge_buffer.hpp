@@ -210,6 +210,9 @@ public:
     const Vertex& vertex(uint32_t v) const { return slots_[v].vertex; }
     Quadric& quadric(uint32_t v) { return slots_[v].quadric; }
     const Quadric& quadric(uint32_t v) const { return slots_[v].quadric; }
+    // The origin positions and quadrics are expressed relative to (the first vertex read), so
+    // that large scan coordinates do not cancel catastrophically.
+    double origin(int axis) const { return origin_[axis]; }
     // Position relative to origin() in double (what quadrics are expressed in).
     void position(uint32_t v, double out[3]) const {
         const float* pos = slots_[v].vertex.pos;
@@ -239,7 +242,19 @@ public:
     // Rounds a relative position to what set_position() would store (float coordinates), so
     // that geometric checks see exactly the position a vertex will get.
     void round_position(double rel[3]) const {
-        for (int i = 0; i < 3; ++i) rel[i] = double(float(rel[i] + origin_[i])) - origin_[i];
+        for (int i = 0; i < 3; ++i) rel[i] = through_float(rel[i] + origin_[i]) - origin_[i];
+    }
+    // double(float(x)), kept from being optimized away: g++ 12's SLP vectorizer dropped the
+    // float conversion of two of the three coordinates in round_position() as inlined into
+    // collapse_placement() at -O3 (checked on its object code), so checks saw positions that
+    // set_position() would not store. The empty asm makes the float a value the compiler
+    // cannot see through.
+    static double through_float(double x) {
+        float f = static_cast<float>(x);
+#if defined(__GNUC__)
+        asm("" : "+m"(f));
+#endif
+        return f;
     }
     const FaceSet& live_faces() const { return live_; }
     const FaceSet& interior_faces() const { return interior_; }  // no P_in vertex

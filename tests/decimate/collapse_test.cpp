@@ -166,6 +166,53 @@ TEST(Collapse, SecondFanAtEitherEndIsSeen) {
     }
 }
 
+// Collapse targets are float positions, exactly what set_position() will store, so that the
+// fold checks and the rating see the position the vertex gets: on a bowl (optimal placement),
+// a cylinder (singular: the fallback to p, q or the midpoint) and a plane (nothing gains by
+// moving), away from the origin so that rounding to float matters. (g++ 12 at -O3 once dropped
+// that rounding for two of the three coordinates: HalfEdgeBuffer::through_float.)
+TEST(Collapse, PlacementTargetsAreStoredFloatPositions) {
+    struct Shape {
+        float x2, y2;  // curvatures along x and y
+        bool some_move;
+    };
+    for (const Shape shape : {Shape{0.13f, 0.08f, true}, Shape{0.13f, 0.0f, true}, Shape{0.0f, 0.0f, false}}) {
+        std::vector<std::array<float, 3>> points;
+        for (int y = 0; y < 7; ++y)
+            for (int x = 0; x < 7; ++x) {
+                const float dx = float(x) - 3.1f, dy = float(y) - 2.9f;
+                points.push_back({1000.25f + 0.7f * float(x) + 0.05f * float(y), -20.5f + 0.9f * float(y),
+                                  5.75f + shape.x2 * dx * dx + shape.y2 * dy * dy});
+            }
+        std::vector<std::array<int, 3>> faces;
+        for (int y = 0; y < 6; ++y)
+            for (int x = 0; x < 6; ++x) {
+                const int a = 7 * y + x;
+                faces.push_back({a, a + 1, a + 8});
+                faces.push_back({a, a + 8, a + 7});
+            }
+        HalfEdgeBuffer buffer(256, 0);
+        add_indexed(buffer, points, faces);
+        buffer.finalize_all();
+        int moved = 0, kept = 0;
+        const FaceSet& live = buffer.live_faces();
+        for (size_t i = 0; i < live.size(); ++i)
+            for (uint32_t k = 0; k < 3; ++k) {
+                const uint32_t h = half_edge(live.at(i), k);
+                if (!collapse_eligible(buffer, h)) continue;
+                const CollapsePlacement placement = collapse_placement(buffer, h);
+                for (int axis = 0; axis < 3; ++axis) {
+                    const double o = buffer.origin(axis);
+                    EXPECT_EQ(placement.target[axis], double(float(placement.target[axis] + o)) - o)
+                        << "not a float position: half-edge " << h << ", axis " << axis;
+                }
+                ++(placement.moves_target ? moved : kept);
+            }
+        EXPECT_EQ(moved > 0, shape.some_move) << moved << " targets moved";
+        EXPECT_GT(kept, 0);
+    }
+}
+
 TEST(Collapse, FlipIsRefused) {
     HalfEdgeBuffer buffer(64, 0);
     // A fan around (0,0,0) on the plane z = 0 with one far outlier neighbour: collapsing the
