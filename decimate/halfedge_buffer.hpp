@@ -210,7 +210,7 @@ public:
     const Vertex& vertex(uint32_t v) const { return slots_[v].vertex; }
     Quadric& quadric(uint32_t v) { return slots_[v].quadric; }
     const Quadric& quadric(uint32_t v) const { return slots_[v].quadric; }
-    // The origin positions and quadrics are expressed relative to (the first vertex read), so
+    // The point positions (position()) and quadrics are relative to: the first vertex read, so
     // that large scan coordinates do not cancel catastrophically.
     double origin(int axis) const { return origin_[axis]; }
     // Position relative to origin() in double (what quadrics are expressed in).
