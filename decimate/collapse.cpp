@@ -154,6 +154,19 @@ bool collapse_valid(HalfEdgeBuffer& buffer, uint32_t h, const double target[3]) 
     bool qa_on = use_ring, qb_on = use_ring;
     uint32_t q_count = 1;
     if (use_ring) add_to_ring(qa);
+    // One step of a walk round q to `next` (kNoIndex: an edge without partner, where it
+    // ends); both walks end where they meet, or past q's face count (not one fan: the corner
+    // list below decides).
+    auto step_q = [&](bool& on, uint32_t& cur, uint32_t other, uint32_t next) {
+        if (next == kNoIndex) {
+            on = false;
+        } else if (next == other || ++q_count > vq.face_count) {
+            qa_on = qb_on = false;
+        } else {
+            cur = next;
+            add_to_ring(cur);
+        }
+    };
     while (pa_on || pb_on || qa_on || qb_on) {
         if (pa_on) {
             const uint32_t next = buffer.twin(prev_in_face(pa));
@@ -183,30 +196,11 @@ bool collapse_valid(HalfEdgeBuffer& buffer, uint32_t h, const double target[3]) 
         }
         if (qa_on) {
             const uint32_t next = buffer.twin(prev_in_face(qa));
-            if (!is_half_edge(next)) {
-                qa_on = false;
-            } else if (next == qb) {
-                qa_on = qb_on = false;
-            } else if (++q_count > vq.face_count) {
-                qa_on = qb_on = false;  // not one fan: the corner list below decides
-            } else {
-                qa = next;
-                add_to_ring(qa);
-            }
+            step_q(qa_on, qa, qb, is_half_edge(next) ? next : kNoIndex);
         }
         if (qb_on) {
             const uint32_t back = buffer.twin(qb);
-            const uint32_t next = is_half_edge(back) ? next_in_face(back) : kNoIndex;
-            if (next == kNoIndex) {
-                qb_on = false;
-            } else if (next == qa) {
-                qa_on = qb_on = false;
-            } else if (++q_count > vq.face_count) {
-                qa_on = qb_on = false;
-            } else {
-                qb = next;
-                add_to_ring(qb);
-            }
+            step_q(qb_on, qb, qa, is_half_edge(back) ? next_in_face(back) : kNoIndex);
         }
     }
     if (count != vp.face_count) return false;

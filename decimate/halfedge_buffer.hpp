@@ -248,10 +248,12 @@ public:
     // float conversion of two of the three coordinates in round_position() as inlined into
     // collapse_placement() at -O3 (checked on its object code), so checks saw positions that
     // set_position() would not store. The empty asm makes the float a value the compiler
-    // cannot see through.
+    // cannot see through (at no cost on x86-64: no store, no load).
     static double through_float(double x) {
         float f = static_cast<float>(x);
-#if defined(__GNUC__)
+#if defined(__GNUC__) && defined(__x86_64__)
+        asm("" : "+x"(f));  // stays in its SSE register
+#elif defined(__GNUC__)
         asm("" : "+m"(f));
 #endif
         return f;

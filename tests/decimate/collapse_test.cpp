@@ -22,21 +22,25 @@ std::set<uint32_t> neighbours(const HalfEdgeBuffer& buffer, uint32_t v) {
     return n;
 }
 
-// A 5×5 vertex grid (32 triangles) on the bowl z = bump·((x−2)² + (y−2)²) (0: flat), rows in
-// reading order.
+// The triangles of an n×n vertex grid numbered row by row, two per cell, rows in reading order.
+std::vector<std::array<int, 3>> grid_faces(int n) {
+    std::vector<std::array<int, 3>> faces;
+    for (int y = 0; y + 1 < n; ++y)
+        for (int x = 0; x + 1 < n; ++x) {
+            const int a = n * y + x;
+            faces.push_back({a, a + 1, a + n + 1});
+            faces.push_back({a, a + n + 1, a + n});
+        }
+    return faces;
+}
+
+// A 5×5 vertex grid (32 triangles) on the bowl z = bump·((x−2)² + (y−2)²) (0: flat).
 void add_grid(HalfEdgeBuffer& buffer, float bump = 0.1f) {
     std::vector<std::array<float, 3>> points;
     for (int y = 0; y < 5; ++y)
         for (int x = 0; x < 5; ++x)
             points.push_back({float(x), float(y), bump * float((x - 2) * (x - 2) + (y - 2) * (y - 2))});
-    std::vector<std::array<int, 3>> faces;
-    for (int y = 0; y < 4; ++y)
-        for (int x = 0; x < 4; ++x) {
-            const int a = 5 * y + x;
-            faces.push_back({a, a + 1, a + 6});
-            faces.push_back({a, a + 6, a + 5});
-        }
-    add_indexed(buffer, points, faces);
+    add_indexed(buffer, points, grid_faces(5));
 }
 
 }  // namespace
@@ -184,15 +188,8 @@ TEST(Collapse, PlacementTargetsAreStoredFloatPositions) {
                 points.push_back({1000.25f + 0.7f * float(x) + 0.05f * float(y), -20.5f + 0.9f * float(y),
                                   5.75f + shape.x2 * dx * dx + shape.y2 * dy * dy});
             }
-        std::vector<std::array<int, 3>> faces;
-        for (int y = 0; y < 6; ++y)
-            for (int x = 0; x < 6; ++x) {
-                const int a = 7 * y + x;
-                faces.push_back({a, a + 1, a + 8});
-                faces.push_back({a, a + 8, a + 7});
-            }
         HalfEdgeBuffer buffer(256, 0);
-        add_indexed(buffer, points, faces);
+        add_indexed(buffer, points, grid_faces(7));
         buffer.finalize_all();
         int moved = 0, kept = 0;
         const FaceSet& live = buffer.live_faces();
