@@ -57,6 +57,10 @@ double weld_epsilon(const std::string& text, const io::MeshHeader& header, const
 
 void run_decimate(const DecimateOptions& opt) {
     const auto start = std::chrono::steady_clock::now();
+    // Checked before any work: the comparison re-reads both files once the output is done.
+    if (opt.report && (opt.input == "-" || opt.output == "-"))
+        throw io::Error(opt.input == "-" ? "<stdin>" : "<stdout>",
+                        "--report needs to re-read both files; it does not work with '-'");
     io::Input in = io::open_input(opt.input, opt.read.from, opt.read.options());
     const io::MeshHeader& header = in.reader->header();
 
@@ -148,8 +152,6 @@ void run_decimate(const DecimateOptions& opt) {
     warnings.print();
 
     if (opt.report) {
-        if (opt.input == "-" || opt.output == "-")
-            throw io::Error(opt.input, "--report needs to re-read both files; it does not work with '-'");
         CompareOptions co;
         co.memory_budget_bytes = opt.read.options().memory_budget_bytes;
         co.tmpdir = opt.read.tmpdir;

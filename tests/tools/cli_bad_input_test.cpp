@@ -104,6 +104,20 @@ TEST(CliBadInput, TruncatedAndLyingFilesExit1WithNoOutput) {
     EXPECT_EQ(listing(dir.path).size(), 2u);
 }
 
+// --report re-reads both files, so it cannot work with '-': refused before anything is read
+// or written (not after the output has been written).
+TEST(CliBadInput, DecimateReportWithAPipeIsRefusedBeforeAnyOutput) {
+    TempDir dir;
+    write_file(dir / "in.stl", binary_stl(grid(4)));
+    CliRun r = run("decimate --report -r 0.5 - " + dir / "out.stl" + " < " + dir / "in.stl");
+    EXPECT_EQ(r.code, 1) << r.err;
+    EXPECT_EQ(r.err.rfind("meshstream: error: <stdin>: --report needs to re-read both files", 0), 0u) << r.err;
+    EXPECT_EQ(listing(dir.path), std::vector<std::string>{"in.stl"});
+    CliRun w = run("decimate --report -r 0.5 --to stl " + dir / "in.stl" + " -");
+    EXPECT_EQ(w.code, 1) << w.err;
+    EXPECT_EQ(w.err.rfind("meshstream: error: <stdout>: --report", 0), 0u) << w.err;
+}
+
 TEST(CliBadInput, NanAndDegenerateTrianglesAreSkippedWithCountedWarnings) {
     TempDir dir;
     const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
