@@ -12,6 +12,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <memory>
 
 namespace meshstream::tools {
@@ -69,6 +70,10 @@ void run_decimate(const DecimateOptions& opt) {
         if (!header.triangle_count)
             throw io::Error(in.source->name(), "--target needs the input triangle count, which this format does "
                                                "not state up front; use --ratio");
+        if (*opt.target > *header.triangle_count)
+            throw io::Error(in.source->name(), "--target " + std::to_string(*opt.target) + " is more than the " +
+                                                   std::to_string(*header.triangle_count) +
+                                                   " triangles of the input (decimation only removes triangles)");
         options.target = *opt.target;
     } else {
         options.ratio = opt.ratio.value_or(0.1);
@@ -146,7 +151,10 @@ void run_decimate(const DecimateOptions& opt) {
         warnings.add("non-manifold, duplicate or mis-oriented edges frozen and passed through", s.nonmanifold_edges);
     if (s.degenerate_passed > 0)
         warnings.add("degenerate triangles (welded corners) passed through", s.degenerate_passed);
-    if (s.triangles_out != s.target_triangles)
+    if (s.target_triangles > s.triangles_in)
+        warnings.add("the target " + std::to_string(s.target_triangles) + " is more than the " +
+                     std::to_string(s.triangles_in) + " usable input triangles: nothing was decimated");
+    else if (s.triangles_out != s.target_triangles)
         warnings.add("output has " + std::to_string(s.triangles_out) + " triangles instead of the target " +
                      std::to_string(s.target_triangles) + " (too little left that could be decimated)");
     warnings.print();
@@ -173,10 +181,28 @@ void add_decimate(CLI::App& app) {
                     "Output size is exactly round(ratio x input), or --target.");
     cmd->add_option("input", opt->input, "Input mesh ('-' = stdin)")->required();
     cmd->add_option("output", opt->output, "Output mesh ('-' = stdout, needs --to)")->required();
+    // CLI::Range would say "Value 0 not in range 0.000000 to 1.000000" for the open end.
+    const CLI::Validator open_unit(
+        [](const std::string& text) -> std::string {
+            double value = 0;
+            if (!CLI::detail::lexical_cast(text, value) || !(value > 0 && value <= 1))
+                return "must be a number in (0, 1], found '" + text + "'";
+            return {};
+        },
+        "in (0, 1]");
     auto* ratio = cmd->add_option("-r,--ratio", opt->ratio, "Fraction of input triangles to keep, in (0, 1] (default 0.1)")
-                      ->check(CLI::Range(1e-9, 1.0));
+                      ->check(open_unit);
     cmd->add_option("--target", opt->target, "Exact output triangle count (needs a format that states the input count)")
-        ->excludes(ratio);
+        ->excludes(ratio)
+        ->check(CLI::Validator(
+            [](const std::string& text) -> std::string {
+                uint64_t value = 0;
+                // (strtoull, under lexical_cast, would take "-3" as 2^64 - 3)
+                if (text.find('-') != std::string::npos || !CLI::detail::lexical_cast(text, value) || value == 0)
+                    return "must be a whole number of triangles, at least 1, found '" + text + "'";
+                return {};
+            },
+            "N >= 1"));
     cmd->add_option("--buffer", opt->buffer, "In-core buffer capacity in triangles (memory is fixed by it)")
         ->capture_default_str()->check(CLI::Range(size_t{16}, size_t{1} << 29));
     cmd->add_option("--candidates", opt->candidates, "Multiple-choice sample size for collapses and writes")
@@ -185,8 +211,18 @@ void add_decimate(CLI::App& app) {
         ->capture_default_str();
     cmd->add_option("--weld", opt->weld, "Weld vertices on a grid of this size (absolute, or N% of the bbox diagonal)");
     cmd->add_option("--sorted-axis", opt->sorted_axis,
-                    "The input is sorted ascending along this axis (0=x, 1=y, 2=z; read from the file when it says so)")
-        ->check(CLI::Range(0, 2));
+                    "The input is sorted along this axis: x, y or z (or 0, 1, 2); read from the file when it says so")
+        ->transform(CLI::Validator(
+            [](std::string& text) -> std::string {
+                static const std::map<std::string, std::string> kAxes = {
+                    {"x", "0"}, {"y", "1"}, {"z", "2"}, {"X", "0"}, {"Y", "1"}, {"Z", "2"},
+                    {"0", "0"}, {"1", "1"}, {"2", "2"}};
+                const auto it = kAxes.find(text);
+                if (it == kAxes.end()) return "must be x, y or z (or 0, 1, 2), found '" + text + "'";
+                text = it->second;
+                return {};
+            },
+            "x|y|z"));
     cmd->add_flag("--report", opt->report, "Compare the output against the input (Hausdorff, mean, RMS) at the end");
     add_read_flags(cmd, opt->read);
     add_write_flags(cmd, opt->write);

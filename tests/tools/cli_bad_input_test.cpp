@@ -118,6 +118,34 @@ TEST(CliBadInput, DecimateReportWithAPipeIsRefusedBeforeAnyOutput) {
     EXPECT_EQ(w.err.rfind("meshstream: error: <stdout>: --report", 0), 0u) << w.err;
 }
 
+TEST(CliBadInput, DecimateOptionValuesOutOfRangeAreRefusedClearly) {
+    TempDir dir;
+    write_file(dir / "in.stl", binary_stl(grid(4)));  // 32 triangles
+    const struct {
+        const char* option;
+        int code;
+        const char* message;
+    } cases[] = {
+        {"--ratio 0", 2, "--ratio: must be a number in (0, 1], found '0'"},
+        {"--ratio 1.5", 2, "--ratio: must be a number in (0, 1], found '1.5'"},
+        {"--target 0", 2, "--target: must be a whole number of triangles, at least 1, found '0'"},
+        {"--target -3", 2, "--target: must be a whole number of triangles, at least 1, found '-3'"},
+        {"--target 33", 1, "in.stl: --target 33 is more than the 32 triangles of the input"},
+        {"--sorted-axis w", 2, "--sorted-axis: must be x, y or z (or 0, 1, 2), found 'w'"},
+    };
+    for (const auto& c : cases) {
+        CliRun r = run("decimate " + dir / "in.stl" + " " + dir / "out.stl " + c.option);
+        EXPECT_EQ(r.code, c.code) << c.option << ": " << r.err;
+        EXPECT_NE(r.err.find(c.message), std::string::npos) << c.option << ": " << r.err;
+        EXPECT_EQ(listing(dir.path), std::vector<std::string>{"in.stl"}) << c.option;
+    }
+    // Axes by name (any case) or number; the target may equal the input count.
+    for (const char* ok : {"--sorted-axis z", "--sorted-axis Y", "--sorted-axis 0 --target 32"}) {
+        CliRun r = run("decimate " + dir / "in.stl" + " " + dir / "out.stl " + ok);
+        EXPECT_EQ(r.code, 0) << ok << ": " << r.err;
+    }
+}
+
 TEST(CliBadInput, NanAndDegenerateTrianglesAreSkippedWithCountedWarnings) {
     TempDir dir;
     const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
