@@ -14,7 +14,7 @@ uint64_t parse_bytes(const std::string& text) {
     const char* begin = text.data();
     const char* end = begin + text.size();
     auto [p, ec] = std::from_chars(begin, end, value);
-    if (ec != std::errc() || value < 0) throw CLI::ValidationError("size", "expected a size like 64M or 1G, got '" + text + "'");
+    if (ec != std::errc() || !(value >= 0) || !std::isfinite(value)) throw CLI::ValidationError("--memory", "expected a size like 64M or 1G, got '" + text + "'");
     std::string suffix(p, end);
     for (char& c : suffix) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
     double mult = 1;
@@ -23,7 +23,7 @@ uint64_t parse_bytes(const std::string& text) {
     else if (suffix == "M" || suffix == "MB" || suffix == "MIB") mult = 1024.0 * 1024;
     else if (suffix == "G" || suffix == "GB" || suffix == "GIB") mult = 1024.0 * 1024 * 1024;
     else if (suffix == "T" || suffix == "TB" || suffix == "TIB") mult = 1024.0 * 1024 * 1024 * 1024;
-    else throw CLI::ValidationError("size", "unknown size suffix in '" + text + "' (use K, M, G or T)");
+    else throw CLI::ValidationError("--memory", "unknown size suffix in '" + text + "' (use K, M, G or T)");
     return static_cast<uint64_t>(value * mult);
 }
 

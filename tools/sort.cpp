@@ -217,7 +217,13 @@ void run_sort(const SortOptions& opt) {
     // The pipe's chunks are part of the sorter's share: each at most 1/64 of the budget.
     const size_t chunk_capacity =
         std::clamp<size_t>(budget / 64 / (record_bytes + 36), 256, io::TriangleChunk::kDefaultCapacity);
-    so.memory_budget_bytes = budget - budget / 4 - kPipeSlots * chunk_capacity * (record_bytes + 36);
+    const uint64_t pipe_bytes = kPipeSlots * chunk_capacity * (record_bytes + 36);
+    if (budget - budget / 4 <= pipe_bytes) {
+        const uint64_t least_kib = (pipe_bytes * 4 / 3 + 2048) / 1024;
+        throw io::Error(in.source->name(), "--memory " + opt.read.memory + " is too small to sort: give at least " +
+                                               std::to_string(least_kib) + "K");
+    }
+    so.memory_budget_bytes = budget - budget / 4 - pipe_bytes;
 
     Progress progress("run generation", header.triangle_count);
     int shown_pass = 0;

@@ -146,6 +146,29 @@ TEST(CliBadInput, DecimateOptionValuesOutOfRangeAreRefusedClearly) {
     }
 }
 
+TEST(CliBadInput, MemoryBudgetsThatAreNotSizesOrTooSmallAreRefusedClearly) {
+    TempDir dir;
+    write_file(dir / "in.stl", binary_stl(grid(4)));
+    const struct {
+        const char* memory;
+        int code;
+        const char* message;
+    } cases[] = {
+        {"nan", 2, "--memory: expected a size like 64M or 1G, got 'nan'"},
+        {"-5M", 2, "--memory: expected a size like 64M or 1G, got '-5M'"},
+        {"12Q", 2, "--memory: unknown size suffix in '12Q'"},
+        {"1", 1, "in.stl: --memory 1 is too small to sort: give at least 98K"},  // used to be "out of memory"
+    };
+    for (const auto& c : cases) {
+        CliRun r = run("sort --axis x --memory " + std::string(c.memory) + " " + dir / "in.stl" + " " + dir / "out.stl");
+        EXPECT_EQ(r.code, c.code) << c.memory << ": " << r.err;
+        EXPECT_NE(r.err.find(c.message), std::string::npos) << c.memory << ": " << r.err;
+        EXPECT_EQ(listing(dir.path), std::vector<std::string>{"in.stl"}) << c.memory;
+    }
+    CliRun ok = run("sort --axis x --memory 98K " + dir / "in.stl" + " " + dir / "out.stl");
+    EXPECT_EQ(ok.code, 0) << ok.err;
+}
+
 TEST(CliBadInput, NanAndDegenerateTrianglesAreSkippedWithCountedWarnings) {
     TempDir dir;
     const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
