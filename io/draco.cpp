@@ -5,6 +5,7 @@
 #include "io/draco.hpp"
 
 #include "io/error.hpp"
+#include "io/text_number.hpp"
 
 #include <draco/attributes/attribute_quantization_transform.h>
 #include <draco/compression/config/compression_shared.h>
@@ -23,8 +24,6 @@ namespace meshstream::io {
 namespace {
 
 constexpr char kMagic[5] = {'D', 'R', 'A', 'C', 'O'};
-
-std::string mib(uint64_t bytes) { return std::to_string((bytes + (1u << 20) - 1) >> 20) + " MiB"; }
 
 // Adds a float32 × 3 per-vertex attribute with identity mapping and copies `values` into it.
 int add_float3_attribute(draco::Mesh& mesh, draco::GeometryAttribute::Type type, const std::vector<float>& values) {
@@ -65,7 +64,7 @@ public:
         if (need > options_.memory_budget_bytes)
             throw Error(sink_.name(), "Draco encodes the whole mesh in memory: " +
                                           std::to_string(indexer_.input_triangle_count()) + " triangles so far need about " +
-                                          mib(need) + ", over the memory budget of " + mib(options_.memory_budget_bytes) +
+                                          binary_size(need) + ", over the memory budget of " + binary_size(options_.memory_budget_bytes) +
                                           "; raise --memory");
     }
 
@@ -93,7 +92,7 @@ public:
             bytes.insert(bytes.end(), buf, buf + n);
             if (bytes.size() > options.memory_budget_bytes)
                 throw Error(source.name(), "Draco decodes whole files in memory and this one is over the memory budget of " +
-                                               mib(options.memory_budget_bytes) + "; raise --memory");
+                                               binary_size(options.memory_budget_bytes) + "; raise --memory");
         }
         mesh_ = decode_draco(bytes, source.name());
         header_.triangle_count = mesh_.indices.size() / 3;

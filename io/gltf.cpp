@@ -7,6 +7,7 @@
 
 #include "io/error.hpp"
 #include "io/mesh_index.hpp"
+#include "io/text_number.hpp"
 #if MESHSTREAM_WITH_DRACO
 #include "io/draco.hpp"
 #endif
@@ -34,8 +35,6 @@ constexpr uint32_t kChunkJson = 0x4E4F534A;  // "JSON"
 constexpr uint32_t kChunkBin = 0x004E4942;   // "BIN\0"
 constexpr const char* kDracoExtension = "KHR_draco_mesh_compression";
 constexpr const char* kQuantizationExtension = "KHR_mesh_quantization";
-
-std::string mib(uint64_t bytes) { return std::to_string((bytes + (1u << 20) - 1) >> 20) + " MiB"; }
 
 void put_u32(std::string& out, uint32_t v) {
     for (int i = 0; i < 4; ++i) out.push_back(static_cast<char>((v >> (8 * i)) & 0xFF));
@@ -128,7 +127,7 @@ public:
         if (need > options_.memory_budget_bytes)
             throw Error(sink_.name(), "glTF is written from the whole mesh in memory: " +
                                           std::to_string(indexer_.input_triangle_count()) + " triangles so far need about " +
-                                          mib(need) + ", over the memory budget of " + mib(options_.memory_budget_bytes) +
+                                          binary_size(need) + ", over the memory budget of " + binary_size(options_.memory_budget_bytes) +
                                           "; raise --memory");
     }
 
@@ -475,7 +474,7 @@ public:
             bytes.insert(bytes.end(), buf, buf + n);
             if (bytes.size() > options.memory_budget_bytes)
                 throw Error(name_, "glTF documents are read whole into memory and this one is over the memory budget of " +
-                                       mib(options.memory_budget_bytes) + "; raise --memory");
+                                       binary_size(options.memory_budget_bytes) + "; raise --memory");
         }
         const bool glb = bytes.size() >= 4 && std::memcmp(bytes.data(), kGlbMagic, 4) == 0;
         if (glb) {
