@@ -129,8 +129,10 @@ void Progress::done() {
 }
 
 void Warnings::print() const {
-    for (const auto& [kind, count] : counts_) std::fprintf(stderr, "meshstream: warning: %s (%llu)\n", kind.c_str(),
-                                                           static_cast<unsigned long long>(count));
+    for (const auto& [kind, count] : counts_) {
+        if (count == 0) std::fprintf(stderr, "meshstream: warning: %s\n", kind.c_str());
+        else std::fprintf(stderr, "meshstream: warning: %s (%llu)\n", kind.c_str(), static_cast<unsigned long long>(count));
+    }
 }
 
 std::string human_count(double n, int significant_digits) {

@@ -73,7 +73,10 @@ private:
 // Counted warnings, summarised once at the end of a command on stderr ("warning: ...").
 class Warnings {
 public:
+    // A kind of event that can happen many times: printed with its count.
     void add(const std::string& kind, uint64_t count = 1) { counts_[kind] += count; }
+    // A one-off finding: printed as it is.
+    void note(const std::string& text) { counts_.emplace(text, 0); }
     bool empty() const { return counts_.empty(); }
     void print() const;
 

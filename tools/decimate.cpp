@@ -137,13 +137,13 @@ void run_decimate(const DecimateOptions& opt) {
     Warnings warnings;
     filter.report(warnings);
     if (s.forced_writes > 0)
-        warnings.add("buffer full of undecimatable triangles: " + std::to_string(s.forced_writes) +
+        warnings.note("buffer full of undecimatable triangles: " + std::to_string(s.forced_writes) +
                      " triangles force-written at full resolution (" +
                      std::to_string(s.premature_writes) +
                      " written before reaching the target resolution); the input is not in streaming order: "
                      "run `meshstream sort` on it first, or raise --buffer");
     if (s.sort_violations > 0)
-        warnings.add(std::string("the input is not sorted along ") + "xyz"[*options.sorted_axis] +
+        warnings.note(std::string("the input is not sorted along ") + "xyz"[*options.sorted_axis] +
                      " as stated: " + std::to_string(s.sort_violations) +
                      " triangles reached behind the sweep, which was switched off at the first (boundary "
                      "finalized before it may show as cracks); run `meshstream sort` on it first");
@@ -151,11 +151,13 @@ void run_decimate(const DecimateOptions& opt) {
         warnings.add("non-manifold, duplicate or mis-oriented edges frozen and passed through", s.nonmanifold_edges);
     if (s.degenerate_passed > 0)
         warnings.add("degenerate triangles (welded corners) passed through", s.degenerate_passed);
-    if (s.target_triangles > s.triangles_in)
-        warnings.add("the target " + std::to_string(s.target_triangles) + " is more than the " +
+    if (s.triangles_in == 0)
+        ;  // the filter's report says so
+    else if (s.target_triangles > s.triangles_in)
+        warnings.note("the target " + std::to_string(s.target_triangles) + " is more than the " +
                      std::to_string(s.triangles_in) + " usable input triangles: nothing was decimated");
     else if (s.triangles_out != s.target_triangles)
-        warnings.add("output has " + std::to_string(s.triangles_out) + " triangles instead of the target " +
+        warnings.note("output has " + std::to_string(s.triangles_out) + " triangles instead of the target " +
                      std::to_string(s.target_triangles) + " (too little left that could be decimated)");
     warnings.print();
 

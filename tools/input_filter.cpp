@@ -44,6 +44,7 @@ size_t TriangleFilter::apply(io::TriangleChunk& chunk) {
 }
 
 void TriangleFilter::report(Warnings& warnings) const {
+    if (seen_ == 0) warnings.note("the input holds no triangles");
     if (non_finite_ > 0) warnings.add("triangles with a NaN or infinite coordinate skipped", non_finite_);
     if (degenerate_ > 0) warnings.add("degenerate triangles (two corners at the same position) skipped", degenerate_);
 }

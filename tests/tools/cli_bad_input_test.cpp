@@ -12,6 +12,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -167,6 +168,39 @@ TEST(CliBadInput, MemoryBudgetsThatAreNotSizesOrTooSmallAreRefusedClearly) {
     }
     CliRun ok = run("sort --axis x --memory 98K " + dir / "in.stl" + " " + dir / "out.stl");
     EXPECT_EQ(ok.code, 0) << ok.err;
+}
+
+TEST(CliBadInput, InputWithoutTrianglesGivesAnEmptyOutputAndAWarning) {
+    TempDir dir;
+    write_file(dir / "none.obj", "# no faces\nv 0 0 0\n");
+    for (const char* cmd : {"convert", "sort --axis x", "decimate"}) {
+        CliRun r = run(std::string(cmd) + " " + dir / "none.obj" + " " + dir / "out.stl");
+        EXPECT_EQ(r.code, 0) << cmd << ": " << r.err;
+        EXPECT_NE(r.err.find("meshstream: warning: the input holds no triangles\n"), std::string::npos) << cmd << ": " << r.err;
+        EXPECT_EQ(fs::file_size(dir / "out.stl"), 84u) << cmd;  // a valid STL of 0 triangles
+        fs::remove(dir / "out.stl");
+    }
+}
+
+// Unsorted input overflowing a small buffer: the decimator force-writes, and says how many
+// triangles that cost and what to do about it (once, not as a counted event).
+TEST(CliBadInput, ForcedWritesEndWithAWarningThatAdvisesSort) {
+    TempDir dir;
+    std::vector<float> tris = grid(24);  // 1152 triangles
+    std::vector<size_t> order(tris.size() / 9);
+    for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::shuffle(order.begin(), order.end(), std::mt19937(5));
+    std::vector<float> shuffled;
+    for (size_t i : order) shuffled.insert(shuffled.end(), tris.begin() + 9 * i, tris.begin() + 9 * i + 9);
+    write_file(dir / "shuffled.stl", binary_stl(shuffled));
+    CliRun r = run("decimate --buffer 64 -r 0.1 " + dir / "shuffled.stl" + " " + dir / "out.stl");
+    EXPECT_EQ(r.code, 0) << r.err;
+    const size_t at = r.err.find("meshstream: warning: buffer full of undecimatable triangles: ");
+    ASSERT_NE(at, std::string::npos) << r.err;
+    const std::string line = r.err.substr(at, r.err.find('\n', at) - at);
+    EXPECT_NE(line.find("triangles force-written at full resolution"), std::string::npos) << line;
+    EXPECT_NE(line.find("run `meshstream sort` on it first, or raise --buffer"), std::string::npos) << line;
+    EXPECT_NE(line.back(), ')') << line;  // no event count appended
 }
 
 TEST(CliBadInput, NanAndDegenerateTrianglesAreSkippedWithCountedWarnings) {
