@@ -47,6 +47,8 @@ float draco_roundtrip(float value, const draco::AttributeQuantizationTransform& 
 
 // Writer: indexes the soup, encodes at finish().
 class DracoWriter final : public Writer {
+    static constexpr const char* kWhy = "Draco encodes the whole mesh in memory";
+
 public:
     DracoWriter(ByteSink& sink, const WriteOptions& options)
         : sink_(sink), options_(options), indexer_(sink.name()) {
@@ -56,16 +58,13 @@ public:
             throw Error(sink.name(), "--draco-qn must be 1-30, got " + std::to_string(options.draco_normal_bits));
         if (options.draco_level < 0 || options.draco_level > 10)
             throw Error(sink.name(), "--draco-cl must be 0-10, got " + std::to_string(options.draco_level));
+        budget_check_up_front(sink.name(), options, kWhy, draco_encode_estimate_bytes);
     }
 
     void write(const TriangleChunk& chunk) override {
         indexer_.add(chunk);
-        uint64_t need = draco_encode_estimate_bytes(indexer_.vertex_count(), indexer_.triangle_count(), options_.normals);
-        if (need > options_.memory_budget_bytes)
-            throw Error(sink_.name(), "Draco encodes the whole mesh in memory: " +
-                                          std::to_string(indexer_.input_triangle_count()) + " triangles so far need about " +
-                                          binary_size(need) + ", over the memory budget of " + binary_size(options_.memory_budget_bytes) +
-                                          "; raise --memory");
+        budget_check(sink_.name(), options_, kWhy, indexer_.input_triangle_count(),
+                     draco_encode_estimate_bytes(indexer_.vertex_count(), indexer_.triangle_count(), options_.normals));
     }
 
     void finish() override {

@@ -69,6 +69,10 @@ struct WriteOptions {
     uint64_t memory_budget_bytes = uint64_t{256} << 20;  // for writers that weld or spool
     std::string tmpdir;
     std::optional<uint64_t> triangle_count;  // total to be written, when known up front
+    // About how many triangles will be written, when known before any are (an input header's
+    // count, decimate's target): whole-mesh writers (Draco, glTF) then refuse a memory budget
+    // that cannot hold them at once, instead of failing part way through a long run.
+    std::optional<uint64_t> expected_triangle_count;
     std::optional<int> sorted_axis;          // recorded in the header when the format has room
     std::string comment;                     // free text for formats with comments
     // Draco / glTF

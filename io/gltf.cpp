@@ -100,6 +100,20 @@ int index_component_type(uint64_t vertex_count, size_t* size) {
 // ---------------------------------------------------------------- writer
 
 class GltfWriter final : public Writer {
+    static constexpr const char* kWhy = "glTF is written from the whole mesh in memory";
+    // The smallest the indexer's tables can be (positions, at least one hash slot per vertex,
+    // indices) plus the output buffer, as in write().
+    static uint64_t plain_need(uint64_t vertices, uint64_t triangles, bool normals) {
+        return vertices * (12 + 4 + 12 + (normals ? 24 : 0)) + triangles * (12 + 12);
+    }
+    static uint64_t draco_need(uint64_t vertices, uint64_t triangles, bool normals) {
+#if MESHSTREAM_WITH_DRACO
+        return draco_encode_estimate_bytes(vertices, triangles, normals);
+#else
+        return plain_need(vertices, triangles, normals);
+#endif
+    }
+
 public:
     GltfWriter(ByteSink& sink, const WriteOptions& options, bool binary)
         : sink_(sink), options_(options), binary_(binary), indexer_(sink.name()) {
@@ -112,6 +126,7 @@ public:
             throw Error(sink.name(), "--draco-qn must be 1-30, got " + std::to_string(options_.draco_normal_bits));
         if (options_.draco_level < 0 || options_.draco_level > 10)
             throw Error(sink.name(), "--draco-cl must be 0-10, got " + std::to_string(options_.draco_level));
+        budget_check_up_front(sink.name(), options_, kWhy, options_.draco ? draco_need : plain_need);
     }
 
     void write(const TriangleChunk& chunk) override {
@@ -124,11 +139,7 @@ public:
 #endif
             // Index tables, plus the output buffer (positions, optional normals, indices).
             need = indexer_.memory_bytes() + v * (12 + (options_.normals ? 24 : 0)) + f * 12;
-        if (need > options_.memory_budget_bytes)
-            throw Error(sink_.name(), "glTF is written from the whole mesh in memory: " +
-                                          std::to_string(indexer_.input_triangle_count()) + " triangles so far need about " +
-                                          binary_size(need) + ", over the memory budget of " + binary_size(options_.memory_budget_bytes) +
-                                          "; raise --memory");
+        budget_check(sink_.name(), options_, kWhy, indexer_.input_triangle_count(), need);
     }
 
     void finish() override;

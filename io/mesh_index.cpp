@@ -3,6 +3,7 @@
 
 #include "io/error.hpp"
 #include "io/hash.hpp"
+#include "io/text_number.hpp"
 
 #include <cmath>
 #include <cstring>
@@ -163,6 +164,27 @@ IndexedMesh MeshIndexer::take() {
     slots_.assign(1024, kEmpty);
     id_mode_ = -1;
     return out;
+}
+
+void budget_check_up_front(const std::string& file, const WriteOptions& options, const char* why,
+                           uint64_t (*need)(uint64_t vertices, uint64_t triangles, bool normals)) {
+    const std::optional<uint64_t> n = options.triangle_count ? options.triangle_count : options.expected_triangle_count;
+    if (!n) return;
+    const uint64_t least = need(*n / 2, *n, options.normals);
+    if (least <= options.memory_budget_bytes) return;
+    const uint64_t mib = (least + (uint64_t{1} << 20) - 1) >> 20;
+    throw Error(file, std::string(why) + ": the " + std::to_string(*n) + " triangles to be written need at least " +
+                          binary_size(least) + ", over the memory budget of " +
+                          binary_size(options.memory_budget_bytes) + "; give --memory " + std::to_string(mib) +
+                          "M or more");
+}
+
+void budget_check(const std::string& file, const WriteOptions& options, const char* why, uint64_t triangles,
+                  uint64_t need) {
+    if (need <= options.memory_budget_bytes) return;
+    throw Error(file, std::string(why) + ": " + std::to_string(triangles) + " triangles so far need about " +
+                          binary_size(need) + ", over the memory budget of " +
+                          binary_size(options.memory_budget_bytes) + "; raise --memory");
 }
 
 }  // namespace meshstream::io

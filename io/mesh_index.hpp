@@ -28,6 +28,17 @@ struct IndexedMesh {
     std::vector<float> smooth_normals() const;
 };
 
+// For the whole-mesh writers' --memory checks. `need(vertices, triangles)` is a writer's
+// estimate of the bytes it holds for a mesh of that size; `why` says why it holds the whole mesh
+// ("Draco encodes the whole mesh in memory"). Throws io::Error naming `file`:
+// - budget_check_up_front: when even the smallest mesh of `options`' expected (or promised)
+//   triangle count, a closed surface with half as many vertices, needs more than the budget;
+// - budget_check: when the `triangles` read so far need more (`need` bytes).
+void budget_check_up_front(const std::string& file, const WriteOptions& options, const char* why,
+                           uint64_t (*need)(uint64_t vertices, uint64_t triangles, bool normals));
+void budget_check(const std::string& file, const WriteOptions& options, const char* why, uint64_t triangles,
+                  uint64_t need);
+
 class MeshIndexer {
 public:
     // `file_name` names the output in error messages.

@@ -25,6 +25,7 @@ void run_convert(const ConvertOptions& opt) {
     // promised to the writer only where nothing can be skipped (--strict) or where the writer
     // cannot patch its header later (stdout, where a difference is then an error).
     if (opt.read.strict || opt.output == "-") wo.triangle_count = header.triangle_count;
+    wo.expected_triangle_count = header.triangle_count;
     wo.sorted_axis = header.sorted_axis;
     io::Output out = io::open_output(opt.output, opt.write.to, wo, opt.write.gzip_level);
 

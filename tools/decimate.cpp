@@ -86,6 +86,10 @@ void run_decimate(const DecimateOptions& opt) {
     decimate::StreamDecimator decimator(options, header.triangle_count);
 
     io::WriteOptions wo = opt.write.options(opt.read);
+    // The output count, for whole-mesh writers to refuse a --memory too small before the work.
+    if (header.triangle_count)
+        wo.expected_triangle_count = options.target ? *options.target
+                                                    : decimate::StreamDecimator::expected_output(options.ratio, *header.triangle_count);
     // No output count is promised to the writer: the decimator lands on round(p·N_in) except
     // when the in-core rest is closed and the target odd (collapses remove two faces; it
     // then ends one over, with a warning), and skipped input triangles change N_in. Writers
@@ -156,9 +160,13 @@ void run_decimate(const DecimateOptions& opt) {
     else if (s.target_triangles > s.triangles_in)
         warnings.note("the target " + std::to_string(s.target_triangles) + " is more than the " +
                      std::to_string(s.triangles_in) + " usable input triangles: nothing was decimated");
+    else if (s.triangles_out == s.target_triangles + 1)
+        warnings.note("output has " + std::to_string(s.triangles_out) + " triangles instead of the target " +
+                      std::to_string(s.target_triangles) +
+                      " (a collapse removes two triangles, and no boundary edge was left to remove the odd one)");
     else if (s.triangles_out != s.target_triangles)
         warnings.note("output has " + std::to_string(s.triangles_out) + " triangles instead of the target " +
-                     std::to_string(s.target_triangles) + " (too little left that could be decimated)");
+                      std::to_string(s.target_triangles) + " (too little left that could be decimated)");
     warnings.print();
 
     if (opt.report) {

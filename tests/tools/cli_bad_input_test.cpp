@@ -203,6 +203,28 @@ TEST(CliBadInput, ForcedWritesEndWithAWarningThatAdvisesSort) {
     EXPECT_NE(line.back(), ')') << line;  // no event count appended
 }
 
+// Whole-mesh outputs (Draco, glTF) whose known size cannot fit --memory are refused before
+// any work, not part way through a long decimation.
+TEST(CliBadInput, WholeMeshOutputTooBigForTheBudgetIsRefusedUpFront) {
+    TempDir dir;
+    write_file(dir / "in.stl", binary_stl(grid(24)));  // 1152 triangles
+    for (const char* out : {"out.drc", "out.glb"}) {
+        CliRun r = run("decimate -r 1 --memory 100K " + dir / "in.stl" + " " + dir / out);
+        EXPECT_EQ(r.code, 1) << out << ": " << r.err;
+        EXPECT_NE(r.err.find(dir / out + ": "), std::string::npos) << r.err;
+        EXPECT_NE(r.err.find("the 1152 triangles to be written need at least"), std::string::npos) << r.err;
+        EXPECT_NE(r.err.find("over the memory budget of 100 KiB; give --memory 1M or more"), std::string::npos) << r.err;
+        EXPECT_EQ(r.err.find("decimated "), std::string::npos) << "refused after the work: " << r.err;
+        EXPECT_EQ(listing(dir.path), std::vector<std::string>{"in.stl"}) << out;
+    }
+    CliRun c = run("convert --memory 100K " + dir / "in.stl" + " " + dir / "out.drc");
+    EXPECT_EQ(c.code, 1) << c.err;
+    EXPECT_NE(c.err.find("the 1152 triangles to be written need at least"), std::string::npos) << c.err;
+    // Where it fits, it is written.
+    CliRun ok = run("decimate -r 0.25 --memory 100K " + dir / "in.stl" + " " + dir / "out.drc");
+    EXPECT_EQ(ok.code, 0) << ok.err;
+}
+
 TEST(CliBadInput, NanAndDegenerateTrianglesAreSkippedWithCountedWarnings) {
     TempDir dir;
     const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
