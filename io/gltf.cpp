@@ -101,10 +101,10 @@ int index_component_type(uint64_t vertex_count, size_t* size) {
 
 class GltfWriter final : public Writer {
     static constexpr const char* kWhy = "glTF is written from the whole mesh in memory";
-    // The smallest the indexer's tables can be (positions, at least one hash slot per vertex,
-    // indices) plus the output buffer, as in write().
+    // The smallest the indexer's tables can be (positions, two 4-byte hash slots per vertex at
+    // load <= 1/2, indices) plus the output buffer, as in write().
     static uint64_t plain_need(uint64_t vertices, uint64_t triangles, bool normals) {
-        return vertices * (12 + 4 + 12 + (normals ? 24 : 0)) + triangles * (12 + 12);
+        return vertices * (12 + 8 + 12 + (normals ? 24 : 0)) + triangles * (12 + 12);
     }
     static uint64_t draco_need(uint64_t vertices, uint64_t triangles, bool normals) {
 #if MESHSTREAM_WITH_DRACO
