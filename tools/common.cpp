@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <limits>
+#include <sys/stat.h>
 #include <unistd.h>
 
 namespace meshstream::tools {
@@ -156,6 +158,33 @@ std::string human_bytes(double bytes) {
     else if (bytes >= 1e3) std::snprintf(buf, sizeof buf, "%.1f kB", bytes / 1e3);
     else std::snprintf(buf, sizeof buf, "%.0f B", bytes);
     return buf;
+}
+
+bool is_regular_file(const std::string& path) {
+    struct stat st;
+    return path != "-" && ::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
+}
+
+io::Bounds input_bounds(const std::string& path, std::string_view from, const io::ReadOptions& options) {
+    io::Input in = io::open_input(path, from, options);
+    if (in.reader->header().bounds) return *in.reader->header().bounds;
+    io::Bounds box;
+    box.min.fill(std::numeric_limits<float>::infinity());
+    box.max.fill(-std::numeric_limits<float>::infinity());
+    io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, in.reader->header().channels);
+    Progress progress("bounding box", in.reader->triangle_count());
+    uint64_t done = 0;
+    while (in.reader->next(chunk)) {
+        auto xyz = chunk.xyz();
+        for (size_t i = 0; i < xyz.size(); i += 3)
+            for (int a = 0; a < 3; ++a)
+                if (std::isfinite(xyz[i + a])) {  // a NaN or inf corner would decide nothing
+                    box.min[a] = std::min(box.min[a], xyz[i + a]);
+                    box.max[a] = std::max(box.max[a], xyz[i + a]);
+                }
+        progress.update(done += chunk.size());
+    }
+    return box;
 }
 
 uint64_t peak_rss_bytes() {

@@ -89,6 +89,12 @@ private:
 // "1.23 M"), or, when `significant_digits` > 0, with that many significant digits ("500 k").
 std::string human_count(double n, int significant_digits = 0);
 std::string human_bytes(double bytes);
+// True for an existing regular file (not "-", a pipe or a device): one that can be read twice.
+bool is_regular_file(const std::string& path);
+// The input's bounding box: from its header when the format states it, else from a first pass
+// over the file (finite coordinates only; a progress bar on stderr). An input without finite
+// coordinates gives min = +inf, max = -inf. Throws io::Error like open_input.
+io::Bounds input_bounds(const std::string& path, std::string_view from, const io::ReadOptions& options);
 // Peak resident set size of this process in bytes (from /proc/self/status VmHWM).
 uint64_t peak_rss_bytes();
 

@@ -32,8 +32,10 @@ struct DecimateOptions {
     WriteFlags write;
 };
 
-// --weld EPS: absolute, or "P%" of the bounding-box diagonal when the reader knows the box.
-double weld_epsilon(const std::string& text, const io::MeshHeader& header, const std::string& input) {
+// --weld EPS: absolute, or "P%" of the bounding-box diagonal: the box the header states, else
+// one found by a first pass over the input (a regular file only: a stream cannot be read twice).
+double weld_epsilon(const DecimateOptions& opt, const io::MeshHeader& header, const std::string& input_name) {
+    const std::string& text = opt.weld;
     if (text.empty()) return 0;
     const bool percent = text.back() == '%';
     double value = 0;
@@ -45,15 +47,16 @@ double weld_epsilon(const std::string& text, const io::MeshHeader& header, const
     if (!(value >= 0) || !std::isfinite(value))
         throw CLI::ValidationError("--weld", "must be a non-negative number, found '" + text + "'");
     if (!percent) return value;
-    if (!header.bounds)
-        throw io::Error(input, "--weld " + text + " needs the bounding box, which this format does not state "
-                               "up front; give an absolute size instead");
+    if (!header.bounds && !is_regular_file(opt.input))
+        throw io::Error(input_name, "--weld " + text + " needs the bounding box, which this format does not state "
+                                    "up front and a stream cannot be read twice for; give an absolute size instead");
+    const io::Bounds box = header.bounds ? *header.bounds : input_bounds(opt.input, opt.read.from, opt.read.options());
     double diag2 = 0;
     for (int i = 0; i < 3; ++i) {
-        const double d = double(header.bounds->max[i]) - header.bounds->min[i];
+        const double d = double(box.max[i]) - box.min[i];
         diag2 += d * d;
     }
-    return value / 100 * std::sqrt(diag2);
+    return std::isfinite(diag2) ? value / 100 * std::sqrt(diag2) : 0;  // no finite corner: nothing to weld
 }
 
 void run_decimate(const DecimateOptions& opt) {
@@ -81,7 +84,7 @@ void run_decimate(const DecimateOptions& opt) {
     options.buffer_triangles = opt.buffer;
     options.candidates = opt.candidates;
     options.seed = opt.seed;
-    options.weld_eps = weld_epsilon(opt.weld, header, in.source->name());
+    options.weld_eps = weld_epsilon(opt, header, in.source->name());
     options.sorted_axis = opt.sorted_axis ? opt.sorted_axis : header.sorted_axis;
     decimate::StreamDecimator decimator(options, header.triangle_count);
 

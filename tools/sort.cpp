@@ -139,43 +139,17 @@ double seconds_since(std::chrono::steady_clock::time_point t) {
 // The longest axis of the input's bounding box, from the header when it states the bounds,
 // else from a first reading pass. Precondition: the input can be opened twice.
 int longest_axis(const SortOptions& opt, const io::ReadOptions& ro) {
-    io::Input in = io::open_input(opt.input, opt.read.from, ro);
-    std::array<float, 3> lo, hi;
-    if (in.reader->header().bounds) {
-        lo = in.reader->header().bounds->min;
-        hi = in.reader->header().bounds->max;
-    } else {
-        lo.fill(std::numeric_limits<float>::infinity());
-        hi.fill(-std::numeric_limits<float>::infinity());
-        io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, in.reader->header().channels);
-        Progress progress("bounding box", in.reader->triangle_count());
-        uint64_t done = 0;
-        while (in.reader->next(chunk)) {
-            auto xyz = chunk.xyz();
-            for (size_t i = 0; i < xyz.size(); i += 3)
-                for (int a = 0; a < 3; ++a)
-                    if (std::isfinite(xyz[i + a])) {  // a NaN or inf corner would decide nothing
-                        lo[a] = std::min(lo[a], xyz[i + a]);
-                        hi[a] = std::max(hi[a], xyz[i + a]);
-                    }
-            progress.update(done += chunk.size());
-        }
-    }
+    const io::Bounds box = input_bounds(opt.input, opt.read.from, ro);
     int best = 2;  // empty or flat input: z, the usual scan axis
     double best_extent = 0;
     for (int a = 0; a < 3; ++a) {
-        double extent = double(hi[a]) - double(lo[a]);
+        double extent = double(box.max[a]) - double(box.min[a]);
         if (extent > best_extent) {
             best_extent = extent;
             best = a;
         }
     }
     return best;
-}
-
-bool is_regular_file(const std::string& path) {
-    struct stat st;
-    return path != "-" && ::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
 }
 
 void run_sort(const SortOptions& opt) {

@@ -16,6 +16,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -223,6 +224,31 @@ TEST(CliBadInput, WholeMeshOutputTooBigForTheBudgetIsRefusedUpFront) {
     // Where it fits, it is written.
     CliRun ok = run("decimate -r 0.25 --memory 100K " + dir / "in.stl" + " " + dir / "out.drc");
     EXPECT_EQ(ok.code, 0) << ok.err;
+}
+
+// --weld P% on a format without a stated bounding box (STL): a regular file is read twice,
+// the box first; a stream cannot be, and says so.
+TEST(CliBadInput, WeldPercentReadsTheBoxFirstOrRefusesAStream) {
+    TempDir dir;
+    const std::vector<float> tris = grid(6);
+    write_file(dir / "in.stl", binary_stl(tris));
+    float lo[3] = {1e30f, 1e30f, 1e30f}, hi[3] = {-1e30f, -1e30f, -1e30f};
+    for (size_t i = 0; i < tris.size(); ++i) {
+        lo[i % 3] = std::min(lo[i % 3], tris[i]);
+        hi[i % 3] = std::max(hi[i % 3], tris[i]);
+    }
+    double diag2 = 0;
+    for (int a = 0; a < 3; ++a) diag2 += (double(hi[a]) - lo[a]) * (double(hi[a]) - lo[a]);
+    char expected[64];
+    std::snprintf(expected, sizeof expected, "  weld %.6g: ", 0.5 / 100 * std::sqrt(diag2));
+
+    CliRun r = run("decimate -r 0.5 --weld 0.5% " + dir / "in.stl" + " " + dir / "out.stl");
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.err.find(expected), std::string::npos) << expected << " in: " << r.err;
+    CliRun p = run("decimate -r 0.5 --weld 0.5% - " + dir / "piped.stl" + " < " + dir / "in.stl");
+    EXPECT_EQ(p.code, 1) << p.err;
+    EXPECT_NE(p.err.find("<stdin>: --weld 0.5% needs the bounding box"), std::string::npos) << p.err;
+    EXPECT_FALSE(fs::exists(dir / "piped.stl"));
 }
 
 TEST(CliBadInput, NanAndDegenerateTrianglesAreSkippedWithCountedWarnings) {
