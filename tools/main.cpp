@@ -8,12 +8,14 @@
 #include <cstdio>
 #include <exception>
 #include <new>
+#include <string>
 
 int main(int argc, char** argv) {
     using namespace meshstream;
     CLI::App app{"meshstream: convert, sort and decimate triangle meshes larger than memory, in one streaming pass"};
     app.set_help_all_flag("--help-all", "Show help for every command");
     app.add_flag("-q,--quiet", tools::global().quiet, "No progress bar");
+    app.set_version_flag("--version", std::string("meshstream ") + MESHSTREAM_VERSION);
     app.require_subcommand(1);
     tools::add_info(app);
     tools::add_convert(app);
@@ -22,6 +24,22 @@ int main(int argc, char** argv) {
     tools::add_compare(app);
 
     io::install_cleanup_handlers();
+    // CLI11 reports an unknown command as "A subcommand is required"; name it instead.
+    for (int i = 1; i < argc; ++i) {
+        const std::string arg = argv[i];
+        if (arg.empty() || arg[0] == '-') continue;
+        std::string names;
+        bool known = false;
+        for (const CLI::App* sub : app.get_subcommands({})) {
+            known |= sub->get_name() == arg;
+            names += (names.empty() ? "" : ", ") + sub->get_name();
+        }
+        if (!known) {
+            std::fprintf(stderr, "meshstream: unknown command '%s' (one of: %s; see --help)\n", arg.c_str(), names.c_str());
+            return 2;
+        }
+        break;
+    }
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

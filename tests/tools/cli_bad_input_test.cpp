@@ -251,6 +251,16 @@ TEST(CliBadInput, WeldPercentReadsTheBoxFirstOrRefusesAStream) {
     EXPECT_FALSE(fs::exists(dir / "piped.stl"));
 }
 
+TEST(CliBadInput, UnknownCommandIsNamedAndVersionIsPrinted) {
+    CliRun r = run("decimat in.stl out.stl");
+    EXPECT_EQ(r.code, 2);
+    EXPECT_EQ(r.err, "meshstream: unknown command 'decimat' (one of: info, convert, decimate, sort, compare; see --help)\n");
+    TempDir dir;
+    CliRun v = run("--version > " + dir / "version.txt");
+    EXPECT_EQ(v.code, 0) << v.err;
+    EXPECT_EQ(slurp(dir / "version.txt").rfind("meshstream ", 0), 0u) << slurp(dir / "version.txt");
+}
+
 TEST(CliBadInput, NanAndDegenerateTrianglesAreSkippedWithCountedWarnings) {
     TempDir dir;
     const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
