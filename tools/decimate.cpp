@@ -158,6 +158,12 @@ void run_decimate(const DecimateOptions& opt) {
         warnings.add("non-manifold, duplicate or mis-oriented edges frozen and passed through", s.nonmanifold_edges);
     if (s.degenerate_passed > 0)
         warnings.add("degenerate triangles (welded corners) passed through", s.degenerate_passed);
+    // Welding that collapses many triangles is coarser than the mesh: they pass through
+    // undecimated, and the output misses its target.
+    if (options.weld_eps > 0 && s.degenerate_passed * 100 > s.triangles_in)
+        warnings.note("--weld " + opt.weld + " welded the corners of " +
+                      std::to_string(s.degenerate_passed * 100 / s.triangles_in) +
+                      " % of the triangles together: it is coarser than the mesh; weld on a smaller size");
     if (s.triangles_in == 0)
         ;  // the filter's report says so
     else if (s.target_triangles > s.triangles_in)

@@ -245,6 +245,12 @@ TEST(CliBadInput, WeldPercentReadsTheBoxFirstOrRefusesAStream) {
     CliRun r = run("decimate -r 0.5 --weld 0.5% " + dir / "in.stl" + " " + dir / "out.stl");
     EXPECT_EQ(r.code, 0) << r.err;
     EXPECT_NE(r.err.find(expected), std::string::npos) << expected << " in: " << r.err;
+    EXPECT_EQ(r.err.find("coarser than the mesh"), std::string::npos) << r.err;
+    // A weld coarser than the triangles collapses most of them: said plainly.
+    CliRun coarse = run("decimate -r 0.5 --weld 30% " + dir / "in.stl" + " " + dir / "coarse.stl");
+    EXPECT_EQ(coarse.code, 0) << coarse.err;
+    EXPECT_NE(coarse.err.find("warning: --weld 30% welded the corners of "), std::string::npos) << coarse.err;
+    EXPECT_NE(coarse.err.find("it is coarser than the mesh; weld on a smaller size\n"), std::string::npos) << coarse.err;
     CliRun p = run("decimate -r 0.5 --weld 0.5% - " + dir / "piped.stl" + " < " + dir / "in.stl");
     EXPECT_EQ(p.code, 1) << p.err;
     EXPECT_NE(p.err.find("<stdin>: --weld 0.5% needs the bounding box"), std::string::npos) << p.err;
