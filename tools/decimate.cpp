@@ -164,18 +164,16 @@ void run_decimate(const DecimateOptions& opt) {
         warnings.note("--weld " + opt.weld + " welded the corners of " +
                       std::to_string(s.degenerate_passed * 100 / s.triangles_in) +
                       " % of the triangles together: it is coarser than the mesh; weld on a smaller size");
-    if (s.triangles_in == 0)
-        ;  // the filter's report says so
-    else if (s.target_triangles > s.triangles_in)
+    // (An input without triangles: the filter's report says so.)
+    const std::string missed = "output has " + std::to_string(s.triangles_out) + " triangles instead of the target " +
+                               std::to_string(s.target_triangles);
+    if (s.triangles_in > 0 && s.target_triangles > s.triangles_in)
         warnings.note("the target " + std::to_string(s.target_triangles) + " is more than the " +
-                     std::to_string(s.triangles_in) + " usable input triangles: nothing was decimated");
-    else if (s.triangles_out == s.target_triangles + 1)
-        warnings.note("output has " + std::to_string(s.triangles_out) + " triangles instead of the target " +
-                      std::to_string(s.target_triangles) +
-                      " (a collapse removes two triangles, and no boundary edge was left to remove the odd one)");
-    else if (s.triangles_out != s.target_triangles)
-        warnings.note("output has " + std::to_string(s.triangles_out) + " triangles instead of the target " +
-                      std::to_string(s.target_triangles) + " (too little left that could be decimated)");
+                      std::to_string(s.triangles_in) + " usable input triangles: nothing was decimated");
+    else if (s.triangles_in > 0 && s.triangles_out == s.target_triangles + 1)
+        warnings.note(missed + " (a collapse removes two triangles, and no boundary edge was left to remove the odd one)");
+    else if (s.triangles_in > 0 && s.triangles_out != s.target_triangles)
+        warnings.note(missed + " (too little left that could be decimated)");
     warnings.print();
 
     if (opt.report) {
