@@ -10,7 +10,6 @@
 #include "tools/common.hpp"
 #include "tools/input_filter.hpp"
 
-#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -21,7 +20,6 @@
 #include <cstdio>
 #include <deque>
 #include <exception>
-#include <limits>
 #include <memory>
 #include <mutex>
 #include <thread>

@@ -20,6 +20,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
 #include <iterator>
 #include <limits>
 #include <random>
@@ -120,27 +121,40 @@ TEST(CliBadInput, DecimateReportWithAPipeIsRefusedBeforeAnyOutput) {
     EXPECT_EQ(w.err.rfind("meshstream: error: <stdout>: --report", 0), 0u) << w.err;
 }
 
-TEST(CliBadInput, DecimateOptionValuesOutOfRangeAreRefusedClearly) {
-    TempDir dir;
-    write_file(dir / "in.stl", binary_stl(grid(4)));  // 32 triangles
-    const struct {
-        const char* option;
-        int code;
-        const char* message;
-    } cases[] = {
-        {"--ratio 0", 2, "--ratio: must be a number in (0, 1], found '0'"},
-        {"--ratio 1.5", 2, "--ratio: must be a number in (0, 1], found '1.5'"},
-        {"--target 0", 2, "--target: must be a whole number of triangles, at least 1, found '0'"},
-        {"--target -3", 2, "--target: must be a whole number of triangles, at least 1, found '-3'"},
-        {"--target 33", 1, "in.stl: --target 33 is more than the 32 triangles of the input"},
-        {"--sorted-axis w", 2, "--sorted-axis: must be x, y or z (or 0, 1, 2), found 'w'"},
-    };
-    for (const auto& c : cases) {
-        CliRun r = run("decimate " + dir / "in.stl" + " " + dir / "out.stl " + c.option);
+namespace {
+
+// A command line that must be refused: the option added, the exit code, a part of the message.
+struct Refusal {
+    const char* option;
+    int code;
+    const char* message;
+};
+
+// Runs `command IN OUT OPTION` for each refusal (IN = dir/in.stl): the exit code and message
+// as expected, and nothing written beside the input.
+void expect_refusals(const TempDir& dir, const std::string& command, std::initializer_list<Refusal> refusals) {
+    for (const Refusal& c : refusals) {
+        CliRun r = run(command + " " + dir / "in.stl" + " " + dir / "out.stl " + c.option);
         EXPECT_EQ(r.code, c.code) << c.option << ": " << r.err;
         EXPECT_NE(r.err.find(c.message), std::string::npos) << c.option << ": " << r.err;
         EXPECT_EQ(listing(dir.path), std::vector<std::string>{"in.stl"}) << c.option;
     }
+}
+
+}  // namespace
+
+TEST(CliBadInput, DecimateOptionValuesOutOfRangeAreRefusedClearly) {
+    TempDir dir;
+    write_file(dir / "in.stl", binary_stl(grid(4)));  // 32 triangles
+    expect_refusals(dir, "decimate",
+                    {
+                        {"--ratio 0", 2, "--ratio: must be a number in (0, 1], found '0'"},
+                        {"--ratio 1.5", 2, "--ratio: must be a number in (0, 1], found '1.5'"},
+                        {"--target 0", 2, "--target: must be a whole number of triangles, at least 1, found '0'"},
+                        {"--target -3", 2, "--target: must be a whole number of triangles, at least 1, found '-3'"},
+                        {"--target 33", 1, "in.stl: --target 33 is more than the 32 triangles of the input"},
+                        {"--sorted-axis w", 2, "--sorted-axis: must be x, y or z (or 0, 1, 2), found 'w'"},
+                    });
     // Axes by name (any case) or number; the target may equal the input count.
     for (const char* ok : {"--sorted-axis z", "--sorted-axis Y", "--sorted-axis 0 --target 32"}) {
         CliRun r = run("decimate " + dir / "in.stl" + " " + dir / "out.stl " + ok);
@@ -151,22 +165,14 @@ TEST(CliBadInput, DecimateOptionValuesOutOfRangeAreRefusedClearly) {
 TEST(CliBadInput, MemoryBudgetsThatAreNotSizesOrTooSmallAreRefusedClearly) {
     TempDir dir;
     write_file(dir / "in.stl", binary_stl(grid(4)));
-    const struct {
-        const char* memory;
-        int code;
-        const char* message;
-    } cases[] = {
-        {"nan", 2, "--memory: expected a size like 64M or 1G, got 'nan'"},
-        {"-5M", 2, "--memory: expected a size like 64M or 1G, got '-5M'"},
-        {"12Q", 2, "--memory: unknown size suffix in '12Q'"},
-        {"1", 1, "in.stl: --memory 1 is too small to sort: give at least 98K"},  // used to be "out of memory"
-    };
-    for (const auto& c : cases) {
-        CliRun r = run("sort --axis x --memory " + std::string(c.memory) + " " + dir / "in.stl" + " " + dir / "out.stl");
-        EXPECT_EQ(r.code, c.code) << c.memory << ": " << r.err;
-        EXPECT_NE(r.err.find(c.message), std::string::npos) << c.memory << ": " << r.err;
-        EXPECT_EQ(listing(dir.path), std::vector<std::string>{"in.stl"}) << c.memory;
-    }
+    expect_refusals(dir, "sort --axis x",
+                    {
+                        {"--memory nan", 2, "--memory: expected a size like 64M or 1G, got 'nan'"},
+                        {"--memory -5M", 2, "--memory: expected a size like 64M or 1G, got '-5M'"},
+                        {"--memory 12Q", 2, "--memory: unknown size suffix in '12Q'"},
+                        // used to be "out of memory"
+                        {"--memory 1", 1, "in.stl: --memory 1 is too small to sort: give at least 98K"},
+                    });
     CliRun ok = run("sort --axis x --memory 98K " + dir / "in.stl" + " " + dir / "out.stl");
     EXPECT_EQ(ok.code, 0) << ok.err;
 }
