@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <fcntl.h>
+#include <filesystem>
 #include <sys/stat.h>
 #include <unistd.h>
 #include <zlib.h>
@@ -141,6 +142,21 @@ void write_all(int fd, const void* data, size_t n, const std::string& name, uint
         n -= static_cast<size_t>(put);
         offset += static_cast<uint64_t>(put);
     }
+}
+
+// The file a path names once symbolic links are followed (an output written through a link
+// replaces the file it points to, not the link). A dangling link names its missing target.
+std::string follow_symlinks(std::string path) {
+    namespace fs = std::filesystem;
+    for (int hops = 0; hops < 40; ++hops) {  // a loop of links: open() then reports ELOOP
+        std::error_code ec;
+        if (!fs::is_symlink(fs::symlink_status(path, ec))) return path;
+        fs::path link = fs::read_symlink(path, ec);
+        if (ec) return path;
+        if (link.is_relative()) link = fs::path(path).parent_path() / link;
+        path = link.string();
+    }
+    return path;
 }
 
 std::string make_temp(std::string pattern, int* fd, const std::string& what) {
@@ -319,11 +335,22 @@ std::unique_ptr<ByteSink> ByteSink::open(const std::string& path, const SinkOpti
     if (path == "-") {
         sink->fd_ = 1;
     } else {
+        sink->target_ = follow_symlinks(path);
         struct stat st;
-        if (::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode)) throw Error(path, "is a directory");
-        sink->temp_path_ = make_temp(path + ".tmp-XXXXXX", &sink->fd_, path);
-        ::fchmod(sink->fd_, default_file_mode());
-        sink->temp_slot_ = register_temp_path(sink->temp_path_);
+        const bool exists = ::stat(sink->target_.c_str(), &st) == 0;
+        if (exists && S_ISDIR(st.st_mode)) throw Error(path, "is a directory");
+        if (exists && !S_ISREG(st.st_mode)) {
+            // A device, FIFO or socket is written in place, like stdout: renaming a file over
+            // it would replace /dev/null or a pipe's reader's FIFO with a regular file.
+            sink->fd_ = ::open(sink->target_.c_str(), O_WRONLY | O_CLOEXEC);
+            if (sink->fd_ < 0) throw Error(path, "cannot open for writing: " + errno_text());
+            sink->owns_fd_ = true;
+        } else {
+            sink->temp_path_ = make_temp(sink->target_ + ".tmp-XXXXXX", &sink->fd_, path);
+            // A replaced file keeps its permissions; a new one gets the umask's.
+            ::fchmod(sink->fd_, exists ? st.st_mode & 07777 : default_file_mode());
+            sink->temp_slot_ = register_temp_path(sink->temp_path_);
+        }
     }
     if (options.gzip_level >= 0) {
         sink->gz_ = std::make_unique<Gzip>();
@@ -337,6 +364,7 @@ std::unique_ptr<ByteSink> ByteSink::open(const std::string& path, const SinkOpti
 
 ByteSink::~ByteSink() {
     if (gz_) deflateEnd(&gz_->zs);
+    if (owns_fd_ && fd_ >= 0) ::close(fd_);
     if (!temp_path_.empty()) {
         if (fd_ >= 0) ::close(fd_);
         if (!committed_) ::unlink(temp_path_.c_str());
@@ -411,6 +439,11 @@ void ByteSink::commit() {
         } while (rc != Z_STREAM_END);
     }
     if (temp_path_.empty()) {
+        if (owns_fd_) {
+            const int fd = fd_;
+            fd_ = -1;
+            if (::close(fd) != 0) throw Error(name_, "write failed on close: " + errno_text());
+        }
         committed_ = true;
         return;
     }
@@ -419,7 +452,7 @@ void ByteSink::commit() {
         throw Error(name_, "write failed on close: " + errno_text());
     }
     fd_ = -1;
-    if (::rename(temp_path_.c_str(), name_.c_str()) != 0)
+    if (::rename(temp_path_.c_str(), target_.c_str()) != 0)
         throw Error(name_, "cannot rename " + temp_path_ + " into place: " + errno_text());
     committed_ = true;
 }

@@ -84,8 +84,10 @@ struct SinkOptions {
 };
 
 // The consumer under every writer. Writes go to `<target>.tmp-XXXXXX` in the target's
-// directory (or straight to stdout for "-"); commit() flushes and renames into place; a sink
-// destroyed without commit() deletes its temporary file.
+// directory; commit() flushes and renames into place, keeping a replaced file's permissions;
+// a sink destroyed without commit() deletes its temporary file. A symbolic link is followed
+// (the file it names is replaced). Stdout ("-") and existing devices, FIFOs and sockets are
+// written in place: nothing can be renamed over them.
 class ByteSink {
 public:
     static constexpr size_t kBufferBytes = size_t{1} << 20;
@@ -114,7 +116,9 @@ private:
     void write_raw(const void* data, size_t n);
 
     std::string name_;       // the target path as given
-    std::string temp_path_;  // empty for stdout
+    std::string target_;     // the file it names, symbolic links followed
+    std::string temp_path_;  // empty when written in place (stdout, devices, FIFOs)
+    bool owns_fd_ = false;   // written in place to an opened device or FIFO
     int temp_slot_ = -1;     // register_temp_path() slot
     int fd_ = -1;
     bool committed_ = false;

@@ -19,6 +19,8 @@
 #include <thread>
 #include <vector>
 
+#include <fcntl.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -220,6 +222,48 @@ TEST_F(ByteStreamTest, SinkErrorsNameTheTarget) {
     EXPECT_THROW(io::ByteSink::open(dir_.string()), io::Error);
     EXPECT_THROW(io::ByteSource::open(path("missing.stl")), io::Error);
     EXPECT_THROW(io::ByteSource::open(dir_.string()), io::Error);
+}
+
+TEST_F(ByteStreamTest, SinkWritesThroughSymlinksAndKeepsPermissions) {
+    // A link is followed: the file it names is replaced and the link stays a link.
+    std::ofstream(path("real.stl")) << "old";
+    fs::create_symlink("real.stl", path("link.stl"));
+    write_sink("link.stl", "new", -1);
+    EXPECT_TRUE(fs::is_symlink(path("link.stl")));
+    EXPECT_EQ(slurp(path("real.stl")), "new");
+    // A dangling link names the file to create.
+    fs::create_symlink("sub/made.stl", path("dangling.stl"));
+    fs::create_directory(path("sub"));
+    write_sink("dangling.stl", "made", -1);
+    EXPECT_TRUE(fs::is_symlink(path("dangling.stl")));
+    EXPECT_EQ(slurp(path("sub/made.stl")), "made");
+    // A replaced file keeps its mode.
+    fs::permissions(path("real.stl"), fs::perms::owner_read | fs::perms::owner_write | fs::perms::group_read);
+    write_sink("real.stl", "again", -1);
+    EXPECT_EQ(fs::status(path("real.stl")).permissions() & fs::perms::all,
+              fs::perms::owner_read | fs::perms::owner_write | fs::perms::group_read);
+}
+
+TEST_F(ByteStreamTest, SinkWritesIntoAFifoInPlace) {
+    // Renaming a file over a FIFO (or /dev/null) would replace it; it is written in place.
+    ASSERT_EQ(::mkfifo(path("pipe").c_str(), 0600), 0);
+    const int reader = ::open(path("pipe").c_str(), O_RDONLY | O_NONBLOCK);  // opens without a writer
+    ASSERT_GE(reader, 0);
+    std::string data = test_bytes(40000, 9);  // under a pipe's 64 KiB: no reader thread needed
+    {
+        auto sink = io::ByteSink::open(path("pipe"));
+        EXPECT_FALSE(sink->patchable());
+        sink->write(data);
+        sink->commit();
+    }
+    EXPECT_TRUE(fs::is_fifo(path("pipe")));
+    std::string got(data.size() + 1, '\0');
+    const ssize_t n = ::read(reader, got.data(), got.size());
+    ::close(reader);
+    ASSERT_EQ(n, static_cast<ssize_t>(data.size()));
+    got.resize(static_cast<size_t>(n));
+    EXPECT_TRUE(got == data);
+    EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()), 1);  // no temp left
 }
 
 TEST_F(ByteStreamTest, PatchOverwritesEarlierBytesOfPlainFilesOnly) {
