@@ -22,6 +22,7 @@
 #include <map>
 #include <memory>
 #include <sstream>
+#include <sys/stat.h>
 
 #ifndef MESHSTREAM_VERSION
 #define MESHSTREAM_VERSION "unknown"
@@ -84,6 +85,18 @@ std::string bin_path_for(std::string path) {
     return path + ".bin";
 }
 
+// The .bin beside a .gltf output is replaced when the .gltf is written. When it exists but the
+// .gltf does not, it is not this output's earlier buffer but someone else's (another glTF's,
+// perhaps the input's): refused before any work instead of breaking that file silently.
+void check_side_file(const std::string& gltf_path) {
+    const std::string bin = bin_path_for(gltf_path);
+    struct stat st;
+    if (::stat(bin.c_str(), &st) == 0 && ::stat(gltf_path.c_str(), &st) != 0)
+        throw Error(gltf_path, "its buffer would replace " + bin +
+                                   ", which exists but belongs to no earlier " + gltf_path +
+                                   " (another glTF's buffer?): move it, choose another name, or write .glb");
+}
+
 std::string base_name(const std::string& path) {
     size_t slash = path.find_last_of('/');
     return slash == std::string::npos ? path : path.substr(slash + 1);
@@ -127,6 +140,7 @@ public:
         if (options_.draco_level < 0 || options_.draco_level > 10)
             throw Error(sink.name(), "--draco-cl must be 0-10, got " + std::to_string(options_.draco_level));
         budget_check_up_front(sink.name(), options_, kWhy, options_.draco ? draco_need : plain_need);
+        if (!binary_ && sink.name() != "<stdout>") check_side_file(sink.name());
     }
 
     void write(const TriangleChunk& chunk) override {

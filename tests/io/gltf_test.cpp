@@ -285,6 +285,29 @@ TEST(GltfWriter, GltfWithBinSideFileBothWaysIsValid) {
     }
 }
 
+TEST(GltfWriter, RefusesToReplaceAnotherFilesBuffer) {
+    TempDir dir;
+    Soup cube = read_soup(fixture("cube.bin.stl"));
+    io::WriteOptions o;
+    o.draco = false;
+    // scene.bin exists, scene.gltf does not: the .bin is someone else's and stays as it was.
+    std::ofstream(dir / "scene.bin") << "not mine";
+    try {
+        write_soup(cube, dir / "scene.gltf", o);
+        ADD_FAILURE() << "no error";
+    } catch (const io::Error& e) {
+        EXPECT_NE(std::string(e.what()).find("scene.bin, which exists but belongs to no earlier"), std::string::npos)
+            << e.what();
+    }
+    EXPECT_EQ(slurp(dir / "scene.bin"), "not mine");
+    EXPECT_FALSE(fs::exists(dir / "scene.gltf"));
+    // A pair written earlier is replaced as a pair.
+    fs::remove(dir / "scene.bin");
+    write_soup(cube, dir / "scene.gltf", o);
+    write_soup(cube, dir / "scene.gltf", o);
+    EXPECT_EQ(read_soup(dir / "scene.gltf").xyz, cube.xyz);
+}
+
 TEST(GltfWriter, SmallestIndexTypeAndEmptyMeshAreValid) {
     TempDir dir;
     Soup cube = read_soup(fixture("cube.bin.stl"));
