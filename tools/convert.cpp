@@ -22,9 +22,10 @@ void run_convert(const ConvertOptions& opt) {
     const io::MeshHeader& header = in.reader->header();
     io::WriteOptions wo = opt.write.options(opt.read);
     // Skipped triangles (input_filter.hpp) make the input's count an upper bound: it is
-    // promised to the writer only where nothing can be skipped (--strict) or where the writer
-    // cannot patch its header later (stdout, where a difference is then an error).
-    if (opt.read.strict || opt.output == "-") wo.triangle_count = header.triangle_count;
+    // promised to the writer only where nothing can be skipped (--strict). Otherwise a writer
+    // that puts a count first patches it (files) or spools the body until it knows (stdout,
+    // gzip): a real scan's few degenerate triangles must not fail a pipe at its end.
+    if (opt.read.strict) wo.triangle_count = header.triangle_count;
     wo.expected_triangle_count = header.triangle_count;
     wo.sorted_axis = header.sorted_axis;
     io::Output out = io::open_output(opt.output, opt.write.to, wo, opt.write.gzip_level);
