@@ -29,6 +29,35 @@ uint64_t parse_bytes(const std::string& text) {
     return static_cast<uint64_t>(value * mult);
 }
 
+namespace {
+
+std::string format_names(bool for_writing) {
+    std::string names;
+    for (const io::Format* f : io::formats())
+        if (for_writing ? f->open_writer != nullptr : f->open_reader != nullptr)
+            names += (names.empty() ? "" : ", ") + std::string(f->name);
+    return names;
+}
+
+// --from/--to take a registered format's name: a typo is a command-line error (exit 2).
+CLI::Validator format_name(bool for_writing) {
+    return CLI::Validator(
+        [for_writing](std::string& name) -> std::string {
+            const io::Format* f = io::find_format(name);
+            if (f != nullptr && (for_writing ? f->open_writer != nullptr : f->open_reader != nullptr)) return {};
+            return std::string("unknown ") + (for_writing ? "output" : "input") + " format '" + name +
+                   "' (one of: " + format_names(for_writing) + ")";
+        },
+        "FORMAT");
+}
+
+}  // namespace
+
+void require_format_for_stdout(const std::string& output, const WriteFlags& flags) {
+    if (output == "-" && flags.to.empty())
+        throw UsageError("<stdout>: writing to stdout needs --to (one of: " + format_names(true) + ")");
+}
+
 io::ReadOptions ReadFlags::options() const {
     io::ReadOptions o;
     o.memory_budget_bytes = parse_bytes(memory);
@@ -38,7 +67,8 @@ io::ReadOptions ReadFlags::options() const {
 }
 
 void add_read_flags(CLI::App* cmd, ReadFlags& flags) {
-    cmd->add_option("--from", flags.from, "Input format, overriding detection (e.g. stl, stl-ascii)");
+    cmd->add_option("--from", flags.from, "Input format, overriding detection (e.g. stl, stl-ascii)")
+        ->check(format_name(false));
     cmd->add_option("--memory", flags.memory,
                     "Memory budget for tables, spills and sort runs, e.g. 64M, 1G (default 256M)");
     cmd->add_option("--tmpdir", flags.tmpdir, "Directory for temporary files (default: $TMPDIR or /tmp)");
@@ -59,7 +89,8 @@ io::WriteOptions WriteFlags::options(const ReadFlags& read) const {
 }
 
 void add_write_flags(CLI::App* cmd, WriteFlags& flags) {
-    cmd->add_option("--to", flags.to, "Output format, overriding the extension (e.g. stl, stl-ascii)");
+    cmd->add_option("--to", flags.to, "Output format, overriding the extension (e.g. stl, stl-ascii)")
+        ->check(format_name(true));
     cmd->add_option("--gzip-level", flags.gzip_level, "zlib level 0-9 for outputs ending in .gz (default 6)")
         ->check(CLI::Range(0, 9));
     // Draco (.drc) and glTF (.glb/.gltf) hold the whole mesh in memory (docs/formats.md).
@@ -163,6 +194,11 @@ std::string human_bytes(double bytes) {
 bool is_regular_file(const std::string& path) {
     struct stat st;
     return path != "-" && ::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
+}
+
+bool is_stream(const std::string& path) {
+    struct stat st;
+    return path == "-" || (::stat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode) && !S_ISDIR(st.st_mode));
 }
 
 io::Bounds input_bounds(const std::string& path, std::string_view from, const io::ReadOptions& options) {

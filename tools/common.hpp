@@ -11,9 +11,16 @@
 #include <cstdint>
 #include <map>
 #include <optional>
+#include <stdexcept>
 #include <string>
 
 namespace meshstream::tools {
+
+// A command line that cannot work, found after parsing (an option that needs a file given a
+// stream, '-' without --to): exit code 2, like CLI11's own errors, before any work.
+struct UsageError : std::runtime_error {
+    using std::runtime_error::runtime_error;
+};
 
 // Parses "256M", "64MiB", "1G", "1.5g", "4096" (bytes; K/M/G/T are binary multiples).
 // Throws CLI::ValidationError on bad text.
@@ -40,6 +47,8 @@ struct WriteFlags {
 };
 // `with_memory`: false when add_read_flags already added --memory/--tmpdir to `cmd`.
 void add_write_flags(CLI::App* cmd, WriteFlags& flags);
+// Throws UsageError when `output` is stdout ("-") and no --to names its format.
+void require_format_for_stdout(const std::string& output, const WriteFlags& flags);
 
 // Global flags (set by main before a subcommand runs).
 struct Global {
@@ -91,6 +100,8 @@ std::string human_count(double n, int significant_digits = 0);
 std::string human_bytes(double bytes);
 // True for an existing regular file (not "-", a pipe or a device): one that can be read twice.
 bool is_regular_file(const std::string& path);
+// True for "-" and existing pipes, devices and sockets: what can be read (or written) once only.
+bool is_stream(const std::string& path);
 // The input's bounding box: from its header when the format states it, else from a first pass
 // over the file (finite coordinates only; a progress bar on stderr). An input without finite
 // coordinates gives min = +inf, max = -inf. Throws io::Error like open_input.

@@ -51,6 +51,8 @@ nlohmann::ordered_json stats_json(const DistanceStats& s, double diagonal) {
 }
 
 void run_compare(const CompareCliOptions& opt) {
+    if (is_stream(opt.a) && is_stream(opt.b))
+        throw UsageError("compare cannot read both A and B from stdin or pipes: one of them is read twice");
     io::ReadOptions read = opt.read.options();
     CompareOptions co;
     co.samples = opt.samples;

@@ -48,8 +48,8 @@ double weld_epsilon(const DecimateOptions& opt, const io::MeshHeader& header, co
         throw CLI::ValidationError("--weld", "must be a non-negative number, found '" + text + "'");
     if (!percent) return value;
     if (!header.bounds && !is_regular_file(opt.input))
-        throw io::Error(input_name, "--weld " + text + " needs the bounding box, which this format does not state "
-                                    "up front and a stream cannot be read twice for; give an absolute size instead");
+        throw UsageError(input_name + ": --weld " + text + " needs the bounding box, which this format does not state "
+                                       "up front and a stream cannot be read twice for; give an absolute size instead");
     const io::Bounds box = header.bounds ? *header.bounds : input_bounds(opt.input, opt.read.from, opt.read.options());
     double diag2 = 0;
     for (int i = 0; i < 3; ++i) {
@@ -62,9 +62,15 @@ double weld_epsilon(const DecimateOptions& opt, const io::MeshHeader& header, co
 void run_decimate(const DecimateOptions& opt) {
     const auto start = std::chrono::steady_clock::now();
     // Checked before any work: the comparison re-reads both files once the output is done.
-    if (opt.report && (opt.input == "-" || opt.output == "-"))
-        throw io::Error(opt.input == "-" ? "<stdin>" : "<stdout>",
-                        "--report needs to re-read both files; it does not work with '-'");
+    require_format_for_stdout(opt.output, opt.write);
+    if (opt.report) {
+        const bool input_stream = is_stream(opt.input);
+        if (input_stream || is_stream(opt.output)) {
+            const std::string name = input_stream ? (opt.input == "-" ? "<stdin>" : opt.input)
+                                                  : (opt.output == "-" ? "<stdout>" : opt.output);
+            throw UsageError(name + ": --report needs to re-read both files; it does not work with '-' or a pipe");
+        }
+    }
     io::Input in = io::open_input(opt.input, opt.read.from, opt.read.options());
     const io::MeshHeader& header = in.reader->header();
 

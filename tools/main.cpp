@@ -5,7 +5,9 @@
 #include "tools/commands.hpp"
 #include "tools/common.hpp"
 
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <exception>
 #include <new>
 #include <string>
@@ -45,6 +47,9 @@ int main(int argc, char** argv) {
     } catch (const CLI::ParseError& e) {
         int code = app.exit(e);  // prints help (code 0) or the parse error
         return code == 0 ? 0 : 2;
+    } catch (const tools::UsageError& e) {
+        std::fprintf(stderr, "meshstream: error: %s\n", e.what());
+        return 2;
     } catch (const meshstream::io::Error& e) {
         std::fprintf(stderr, "meshstream: error: %s\n", e.what());
         return 1;
@@ -53,6 +58,12 @@ int main(int argc, char** argv) {
         return 1;
     } catch (const std::exception& e) {
         std::fprintf(stderr, "meshstream: error: %s\n", e.what());
+        return 1;
+    }
+    // Reports and summaries printed to stdout (info, compare, --help) are output too: a full
+    // disk or a closed pipe must not end in exit 0.
+    if (std::fflush(stdout) != 0 || std::ferror(stdout)) {
+        std::fprintf(stderr, "meshstream: error: <stdout>: write failed: %s\n", std::strerror(errno));
         return 1;
     }
     return 0;

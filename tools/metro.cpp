@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <sys/stat.h>
 
 namespace meshstream::tools {
 namespace {
@@ -528,6 +529,8 @@ EdgeCounts EdgeCounter::finish() {
 MeshSource file_source(const std::string& path, std::string_view from, const io::ReadOptions& options) {
     MeshSource s;
     s.name = path;
+    struct stat st;
+    s.once = path == "-" || (::stat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode));
     s.open = [path, from = std::string(from), options]() -> std::unique_ptr<io::Reader> {
         return std::make_unique<InputReader>(io::open_input(path, from, options));
     };
@@ -561,11 +564,12 @@ double MeshSummary::diagonal() const {
 // ---- compare_meshes ----------------------------------------------------------------------
 
 CompareResult compare_meshes(const MeshSource& a, const MeshSource& b, const CompareOptions& options) {
-    // Which one to hold: the smaller by header count when both are known, else B. Stdin
-    // cannot be read twice, so a mesh from "-" is always the held one.
-    if (a.name == "-" && b.name == "-") throw io::Error("-", "compare cannot read both meshes from stdin");
-    bool hold_a = a.name == "-";
-    if (a.name != "-" && b.name != "-") {
+    // Which one to hold: the smaller by header count when both are known, else B. A stream
+    // cannot be read twice (nor opened once just for its count), so it is always the held one.
+    if (a.once && b.once)
+        throw io::Error(b.name, "compare cannot stream both meshes (stdin or pipes): one of them is read twice");
+    bool hold_a = a.once;
+    if (!a.once && !b.once) {
         std::optional<uint64_t> count_a = a.open()->triangle_count();
         std::optional<uint64_t> count_b = b.open()->triangle_count();
         hold_a = count_a && count_b && *count_a < *count_b;

@@ -30,9 +30,11 @@ namespace meshstream::tools {
 struct MeshSource {
     std::string name;  // for messages and reports
     std::function<std::unique_ptr<io::Reader>()> open;
+    bool once = false;  // readable once only (stdin, a pipe): it must be the held mesh
 };
 
-// A file ("-" = stdin, which can only be the in-memory side), format `from` (empty: detect).
+// A file ("-" = stdin, or a pipe, which can only be the in-memory side), format `from` (empty:
+// detect).
 MeshSource file_source(const std::string& path, std::string_view from = {}, const io::ReadOptions& options = {});
 // Triangles held by the caller (9 floats each), for tests and in-process comparisons.
 MeshSource memory_source(std::string name, std::vector<float> xyz);

@@ -152,6 +152,7 @@ int longest_axis(const SortOptions& opt, const io::ReadOptions& ro) {
 
 void run_sort(const SortOptions& opt) {
     const auto t0 = std::chrono::steady_clock::now();
+    require_format_for_stdout(opt.output, opt.write);
     if (opt.output != "-") {
         // Fail before a long sort, not after it.
         std::string dir = io::parent_dir(opt.output);
@@ -171,9 +172,9 @@ void run_sort(const SortOptions& opt) {
     int axis;
     if (opt.axis == "auto") {
         if (!is_regular_file(opt.input))
-            throw io::Error(opt.input == "-" ? "<stdin>" : opt.input,
-                            "--axis auto reads the input twice (bounding box first), which needs a regular file; "
-                            "give --axis x, y or z to sort a stream");
+            throw UsageError((opt.input == "-" ? std::string("<stdin>") : opt.input) +
+                             ": --axis auto reads the input twice (bounding box first), which needs a regular file; "
+                             "give --axis x, y or z to sort a stream");
         axis = longest_axis(opt, ro);
     } else {
         axis = static_cast<int>(std::find(std::begin(kAxisNames), std::end(kAxisNames), opt.axis) - std::begin(kAxisNames));

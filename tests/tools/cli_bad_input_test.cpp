@@ -113,11 +113,11 @@ TEST(CliBadInput, DecimateReportWithAPipeIsRefusedBeforeAnyOutput) {
     TempDir dir;
     write_file(dir / "in.stl", binary_stl(grid(4)));
     CliRun r = run("decimate --report -r 0.5 - " + dir / "out.stl" + " < " + dir / "in.stl");
-    EXPECT_EQ(r.code, 1) << r.err;
+    EXPECT_EQ(r.code, 2) << r.err;  // a command line that cannot work
     EXPECT_EQ(r.err.rfind("meshstream: error: <stdin>: --report needs to re-read both files", 0), 0u) << r.err;
     EXPECT_EQ(listing(dir.path), std::vector<std::string>{"in.stl"});
     CliRun w = run("decimate --report -r 0.5 --to stl " + dir / "in.stl" + " -");
-    EXPECT_EQ(w.code, 1) << w.err;
+    EXPECT_EQ(w.code, 2) << w.err;
     EXPECT_EQ(w.err.rfind("meshstream: error: <stdout>: --report", 0), 0u) << w.err;
 }
 
@@ -258,9 +258,62 @@ TEST(CliBadInput, WeldPercentReadsTheBoxFirstOrRefusesAStream) {
     EXPECT_NE(coarse.err.find("warning: --weld 30% welded the corners of "), std::string::npos) << coarse.err;
     EXPECT_NE(coarse.err.find("it is coarser than the mesh; weld on a smaller size\n"), std::string::npos) << coarse.err;
     CliRun p = run("decimate -r 0.5 --weld 0.5% - " + dir / "piped.stl" + " < " + dir / "in.stl");
-    EXPECT_EQ(p.code, 1) << p.err;
+    EXPECT_EQ(p.code, 2) << p.err;
     EXPECT_NE(p.err.find("<stdin>: --weld 0.5% needs the bounding box"), std::string::npos) << p.err;
     EXPECT_FALSE(fs::exists(dir / "piped.stl"));
+}
+
+TEST(CliBadInput, CommandLinesThatCannotWorkExit2BeforeAnyWork) {
+    TempDir dir;
+    write_file(dir / "in.stl", binary_stl(grid(4)));
+    const std::string in = dir / "in.stl", out = dir / "out.stl";
+    const struct {
+        std::string args;
+        const char* message;
+    } cases[] = {
+        {"convert " + in + " " + out + " --to foo", "--to: unknown output format 'foo' (one of: draco, glb"},
+        {"convert " + in + " " + out + " --from foo", "--from: unknown input format 'foo'"},
+        {"convert " + in + " -", "<stdout>: writing to stdout needs --to (one of: draco"},
+        {"decimate -r 0.5 " + in + " -", "<stdout>: writing to stdout needs --to"},
+        {"sort --axis x " + in + " -", "<stdout>: writing to stdout needs --to"},
+        {"sort - " + out + " < " + in, "<stdin>: --axis auto reads the input twice"},
+        {"compare - - < " + in, "compare cannot read both A and B from stdin or pipes"},
+        {"decimate --report -r 0.5 " + in + " /dev/null --to stl", "/dev/null: --report needs to re-read both files"},
+    };
+    for (const auto& c : cases) {
+        CliRun r = run(c.args);
+        EXPECT_EQ(r.code, 2) << c.args << ": " << r.err;
+        EXPECT_NE(r.err.find(c.message), std::string::npos) << c.args << ": " << r.err;
+        EXPECT_EQ(listing(dir.path), std::vector<std::string>{"in.stl"}) << c.args;
+    }
+}
+
+TEST(CliBadInput, CompareHoldsAMeshFromAPipe) {
+    // A pipe cannot be opened once for its count and then again: it is the held mesh, as '-'.
+    TempDir dir;
+    write_file(dir / "small.stl", binary_stl(grid(2)));
+    write_file(dir / "big.stl", binary_stl(grid(6)));
+    ASSERT_EQ(::mkfifo((dir / "pipe").c_str(), 0600), 0);
+    for (const bool pipe_is_a : {false, true}) {
+        const std::string a = pipe_is_a ? dir / "pipe" : dir / "small.stl";
+        const std::string b = pipe_is_a ? dir / "small.stl" : dir / "pipe";
+        CliRun r = run("compare --json --samples 1000 " + a + " " + b + " > " + dir / "r.json",
+                       "cat " + dir / "big.stl" + " > " + dir / "pipe" + " &");
+        ASSERT_EQ(r.code, 0) << r.err;
+        const std::string json = slurp(dir / "r.json");
+        EXPECT_NE(json.find("\"triangles\": 72"), std::string::npos) << json;  // the piped mesh, whole
+    }
+}
+
+TEST(CliBadInput, StdoutWriteFailuresExit1) {
+    TempDir dir;
+    write_file(dir / "in.stl", binary_stl(grid(4)));
+    for (const std::string& cmd : {std::string("info --json "), "compare --json --samples 1000 " + dir / "in.stl" + " "}) {
+        CliRun r = run(cmd + dir / "in.stl" + " > /dev/full");
+        EXPECT_EQ(r.code, 1) << cmd << r.err;
+        EXPECT_NE(r.err.find("meshstream: error: <stdout>: write failed: No space left on device"), std::string::npos)
+            << cmd << r.err;
+    }
 }
 
 TEST(CliBadInput, UnknownCommandIsNamedAndVersionIsPrinted) {
