@@ -255,7 +255,7 @@ std::string format_order_text(const OrderReport& r, uint64_t buffer_triangles) {
     if (r.exact()) {
         out += " (exact)";
     } else {
-        std::snprintf(buf, sizeof buf, " ± %.0f (≈95%%; sampled 1/%.0f of the triangles to fit --memory)",
+        std::snprintf(buf, sizeof buf, " ± %.0f (3σ; sampled 1/%.0f of the triangles to fit --memory)",
                       r.width_error, 1 / r.sample_rate);
         out += buf;
     }
