@@ -19,6 +19,8 @@ int main(int argc, char** argv) {
     app.add_flag("-q,--quiet", tools::global().quiet, "No progress bar");
     app.set_version_flag("--version", std::string("meshstream ") + MESHSTREAM_VERSION);
     app.require_subcommand(1);
+    // Subcommands pass options they do not know to the app, so -q works after the command too.
+    app.fallthrough();
     tools::add_info(app);
     tools::add_convert(app);
     tools::add_decimate(app);

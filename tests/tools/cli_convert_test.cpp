@@ -91,6 +91,16 @@ TEST(CliConvert, BadCommandLineExits2) {
     EXPECT_EQ(run("convert " + kBunny + " out.stl --gzip-level 12").code, 2);
 }
 
+TEST(CliConvert, QuietWorksAfterTheCommandToo) {
+    TempDir dir;
+    for (const char* flag : {"-q", "--quiet"}) {
+        cli_test::CliRun r = run("convert " + kBunny + " " + dir / "out.stl " + flag);
+        EXPECT_EQ(r.code, 0) << flag << ": " << r.err;
+        EXPECT_TRUE(std::filesystem::exists(dir / "out.stl")) << flag;
+        std::filesystem::remove(dir / "out.stl");
+    }
+}
+
 TEST(CliConvert, UnknownOutputExtensionIsAnErrorNamingTheFile) {
     TempDir dir;
     auto r = run("convert " + kBunny + " " + (dir / "out.xyz"));
