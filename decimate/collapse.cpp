@@ -239,6 +239,21 @@ bool collapse_valid(HalfEdgeBuffer& buffer, uint32_t h, const double target[3]) 
         }
     }
 
+    // Into a written q: p's other written neighbours y would gain an edge q–y, which the
+    // written mesh may already hold (two P_out stretches meeting, a written triangle q, y, z
+    // beyond a thin strip): the link condition above sees only in-core edges, and the output
+    // would get an edge with four triangles. Such collapses are refused; edges to unwritten
+    // neighbours are all in core, so the link condition covers them.
+    if ((vq.flags & kFrozen) != 0) {
+        auto written_other = [&](uint32_t y) {
+            return y != q && y != r && y != s && (buffer.vertex(y).flags & kFrozen) != 0;
+        };
+        for (uint32_t cp = vp.first_corner; cp != kNoIndex; cp = buffer.next_corner(cp))
+            if (written_other(buffer.corner_vertex(next_in_face(cp))) ||
+                written_other(buffer.corner_vertex(prev_in_face(cp))))
+                return false;
+    }
+
     double from_p[3];
     buffer.position(p, from_p);
     const uint32_t skip1 = boundary ? kNoIndex : face_of(t);
