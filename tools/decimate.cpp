@@ -152,9 +152,13 @@ void run_decimate(const DecimateOptions& opt) {
     if (s.forced_writes > 0)
         warnings.note("buffer full of undecimatable triangles: " + std::to_string(s.forced_writes) +
                      " triangles force-written at full resolution (" +
-                     std::to_string(s.premature_writes) +
-                     " written before reaching the target resolution); the input is not in streaming order: "
-                     "run `meshstream sort` on it first, or raise --buffer");
+                     std::to_string(s.premature_writes) + " written before reaching the target resolution)" +
+                     (s.orphans_evicted > 0
+                          ? "; " + std::to_string(s.orphans_evicted) +
+                                " of their vertices were evicted from the weld table to make room, so triangles "
+                                "read later at those positions are not joined to them (the output has cracks there)"
+                          : std::string()) +
+                     "; the input is not in streaming order: run `meshstream sort` on it first, or raise --buffer");
     if (s.sort_violations > 0)
         warnings.note(std::string("the input is not sorted along ") + "xyz"[*options.sorted_axis] +
                      " as stated: " + std::to_string(s.sort_violations) +
