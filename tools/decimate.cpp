@@ -158,7 +158,12 @@ void run_decimate(const DecimateOptions& opt) {
                                 " of their vertices were evicted from the weld table to make room, so triangles "
                                 "read later at those positions are not joined to them (the output has cracks there)"
                           : std::string()) +
-                     "; the input is not in streaming order: run `meshstream sort` on it first, or raise --buffer");
+                     (options.sorted_axis && s.sort_violations == 0
+                          ? "; the input is sorted, but its width (the triangles held before all their neighbours "
+                            "arrive) is more than the buffer holds: raise --buffer (`meshstream info --order` "
+                            "measures the width; decimate needs about a quarter more)"
+                          : "; the input is not in streaming order: run `meshstream sort` on it first, or raise "
+                            "--buffer"));
     if (s.sort_violations > 0)
         warnings.note(std::string("the input is not sorted along ") + "xyz"[*options.sorted_axis] +
                      " as stated: " + std::to_string(s.sort_violations) +

@@ -223,7 +223,7 @@ OrderReport OrderMeter::finish() {
 BufferVerdict buffer_verdict(const OrderReport& report, uint64_t buffer_triangles) {
     const double b = static_cast<double>(buffer_triangles);
     const double w = static_cast<double>(report.width);
-    if (w + report.width_error <= b) return BufferVerdict::kSuffices;
+    if (kBufferPerWidth * (w + report.width_error) <= b) return BufferVerdict::kSuffices;
     if (w - report.width_error > b) return BufferVerdict::kTooSmall;
     return BufferVerdict::kUncertain;
 }
@@ -244,7 +244,9 @@ std::optional<std::string> sorting_hint(const OrderReport& report, uint64_t buff
     std::string width = human_count(static_cast<double>(report.width), 3) + " triangles";
     if (report.descents[axis] == 0)
         return "the input is already sorted along " + std::string(kAxisNames[axis]) + " but its width is " + width +
-               "; a --buffer of at least that would avoid forced writes";
+               "; a --buffer of " +
+               std::to_string(static_cast<uint64_t>(std::ceil(kBufferPerWidth * double(report.width)))) +
+               " (a quarter more) would avoid forced writes";
     return "the input's width is " + width + " (a --buffer of " + std::to_string(buffer_triangles) +
            " holds fewer): sorting it first would help (meshstream sort --axis " + kAxisNames[axis] + ")";
 }
@@ -271,7 +273,7 @@ std::string format_order_text(const OrderReport& r, uint64_t buffer_triangles) {
     out += "buffer:      --buffer " + std::to_string(buffer_triangles) +
            (v == BufferVerdict::kSuffices  ? " suffices\n"
             : v == BufferVerdict::kTooSmall ? " is too small (decimate would force-write)\n"
-                                            : " may be too small (within the estimate's error)\n");
+                                            : " may be too small (decimate needs the width and a quarter more)\n");
     std::snprintf(buf, sizeof buf, "key descents: x %llu, y %llu, z %llu",
                   static_cast<unsigned long long>(r.descents[0]), static_cast<unsigned long long>(r.descents[1]),
                   static_cast<unsigned long long>(r.descents[2]));

@@ -212,6 +212,16 @@ TEST(CliBadInput, ForcedWritesEndWithAWarningThatAdvisesSort) {
               std::string::npos) << line;
     EXPECT_NE(line.find("run `meshstream sort` on it first, or raise --buffer"), std::string::npos) << line;
     EXPECT_NE(line.back(), ')') << line;  // no event count appended
+
+    // Sorted input (here in row order, said by --sorted-axis) in a buffer below its width:
+    // sorting again would not help, a larger buffer would.
+    write_file(dir / "rows.stl", binary_stl(tris));
+    CliRun s = run("decimate --buffer 40 --sorted-axis y -r 0.1 " + dir / "rows.stl" + " " + dir / "out2.stl");
+    EXPECT_EQ(s.code, 0) << s.err;
+    EXPECT_NE(s.err.find("; the input is sorted, but its width (the triangles held before all their neighbours arrive) "
+                         "is more than the buffer holds: raise --buffer"),
+              std::string::npos) << s.err;
+    EXPECT_EQ(s.err.find("run `meshstream sort`"), std::string::npos) << s.err;
 }
 
 // Whole-mesh outputs (Draco, glTF) whose known size cannot fit --memory are refused before

@@ -122,15 +122,17 @@ TEST(OrderMeter, BufferVerdictAndHint) {
     r.width = 500000;
     r.descents = {10, 20, 30000};
     EXPECT_EQ(tools::buffer_verdict(r, 400000), tools::BufferVerdict::kTooSmall);
-    EXPECT_EQ(tools::buffer_verdict(r, 500000), tools::BufferVerdict::kSuffices);
+    EXPECT_EQ(tools::buffer_verdict(r, 500000), tools::BufferVerdict::kUncertain);  // no room behind the front
+    EXPECT_EQ(tools::buffer_verdict(r, 625000), tools::BufferVerdict::kSuffices);
     std::optional<std::string> hint = tools::sorting_hint(r, 400000);
     ASSERT_TRUE(hint);
     EXPECT_NE(hint->find("sorting it first would help (meshstream sort --axis x)"), std::string::npos) << *hint;
-    EXPECT_FALSE(tools::sorting_hint(r, 600000));
+    EXPECT_FALSE(tools::sorting_hint(r, 625000));
     r.descents = {10, 0, 5};
     hint = tools::sorting_hint(r, 400000);
     ASSERT_TRUE(hint);
     EXPECT_NE(hint->find("already sorted along y"), std::string::npos) << *hint;
+    EXPECT_NE(hint->find("a --buffer of 625000 (a quarter more) would avoid forced writes"), std::string::npos) << *hint;
     r.sample_rate = 1.0 / 16;
     r.width_error = 200000;
     EXPECT_EQ(tools::buffer_verdict(r, 400000), tools::BufferVerdict::kUncertain);
