@@ -1,0 +1,24 @@
+// Reads a mesh through the installed io library and decimates it with the installed decimator:
+// prints "<input triangles> <output triangles>".
+#include "decimate/stream_decimator.hpp"
+#include "io/format.hpp"
+
+#include <cstdio>
+
+int main(int argc, char** argv) {
+    if (argc != 2) return 2;
+    meshstream::io::Input in = meshstream::io::open_input(argv[1]);
+    meshstream::decimate::Options options;
+    options.ratio = 0.5;
+    meshstream::decimate::StreamDecimator decimator(options, in.reader->header().triangle_count);
+    unsigned long long read = 0, written = 0;
+    auto emit = [&](const meshstream::io::TriangleChunk& chunk) { written += chunk.size(); };
+    meshstream::io::TriangleChunk chunk;
+    while (in.reader->next(chunk)) {
+        read += chunk.size();
+        decimator.push(chunk, emit);
+    }
+    decimator.finish(emit);
+    std::printf("%llu %llu\n", read, written);
+    return 0;
+}
