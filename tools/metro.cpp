@@ -488,12 +488,14 @@ void EdgeCounter::add_triangle(const float* tri) {
     uint32_t v[3][3];
     for (int i = 0; i < 3; ++i)
         for (int a = 0; a < 3; ++a) v[i][a] = Impl::bits(tri[3 * i + a]);
+    // A triangle with a repeated corner (a, b, b) is no surface element: its edge a–b, met both
+    // ways, would otherwise count as two uses and make a manifold edge non-manifold.
+    for (int e = 0; e < 3; ++e)
+        if (std::equal(v[e], v[e] + 3, v[(e + 1) % 3])) return;
     for (int e = 0; e < 3; ++e) {
         const uint32_t* p = v[e];
         const uint32_t* q = v[(e + 1) % 3];
-        bool less = std::lexicographical_compare(p, p + 3, q, q + 3);
-        if (!less && std::equal(p, p + 3, q)) continue;  // zero-length edge
-        if (!less) std::swap(p, q);
+        if (!std::lexicographical_compare(p, p + 3, q, q + 3)) std::swap(p, q);
         m.buffer.push_back({p[0], p[1], p[2], q[0], q[1], q[2]});
         if (m.buffer.size() >= m.buffer_capacity) m.spill();
     }

@@ -53,7 +53,8 @@ struct CompareOptions {
 uint64_t default_sample_count(uint64_t triangle_count);
 
 struct EdgeCounts {
-    uint64_t edges = 0;               // distinct edges after exact welding (zero-length skipped)
+    uint64_t edges = 0;               // distinct edges after exact welding (triangles with a
+                                      // repeated corner add none)
     uint64_t boundary_edges = 0;      // used by exactly one triangle
     uint64_t non_manifold_edges = 0;  // used by three or more triangles
 };

@@ -65,10 +65,12 @@ void TopologyCounter::add(const io::TriangleChunk& chunk) {
             }
             sorters_->vertices.push(k[c]);
         }
+        // A triangle with a repeated corner (a, b, b) is no surface element: its edge a–b, met
+        // both ways, would otherwise count as two uses and make a manifold edge non-manifold.
+        if (k[0] == k[1] || k[1] == k[2] || k[2] == k[0]) continue;
         for (int e = 0; e < 3; ++e) {
             const VertexKey& u = k[e];
             const VertexKey& v = k[(e + 1) % 3];
-            if (u == v) continue;
             sorters_->edges.push(u < v ? EdgeKey{u, v} : EdgeKey{v, u});
         }
     }

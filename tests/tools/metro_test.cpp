@@ -193,15 +193,16 @@ TEST(EdgeCounter, ThreeTrianglesOnOneEdgeIsOneNonManifoldEdge) {
     EXPECT_EQ(c.non_manifold_edges, 1u);
 }
 
-TEST(EdgeCounter, NegativeZeroWeldsWithZeroAndZeroLengthEdgesAreSkipped) {
+TEST(EdgeCounter, NegativeZeroWeldsWithZeroAndTrianglesWithARepeatedCornerAddNoEdges) {
     float a[3] = {0, 0, 0}, b[3] = {1, 0, 0}, c[3] = {0, 1, 0}, nc[3] = {-0.0f, 1, -0.0f}, d[3] = {1, 1, 0};
     float e[3] = {5, 5, 5}, f[3] = {6, 5, 5};
     std::vector<float> tris;
     push_tri(tris, a, b, c);
     push_tri(tris, nc, b, d);  // shares b-c through -0 == +0
-    push_tri(tris, e, e, f);   // degenerate: e-e is skipped, e-f is used twice
+    push_tri(tris, e, e, f);   // no surface: adds nothing
+    push_tri(tris, a, b, b);   // lies on a-b: counted, a-b would have three uses (non-manifold)
     EdgeCounts counts = count_edges(tris);
-    EXPECT_EQ(counts.edges, 6u);           // ab, bc, ca, bd, dc, ef
+    EXPECT_EQ(counts.edges, 5u);           // ab, bc, ca, bd, dc
     EXPECT_EQ(counts.boundary_edges, 4u);  // ab, ca, bd, dc
     EXPECT_EQ(counts.non_manifold_edges, 0u);
 }
