@@ -65,6 +65,14 @@ std::vector<float> grid(int k) {
     return tris;
 }
 
+// Replaces every `token` in `text` by `value`, scanning forward. Tokens are braced: a bare
+// OUT replaced by a temporary directory that happened to be named ...-jOUT2b looped forever.
+std::string expand(std::string text, const std::string& token, const std::string& value) {
+    for (size_t at = 0; (at = text.find(token, at)) != std::string::npos; at += value.size())
+        text.replace(at, token.size(), value);
+    return text;
+}
+
 void write_file(const std::string& path, const std::string& bytes) {
     std::ofstream(path, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
 }
@@ -406,11 +414,10 @@ TEST(CliBadInput, HelpDescribesTheSkipPolicy) {
 // open, so the command is provably still running (blocked reading) when SIGINT arrives.
 TEST(CliBadInput, SigintDuringConvertSortDecimateLeavesNoFiles) {
     const std::string stl = binary_stl(grid(200));  // 80000 triangles, 4 MB
-    for (const char* args : {"convert --from stl - OUT/out.ply", "sort --from stl --axis x --memory 1M --tmpdir OUT - OUT/out.stl",
-                             "decimate --from stl --ratio 0.2 - OUT/out.stl"}) {
+    for (const char* args : {"convert --from stl - {OUT}/out.ply", "sort --from stl --axis x --memory 1M --tmpdir {OUT} - {OUT}/out.stl",
+                             "decimate --from stl --ratio 0.2 - {OUT}/out.stl"}) {
         TempDir dir;
-        std::string cmdline = args;
-        for (size_t at; (at = cmdline.find("OUT")) != std::string::npos;) cmdline.replace(at, 3, dir.path.string());
+        const std::string cmdline = expand(args, "{OUT}", dir.path.string());
         int fds[2];
         ASSERT_EQ(::pipe(fds), 0);
         pid_t pid = ::fork();
@@ -452,12 +459,10 @@ TEST(CliBadInput, SigintDuringConvertSortDecimateLeavesNoFiles) {
 TEST(CliBadInput, FileSizeLimitGivesAClearErrorAndNoFiles) {
     TempDir dir;
     write_file(dir / "in.stl", binary_stl(grid(100)));  // 20000 triangles, 1 MB
-    for (const char* args : {"convert IN OUT/out.ply", "convert IN OUT/out.stl", "sort --axis x IN OUT/out.stl",
-                             "decimate --ratio 0.9 IN OUT/out.stl"}) {
-        std::string cmdline = args;
+    for (const char* args : {"convert {IN} {OUT}/out.ply", "convert {IN} {OUT}/out.stl", "sort --axis x {IN} {OUT}/out.stl",
+                             "decimate --ratio 0.9 {IN} {OUT}/out.stl"}) {
         fs::create_directory(dir / "o");
-        cmdline.replace(cmdline.find("IN"), 2, dir / "in.stl");
-        cmdline.replace(cmdline.find("OUT"), 3, dir / "o");
+        const std::string cmdline = expand(expand(args, "{OUT}", dir / "o"), "{IN}", dir / "in.stl");
         CliRun r = run(cmdline, "ulimit -f 256;");  // 128 KiB (dash counts 512-byte blocks)
         EXPECT_EQ(r.code, 1) << args << ": " << r.err;
         EXPECT_NE(r.err.find("meshstream: error: "), std::string::npos) << r.err;
