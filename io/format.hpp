@@ -25,7 +25,7 @@ struct Bounds {
 // What a reader knows from the file's header, before or while streaming. Every field is
 // optional: formats fill what they know.
 struct MeshHeader {
-    std::optional<uint64_t> triangle_count;  // total triangles (after fan triangulation)
+    std::optional<uint64_t> triangle_count;  // total triangles (an n-gon counts n - 2)
     std::optional<uint64_t> vertex_count;    // indexed formats
     std::optional<int> sorted_axis;          // 0,1,2 when the file says it is sorted (meshstream sort)
     std::optional<Bounds> bounds;            // when the header states it (glTF accessors)

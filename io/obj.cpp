@@ -51,7 +51,9 @@ public:
     bool next(TriangleChunk& chunk) override {
         chunk.clear();
         for (;;) {
-            if (fan_next_ + 1 < polygon_.size() && !emit_fan(table_, polygon_, &fan_next_, chunk)) return true;
+            if (polygon_next_ + 2 < polygon_.size() &&
+                !emit_polygon(table_, polygon_, polygon_scratch_, &polygon_next_, chunk))
+                return true;
             if (chunk.full()) return true;
             if (!next_statement()) return !chunk.empty();
         }
@@ -163,7 +165,7 @@ private:
 
     void read_face(std::string_view rest) {
         polygon_.clear();
-        fan_next_ = 1;
+        polygon_next_ = 0;
         const uint64_t defined = table_.size();
         for (;;) {
             std::string_view tok = next_word(rest);
@@ -194,7 +196,8 @@ private:
     std::string_view line_;
     uint64_t line_no_ = 0, physical_lines_ = 0, line_offset_ = 0;
     std::vector<uint64_t> polygon_;
-    size_t fan_next_ = 1;
+    PolygonScratch polygon_scratch_;
+    size_t polygon_next_ = 0;  // next triangle of polygon_ to emit
 };
 
 class ObjWriter : public Writer {

@@ -109,8 +109,8 @@ public:
     bool next(TriangleChunk& chunk) override {
         chunk.clear();
         for (;;) {
-            if (fan_next_ + 1 < polygon_.size()) {
-                if (!emit_fan(*table_, polygon_, &fan_next_, chunk)) return true;
+            if (polygon_next_ + 2 < polygon_.size()) {
+                if (!emit_polygon(*table_, polygon_, polygon_scratch_, &polygon_next_, chunk)) return true;
             }
             if (chunk.full()) return true;
             // Elements after the faces carry nothing we use and are not read: real files get
@@ -529,7 +529,7 @@ private:
     void read_face() {
         const Element& e = elements_[static_cast<size_t>(face_)];
         polygon_.clear();
-        fan_next_ = 1;
+        polygon_next_ = 0;
         for (size_t p = 0; p < e.props.size(); ++p) {
             const Property& prop = e.props[p];
             if (static_cast<int>(p) != index_prop_) {
@@ -586,7 +586,8 @@ private:
     uint64_t token_offset_ = 0;
     std::unique_ptr<VertexTable> table_;
     std::vector<uint64_t> polygon_;
-    size_t fan_next_ = 1;
+    PolygonScratch polygon_scratch_;
+    size_t polygon_next_ = 0;  // next triangle of polygon_ to emit
 };
 
 // ---------------- writer ----------------

@@ -167,19 +167,43 @@ void VertexTable::get(uint64_t i, float* xyz, uint8_t* rgb) {
     }
 }
 
-bool emit_fan(VertexTable& table, const std::vector<uint64_t>& polygon, size_t* next, TriangleChunk& chunk) {
-    while (*next + 1 < polygon.size()) {
+bool emit_polygon(VertexTable& table, const std::vector<uint64_t>& polygon, PolygonScratch& scratch, size_t* next,
+                  TriangleChunk& chunk) {
+    const size_t n = polygon.size();
+    if (*next + 2 >= n) return true;  // done, or fewer than 3 corners
+    if (chunk.full()) return false;
+    if (n == 3) {  // most faces: straight into the chunk
+        size_t i = chunk.size();
+        float* xyz = chunk.push_slot();
+        uint8_t* rgb = chunk.rgb_at(i);
+        uint64_t* ids = chunk.id_at(i);
+        for (int k = 0; k < 3; ++k) {
+            table.get(polygon[k], xyz + 3 * k, rgb ? rgb + 3 * k : nullptr);
+            if (ids) ids[k] = polygon[k];
+        }
+        *next = 1;
+        return true;
+    }
+    if (*next == 0) {
+        // Each corner is read once, then copied into its triangles.
+        scratch.xyz.resize(3 * n);
+        scratch.rgb.resize(3 * n);
+        for (size_t k = 0; k < n; ++k) table.get(polygon[k], &scratch.xyz[3 * k], &scratch.rgb[3 * k]);
+        scratch.triangles.clear();
+        triangulate_polygon(scratch.xyz, scratch.triangulate, scratch.triangles);
+    }
+    for (; *next + 2 < n; ++*next) {
         if (chunk.full()) return false;
         size_t i = chunk.size();
         float* xyz = chunk.push_slot();
         uint8_t* rgb = chunk.rgb_at(i);
         uint64_t* ids = chunk.id_at(i);
-        const uint64_t corner[3] = {polygon[0], polygon[*next], polygon[*next + 1]};
         for (int k = 0; k < 3; ++k) {
-            table.get(corner[k], xyz + 3 * k, rgb ? rgb + 3 * k : nullptr);
-            if (ids) ids[k] = corner[k];
+            const uint32_t corner = scratch.triangles[3 * *next + k];
+            std::memcpy(xyz + 3 * k, &scratch.xyz[3 * corner], 3 * sizeof(float));
+            if (rgb) std::memcpy(rgb + 3 * k, &scratch.rgb[3 * corner], 3);
+            if (ids) ids[k] = polygon[corner];
         }
-        ++*next;
     }
     return true;
 }

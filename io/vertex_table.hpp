@@ -3,7 +3,8 @@
 // memory (64 Ki-record blocks, no reallocation copies); past it they go to an io::TempFile that
 // is read through a shared read-only mmap (the OS page cache does the caching). A seekable
 // binary PLY whose x, y, z are float32 in host byte order is not copied at all: its own vertex
-// block is mapped (map_input_file).
+// block is mapped (map_input_file). emit_polygon, at the end, turns a face into triangles for
+// both readers.
 //
 // Memory: mapped pages count towards RSS once touched, so reads through a mapping larger than
 // the budget track the pages they touch in a bitmap (1 bit per 4 KiB page) and drop them all
@@ -13,6 +14,7 @@
 
 #include "io/byte_stream.hpp"
 #include "io/chunk.hpp"
+#include "io/triangulate.hpp"
 
 #include <cstddef>
 #include <cstdint>
@@ -84,10 +86,24 @@ private:
     uint64_t page_limit_ = 0;
 };
 
-// Emits the fan triangulation (p0, pk, pk+1) of `polygon`, starting at fan position `*next`
-// (1 for a fresh polygon), into `chunk` until it is full or the fan is done. Sets the chunk's
-// vertex ids (the polygon's indices) and colours when the chunk has those channels. Returns
-// true when the polygon is finished. Indices must be < table.size().
-bool emit_fan(VertexTable& table, const std::vector<uint64_t>& polygon, size_t* next, TriangleChunk& chunk);
+// What emit_polygon keeps between calls: the current polygon's corners and its triangles. One
+// per reader, reused, so a polygon allocates nothing once a larger one has been read; it holds
+// about 80 bytes a corner of the largest polygon.
+struct PolygonScratch {
+    std::vector<float> xyz;           // 3 per corner
+    std::vector<uint8_t> rgb;         // 3 per corner
+    std::vector<uint32_t> triangles;  // 3 corner numbers per triangle
+    TriangulateScratch triangulate;
+};
+
+// Emits the triangulation of `polygon` (triangulate_polygon: the fan (p0, pk, pk+1) when it is
+// convex, ear clipping otherwise; always size - 2 triangles) into `chunk`, from triangle
+// `*next` on, until the chunk is full or the polygon is done. The first call for a polygon
+// passes *next == 0 and reads its corners and triangulates it into `scratch`; later calls
+// for it must pass the same scratch. Sets the chunk's vertex ids (the polygon's indices) and
+// colours when the chunk has those channels. Returns true when the polygon is finished
+// (at once for fewer than 3 corners). Indices must be < table.size(); fewer than 2^32 corners.
+bool emit_polygon(VertexTable& table, const std::vector<uint64_t>& polygon, PolygonScratch& scratch, size_t* next,
+                  TriangleChunk& chunk);
 
 }  // namespace meshstream::io

@@ -1,11 +1,18 @@
-// OBJ reader and writer: corpus fixtures with the MANIFEST's counts, every face form, relative
-// indices, continuations, chunk boundaries, round trips, a spilled vertex table, and bad
-// input reported with file, line and offset.
+// OBJ reader and writer: corpus fixtures with the MANIFEST's counts, concave polygons covered
+// once, every face form, relative indices, continuations, chunk boundaries, round trips, a
+// spilled vertex table, and bad input reported with file, line and offset.
 #include "io/obj.hpp"
 
 #include "indexed_test_util.hpp"
+#include "io/text_number.hpp"
 
 #include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <sstream>
+#include <string>
+#include <vector>
 
 using namespace meshstream;
 using test::fixture;
@@ -50,6 +57,89 @@ TEST(ObjReader, ChunkCapacitiesGiveIdenticalTriangles) {
             EXPECT_EQ(part.ids, whole.ids);
         }
     }
+}
+
+// concave_polygon.obj is one face of 66 corners in the plane x = -1.146: a ring whose hole is
+// joined to the outline by an edge walked both ways (vertices 31 and 32 come twice). The fan
+// from corner 0 folded it over itself: 13 times its area and 2 non-manifold edges.
+TEST(ObjReader, ConcavePolygonFixtureIsCoveredOnce) {
+    std::vector<std::array<float, 3>> v;
+    std::vector<std::array<double, 2>> yz;  // the face's corners in its plane
+    std::istringstream file(test::slurp(fixture("obj/concave_polygon.obj")));
+    for (std::string line; std::getline(file, line);) {
+        std::istringstream in(line);
+        std::string key;
+        in >> key;
+        if (key == "v") {
+            std::array<float, 3> p;
+            in >> p[0] >> p[1] >> p[2];
+            v.push_back(p);
+        } else if (key == "f") {
+            for (std::string corner; in >> corner;) {
+                const std::array<float, 3>& p = v.at(std::stoul(corner) - 1);  // "27//1": stoul stops at '/'
+                EXPECT_EQ(p[0], v[0][0]);
+                yz.push_back({p[1], p[2]});
+            }
+        }
+    }
+    ASSERT_EQ(yz.size(), 66u);
+    double area = 0;  // the shoelace formula, positive when the face looks along +x
+    for (size_t i = 0; i < yz.size(); ++i) {
+        const auto& q = yz[(i + 1) % yz.size()];
+        area += (yz[i][0] * q[1] - q[0] * yz[i][1]) / 2;
+    }
+    EXPECT_NEAR(std::abs(area), 0.2455, 5e-4);
+    test::Soup s = read_soup(fixture("obj/concave_polygon.obj"));
+    ASSERT_EQ(s.triangles(), 64u);
+    test::expect_covers_once(s.xyz, std::abs(area), {area > 0 ? 1.0 : -1.0, 0, 0}, 1e-4);
+}
+
+// An E (12 corners) and a star (10) on a tilted plane, the star also clockwise, then a convex
+// hexagon: the concave ones are covered once whatever the chunk size, the hexagon is the fan.
+TEST(ObjReader, ConcavePolygonsAreCoveredOnceAndConvexOnesFanned) {
+    std::vector<std::array<double, 2>> star = test::star_shape(5, 0.4);
+    const std::vector<test::PlacedPolygon> polygons = {
+        test::place_polygon(test::e_shape()), test::place_polygon(star),
+        test::place_polygon({star.rbegin(), star.rend()}),
+        test::place_polygon({{2, 0}, {1, 1.7}, {-1, 1.7}, {-2, 0}, {-1, -1.7}, {1, -1.7}})};
+    std::string text;
+    uint64_t first = 1;
+    for (const test::PlacedPolygon& p : polygons) {
+        for (size_t k = 0; k < p.corners(); ++k) {
+            text += 'v';
+            for (int a = 0; a < 3; ++a) {
+                text += ' ';
+                io::append_number(text, p.xyz[3 * k + a]);
+            }
+            text += '\n';
+        }
+        text += 'f';
+        for (size_t k = 0; k < p.corners(); ++k) {
+            text += ' ';
+            io::append_number(text, first + k);
+        }
+        text += '\n';
+        first += p.corners();
+    }
+    TempDir dir;
+    test::spit(dir / "p.obj", text);
+    for (size_t capacity : {size_t{1}, size_t{7}, io::TriangleChunk::kDefaultCapacity}) {
+        SCOPED_TRACE(capacity);
+        test::Soup s = read_soup(dir / "p.obj", capacity);
+        test::expect_polygons(s, polygons);
+        ASSERT_EQ(s.triangles(), 10u + 8 + 8 + 4);
+        EXPECT_EQ(std::vector<uint64_t>(s.ids.end() - 12, s.ids.end()),
+                  (std::vector<uint64_t>{32, 33, 34, 32, 34, 35, 32, 35, 36, 32, 36, 37}));
+    }
+}
+
+// Collinear corners doubling back, a repeated corner and a bow-tie have no honest
+// triangulation, but each still gives n - 2 triangles.
+TEST(ObjReader, DegeneratePolygonsStillGiveNMinus2Triangles) {
+    TempDir dir;
+    test::spit(dir / "d.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 3 0 0\nv 1 1 0\nv 0 1 0\n"
+                              "f 1 2 3 4 2\nf 1 2 2 5 6\nf 1 5 2 6\n");
+    EXPECT_EQ(read_soup(dir / "d.obj").triangles(), 3u + 3 + 2);
 }
 
 TEST(ObjReader, EveryFaceFormContinuationsCrlfAndSkippedStatements) {

@@ -1,9 +1,11 @@
-// PLY reader and writer: corpus fixtures with the MANIFEST's counts, chunk boundaries, round
-// trips through every encoding (big endian made by a byte-swapping helper), bounded memory
-// giving the same bytes as the in-memory path, and bad input with file + element + offset.
+// PLY reader and writer: corpus fixtures with the MANIFEST's counts, concave polygons covered
+// once, chunk boundaries, round trips through every encoding (big endian made by a
+// byte-swapping helper), bounded memory giving the same bytes as the in-memory path, and bad
+// input with file + element + offset.
 #include "io/ply.hpp"
 
 #include "indexed_test_util.hpp"
+#include "io/text_number.hpp"
 
 #include <gtest/gtest.h>
 
@@ -79,11 +81,49 @@ TEST(PlyReader, ReadsCorpusFixturesWithManifestCounts) {
     }
 }
 
-TEST(PlyReader, PolygonsAreFans) {
-    // cube.ply's first face is "4 0 1 2 3": triangles (0 1 2) and (0 2 3).
+TEST(PlyReader, ConvexPolygonsAreFans) {
+    // cube.ply's first face is the square "4 0 1 2 3": triangles (0 1 2) and (0 2 3).
     test::Soup s = read_soup(fixture("ply/cube.ply"));
     ASSERT_GE(s.ids.size(), 6u);
     EXPECT_EQ((std::vector<uint64_t>(s.ids.begin(), s.ids.begin() + 6)), (std::vector<uint64_t>{0, 1, 2, 0, 2, 3}));
+}
+
+// An E (12 corners) and a star (10) on a tilted plane, in ascii with a colour per vertex: each
+// is covered once, whatever the chunk size, and every corner has its vertex's colour.
+TEST(PlyReader, ConcavePolygonsAreCoveredOnceWithTheirColours) {
+    const std::vector<test::PlacedPolygon> polygons = {test::place_polygon(test::e_shape()),
+                                                       test::place_polygon(test::star_shape(5, 0.4))};
+    std::string vertices, faces;
+    uint64_t first = 0;
+    for (const test::PlacedPolygon& p : polygons) {
+        io::append_number(faces, p.corners());
+        for (size_t k = 0; k < p.corners(); ++k) {
+            for (int a = 0; a < 3; ++a) {
+                io::append_number(vertices, p.xyz[3 * k + a]);
+                vertices += ' ';
+            }
+            vertices += std::to_string(first + k) + " " + std::to_string(255 - (first + k)) + " 7\n";
+            faces += ' ';
+            io::append_number(faces, first + k);
+        }
+        faces += '\n';
+        first += p.corners();
+    }
+    TempDir dir;
+    test::spit(dir / "p.ply", "ply\nformat ascii 1.0\nelement vertex 22\nproperty float x\nproperty float y\n"
+                              "property float z\nproperty uchar red\nproperty uchar green\nproperty uchar blue\n"
+                              "element face 2\nproperty list uchar int vertex_indices\nend_header\n" +
+                                  vertices + faces);
+    for (size_t capacity : {size_t{1}, size_t{7}, io::TriangleChunk::kDefaultCapacity}) {
+        SCOPED_TRACE(capacity);
+        test::Soup s = read_soup(dir / "p.ply", capacity);
+        test::expect_polygons(s, polygons);
+        ASSERT_EQ(s.triangles(), 10u + 8);
+        ASSERT_EQ(s.rgb.size(), 3 * s.ids.size());
+        for (size_t c = 0; c < s.ids.size(); ++c)
+            EXPECT_EQ((std::vector<uint8_t>(s.rgb.begin() + 3 * c, s.rgb.begin() + 3 * c + 3)),
+                      (std::vector<uint8_t>{uint8_t(s.ids[c]), uint8_t(255 - s.ids[c]), 7}));
+    }
 }
 
 TEST(PlyReader, ChunkCapacitiesGiveIdenticalTriangles) {
