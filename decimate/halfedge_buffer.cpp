@@ -50,6 +50,12 @@ uint32_t float_key(float x) {
 
 }  // namespace
 
+size_t HalfEdgeBuffer::reserved_bytes(size_t triangle_capacity) {
+    const size_t n = triangle_capacity, vertices = 3 * n + 3;
+    return n * (sizeof(Face) + 4 + 3 * 4) + vertices * (sizeof(VertexSlot) + 4) +
+           pow2_at_least(2 * vertices) * 4 + pow2_at_least(n / 8) * sizeof(Stub);
+}
+
 HalfEdgeBuffer::HalfEdgeBuffer(size_t triangle_capacity, double weld_eps)
     : face_capacity_(triangle_capacity),
       // Worst case every in-core face owns three vertices; orphans left by forced writes

@@ -140,6 +140,9 @@ public:
     // `triangle_capacity` ≥ 4. `weld_eps` = 0: weld on exact float position (−0 equals +0);
     // > 0: weld positions falling into the same cell of a grid of that size.
     HalfEdgeBuffer(size_t triangle_capacity, double weld_eps);
+    // The address space the constructor reserves for `triangle_capacity` (about 500 bytes a
+    // triangle); the hash and stub tables of it are resident at once, the pools when touched.
+    static size_t reserved_bytes(size_t triangle_capacity);
 
     size_t face_capacity() const { return face_capacity_; }
     size_t face_count() const { return live_.size(); }
