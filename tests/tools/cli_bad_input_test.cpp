@@ -338,6 +338,22 @@ TEST(CliBadInput, StdoutWriteFailuresExit1) {
     }
 }
 
+TEST(CliBadInput, ABufferTheSystemCannotReserveIsNamedWithItsSize) {
+#if defined(__SANITIZE_ADDRESS__)
+    GTEST_SKIP() << "AddressSanitizer reserves terabytes of shadow memory: no address-space limit possible";
+#else
+    TempDir dir;
+    write_file(dir / "in.stl", binary_stl(grid(4)));
+    // 1 GiB of address space; --buffer 10000000 reserves about 5 GB.
+    CliRun r = run("decimate --buffer 10000000 -r 0.5 " + dir / "in.stl" + " " + dir / "out.stl", "ulimit -v 1048576;");
+    EXPECT_EQ(r.code, 1) << r.err;
+    EXPECT_NE(r.err.find("meshstream: error: --buffer 10000000 reserves 5."), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("which this system refused: give a smaller --buffer (the default 400000 reserves 208.2 MB)"),
+              std::string::npos) << r.err;
+    EXPECT_EQ(listing(dir.path), std::vector<std::string>{"in.stl"});
+#endif
+}
+
 TEST(CliBadInput, UnknownCommandIsNamedAndVersionIsPrinted) {
     CliRun r = run("decimat in.stl out.stl");
     EXPECT_EQ(r.code, 2);
