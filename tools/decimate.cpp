@@ -78,13 +78,14 @@ void run_decimate(const DecimateOptions& opt) {
 
     decimate::Options options;
     if (opt.target) {
+        // Options that cannot work with this input: exit 2, like the command line's own errors.
         if (!header.triangle_count)
-            throw io::Error(in.source->name(), "--target needs the input triangle count, which this format does "
-                                               "not state up front; use --ratio");
+            throw UsageError(in.source->name() + ": --target needs the input triangle count, which this format does "
+                                                 "not state up front (binary STL, Draco and glTF do); use --ratio");
         if (*opt.target > *header.triangle_count)
-            throw io::Error(in.source->name(), "--target " + std::to_string(*opt.target) + " is more than the " +
-                                                   std::to_string(*header.triangle_count) +
-                                                   " triangles of the input (decimation only removes triangles)");
+            throw UsageError(in.source->name() + ": --target " + std::to_string(*opt.target) + " is more than the " +
+                             std::to_string(*header.triangle_count) +
+                             " triangles of the input (decimation only removes triangles)");
         options.target = *opt.target;
     } else {
         options.ratio = opt.ratio.value_or(0.1);
@@ -201,6 +202,9 @@ void run_decimate(const DecimateOptions& opt) {
         warnings.note(missed + " (a collapse removes two triangles, and no boundary edge was left to remove the odd one)");
     else if (s.triangles_in > 0 && s.triangles_out != s.target_triangles)
         warnings.note(missed + " (too little left that could be decimated)");
+    else if (s.triangles_in > 0 && s.target_triangles == 0)
+        warnings.note("the target rounds to 0 triangles (" + std::to_string(s.triangles_in) +
+                      " in): the output is empty; give a larger --ratio or --target");
     warnings.print();
 
     if (opt.report) {

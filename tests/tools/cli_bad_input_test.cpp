@@ -160,7 +160,7 @@ TEST(CliBadInput, DecimateOptionValuesOutOfRangeAreRefusedClearly) {
                         {"--ratio 1.5", 2, "--ratio: must be a number in (0, 1], found '1.5'"},
                         {"--target 0", 2, "--target: must be a whole number of triangles, at least 1, found '0'"},
                         {"--target -3", 2, "--target: must be a whole number of triangles, at least 1, found '-3'"},
-                        {"--target 33", 1, "in.stl: --target 33 is more than the 32 triangles of the input"},
+                        {"--target 33", 2, "in.stl: --target 33 is more than the 32 triangles of the input"},
                         {"--sorted-axis w", 2, "--sorted-axis: must be x, y or z (or 0, 1, 2), found 'w'"},
                     });
     // Axes by name (any case) or number; the target may equal the input count.
@@ -288,6 +288,7 @@ TEST(CliBadInput, WeldPercentReadsTheBoxFirstOrRefusesAStream) {
 TEST(CliBadInput, CommandLinesThatCannotWorkExit2BeforeAnyWork) {
     TempDir dir;
     write_file(dir / "in.stl", binary_stl(grid(4)));
+    write_file(dir / "in.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
     const std::string in = dir / "in.stl", out = dir / "out.stl";
     const struct {
         std::string args;
@@ -301,12 +302,13 @@ TEST(CliBadInput, CommandLinesThatCannotWorkExit2BeforeAnyWork) {
         {"sort - " + out + " < " + in, "<stdin>: --axis auto reads the input twice"},
         {"compare - - < " + in, "compare cannot read both A and B from stdin or pipes"},
         {"decimate --report -r 0.5 " + in + " /dev/null --to stl", "/dev/null: --report needs to re-read both files"},
+        {"decimate --target 1 " + dir / "in.obj" + " " + out, "in.obj: --target needs the input triangle count"},
     };
     for (const auto& c : cases) {
         CliRun r = run(c.args);
         EXPECT_EQ(r.code, 2) << c.args << ": " << r.err;
         EXPECT_NE(r.err.find(c.message), std::string::npos) << c.args << ": " << r.err;
-        EXPECT_EQ(listing(dir.path), std::vector<std::string>{"in.stl"}) << c.args;
+        EXPECT_EQ(listing(dir.path), (std::vector<std::string>{"in.obj", "in.stl"})) << c.args;
     }
 }
 

@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <fstream>
 #include <string>
 
 namespace {
@@ -43,4 +44,16 @@ TEST(CliDecimate, SmallBuffersAddNoNonManifoldEdges) {
         EXPECT_LE(out.non_manifold_edges, in.non_manifold_edges) << options;
         EXPECT_EQ(out.boundary_edges, 0u) << options;
     }
+}
+
+TEST(CliDecimate, ATargetOfZeroTrianglesIsSaid) {
+    TempDir dir;
+    const std::string in = dir / "one.stl";
+    std::ofstream(in) << "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
+                         "endloop\nendfacet\nendsolid t\n";
+    CliRun r = run("decimate -r 0.1 " + in + " " + dir / "out.stl");
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.err.find("warning: the target rounds to 0 triangles (1 in): the output is empty; give a larger --ratio "
+                         "or --target"),
+              std::string::npos) << r.err;
 }
