@@ -153,6 +153,12 @@ int longest_axis(const SortOptions& opt, const io::ReadOptions& ro) {
 void run_sort(const SortOptions& opt) {
     const auto t0 = std::chrono::steady_clock::now();
     require_format_for_stdout(opt.output, opt.write);
+    // Draco's connectivity coder reorders the triangles: the sorted order would be lost.
+    const io::Format* to = opt.write.to.empty() ? io::format_for_extension(opt.output, true) : io::find_format(opt.write.to);
+    if (to != nullptr && (to->name == "draco" || ((to->name == "glb" || to->name == "gltf") && opt.write.draco)))
+        throw UsageError((opt.output == "-" ? std::string("<stdout>") : opt.output) +
+                         ": Draco compression reorders triangles, so the sorted order would be lost: write STL, PLY "
+                         "or OBJ (or glTF with --no-draco)");
     if (opt.output != "-") {
         // Fail before a long sort, not after it.
         std::string dir = io::parent_dir(opt.output);

@@ -303,6 +303,8 @@ TEST(CliBadInput, CommandLinesThatCannotWorkExit2BeforeAnyWork) {
         {"compare - - < " + in, "compare cannot read both A and B from stdin or pipes"},
         {"decimate --report -r 0.5 " + in + " /dev/null --to stl", "/dev/null: --report needs to re-read both files"},
         {"decimate --target 1 " + dir / "in.obj" + " " + out, "in.obj: --target needs the input triangle count"},
+        {"sort --axis x " + in + " " + dir / "s.glb", "s.glb: Draco compression reorders triangles"},
+        {"sort --axis x " + in + " - --to draco", "<stdout>: Draco compression reorders triangles"},
     };
     for (const auto& c : cases) {
         CliRun r = run(c.args);
