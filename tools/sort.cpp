@@ -198,9 +198,13 @@ void run_sort(const SortOptions& opt) {
         std::clamp<size_t>(budget / 64 / (record_bytes + 36), 256, io::TriangleChunk::kDefaultCapacity);
     const uint64_t pipe_bytes = kPipeSlots * chunk_capacity * (record_bytes + 36);
     if (budget - budget / 4 <= pipe_bytes) {
-        const uint64_t least_kib = (pipe_bytes * 4 / 3 + 2048) / 1024;
-        throw io::Error(in.source->name(), "--memory " + opt.read.memory + " is too small to sort: give at least " +
-                                               std::to_string(least_kib) + "K");
+        // The least budget b with b - b/4 > pipe_bytes (the pipe's size is fixed at such small
+        // budgets: its chunks are at their minimum), in whole KiB.
+        uint64_t least = pipe_bytes * 4 / 3;
+        while (least - least / 4 <= pipe_bytes) ++least;
+        const uint64_t least_kib = (least + 1023) / 1024;
+        throw UsageError(in.source->name() + ": --memory " + opt.read.memory + " is too small to sort: give at least " +
+                         std::to_string(least_kib) + "K");
     }
     so.memory_budget_bytes = budget - budget / 4 - pipe_bytes;
 
