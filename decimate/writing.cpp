@@ -84,6 +84,9 @@ uint32_t pick_write(const HalfEdgeBuffer& buffer, Rng& rng, int candidates) {
 bool place_vertex(HalfEdgeBuffer& buffer, uint32_t v) {
     const Vertex& x = buffer.vertex(v);
     if ((x.flags & (kInHash | kNonManifold | kFrozen)) != 0 || x.open_edges != 0) return false;
+    // Nothing collapsed into v: every plane of its quadric passes through v, so its own
+    // position is the minimum, and a solve would only move it by round-off.
+    if ((x.flags & kHasPartner) == 0) return false;
     const Quadric& q = buffer.quadric(v);
     double old[3], best[3];
     buffer.position(v, old);

@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <map>
 #include <numeric>
 
@@ -148,6 +149,21 @@ TEST(StreamDecimator, RatioOneKeepsEveryTriangle) {
     const Decimated d = run_decimator(bunny(), options);
     EXPECT_EQ(d.triangle_count(), 69451u);
     EXPECT_EQ(d.stats.collapses, 0u);
+    // Nothing was collapsed, so nothing moves: the same triangles, corner for corner (in
+    // writing order, which differs from the input's).
+    auto sorted_triangles = [](const std::vector<float>& xyz) {
+        std::vector<std::array<float, 9>> t(xyz.size() / 9);
+        for (size_t i = 0; i < t.size(); ++i) std::copy_n(&xyz[9 * i], 9, t[i].begin());
+        for (auto& x : t) {  // rotate each to start at its smallest corner, keeping orientation
+            int k = 0;
+            for (int j = 1; j < 3; ++j)
+                if (std::lexicographical_compare(&x[3 * j], &x[3 * j] + 3, &x[3 * k], &x[3 * k] + 3)) k = j;
+            std::rotate(x.begin(), x.begin() + 3 * k, x.end());
+        }
+        std::sort(t.begin(), t.end());
+        return t;
+    };
+    EXPECT_TRUE(sorted_triangles(d.xyz) == sorted_triangles(bunny()));
 }
 
 TEST(StreamDecimator, SortedHolesAreFinalizedBySweep) {

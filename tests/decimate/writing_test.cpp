@@ -99,6 +99,12 @@ TEST(Writing, VertexMovesToItsQuadricMinimumOnce) {
     buffer.quadric(top) = oct.plane({0.1, 0, 0}, {0.1, 1, 0}, {0.1, 0, 1}) +
                           oct.plane({0, -0.1, 0}, {0, -0.1, 1}, {1, -0.1, 0}) +
                           oct.plane({0, 0, 0.9}, {1, 0, 0.9}, {0, 1, 0.9});
+    // A vertex nothing was collapsed into is the minimum of its own planes: it stays put
+    // (ratio 1 copies the input exactly).
+    EXPECT_FALSE(place_vertex(buffer, top));
+    EXPECT_EQ(buffer.vertex(top).pos[2], 1.0f);
+    const float far_end[3] = {0.0f, 0.0f, 0.8f};  // as if a vertex there had been collapsed into it
+    buffer.set_partner(top, far_end);
     ASSERT_TRUE(place_vertex(buffer, top));
     EXPECT_FLOAT_EQ(buffer.vertex(top).pos[0], 0.1f);
     EXPECT_FLOAT_EQ(buffer.vertex(top).pos[1], -0.1f);
