@@ -3,7 +3,8 @@
 // whitespace-separated tokens parsed with std::from_chars (ascii), the way miniply walks its
 // refill buffer. Based on Greg Turk's PLY description and the quirks seen in PDAL's PlyReader
 // and happly: type aliases (float32, uint8, ...), `vertex_index` as well as `vertex_indices`,
-// elements in any order around vertex and face.
+// elements in any order around vertex and face. Without a face element, a `tristrips` element
+// (old Stanford scans: one list of vertex indices per strip, -1 restarting) is read instead.
 #include "io/ply.hpp"
 
 #include "io/error.hpp"
@@ -113,6 +114,12 @@ public:
                 if (!emit_polygon(*table_, polygon_, polygon_scratch_, &polygon_next_, chunk)) return true;
             }
             if (chunk.full()) return true;
+            if (strip_next_ < strip_triangles_.size()) {  // the current strip, a triangle at a time
+                polygon_.assign(strip_triangles_.begin() + strip_next_, strip_triangles_.begin() + strip_next_ + 3);
+                polygon_next_ = 0;
+                strip_next_ += 3;
+                continue;
+            }
             // Elements after the faces carry nothing we use and are not read: real files get
             // them wrong (CGAL's colored_tetra.ply promises 3 properties per 'edge', writes 2).
             if (face_ < 0 || item_ == elements_[static_cast<size_t>(face_)].count) {
@@ -216,9 +223,15 @@ private:
         if (!have_format) throw Error(src_.name(), Error::kNoOffset, line_, "PLY header has no 'format' line");
         swap_ = (encoding_ == Encoding::kBinaryBig) == (std::endian::native == std::endian::little);
 
+        int strips = -1;
         for (size_t i = 0; i < elements_.size(); ++i) {
             if (elements_[i].name == "vertex" && vertex_ < 0) vertex_ = static_cast<int>(i);
             if (elements_[i].name == "face" && face_ < 0) face_ = static_cast<int>(i);
+            if (elements_[i].name == "tristrips" && strips < 0) strips = static_cast<int>(i);
+        }
+        if (face_ < 0 && strips >= 0) {
+            face_ = strips;
+            strips_ = true;
         }
         if (face_ >= 0) {
             const Element& f = elements_[static_cast<size_t>(face_)];
@@ -227,7 +240,7 @@ private:
                     index_prop_ = static_cast<int>(p);
             if (index_prop_ < 0 && f.count > 0)
                 throw Error(src_.name(), Error::kNoOffset, line_,
-                            "face element has no list property 'vertex_indices' or 'vertex_index'");
+                            f.name + " element has no list property 'vertex_indices' or 'vertex_index'");
             if (f.count > 0 && vertex_ < 0)
                 throw Error(src_.name(), Error::kNoOffset, line_, "faces but no vertex element");
             if (f.count > 0 && face_ < vertex_)
@@ -252,7 +265,7 @@ private:
         header_.channels.color = has_color_;
         uint64_t faces = face_ >= 0 ? elements_[static_cast<size_t>(face_)].count : 0;
         if (faces == 0) header_.triangle_count = 0;
-        header_.notes.emplace_back("faces", std::to_string(faces));
+        header_.notes.emplace_back(strips_ ? "tristrips" : "faces", std::to_string(faces));
     }
 
     // ---- body primitives ----
@@ -540,15 +553,35 @@ private:
             const uint64_t vertices = table_->size();
             for (int64_t k = 0; k < n; ++k) {
                 int64_t index = read_integer(prop.type);
+                if (strips_ && index == -1) {  // restart
+                    strip_to_triangles();
+                    continue;
+                }
                 if (index < 0 || static_cast<uint64_t>(index) >= vertices)
                     item_fail(token_offset_, "vertex index " + std::to_string(index) + " out of range (" +
                                                  std::to_string(vertices) + " vertices)");
                 polygon_.push_back(static_cast<uint64_t>(index));
             }
-            if (n < 3 && options_.strict)
+            if (strips_) strip_to_triangles();
+            else if (n < 3 && options_.strict)
                 item_fail(token_offset_, "face with " + std::to_string(n) + " vertices (--strict)");
         }
         ++item_;
+    }
+
+    // Turns the strip gathered in polygon_ into triangles (every other one flipped, so all
+    // keep the first one's orientation) queued in strip_triangles_; the triangles with a
+    // repeated index that join strips are stitching, not surface, and are dropped.
+    void strip_to_triangles() {
+        if (strip_next_ == strip_triangles_.size()) strip_triangles_.clear(), strip_next_ = 0;
+        for (size_t i = 0; i + 2 < polygon_.size(); ++i) {
+            uint64_t a = polygon_[i], b = polygon_[i + 1];
+            const uint64_t c = polygon_[i + 2];
+            if (i % 2 == 1) std::swap(a, b);
+            if (a == b || b == c || c == a) continue;
+            strip_triangles_.insert(strip_triangles_.end(), {a, b, c});
+        }
+        polygon_.clear();
     }
 
     // When the faces are the last element, anything but blanks after them is data the header
@@ -588,6 +621,9 @@ private:
     std::vector<uint64_t> polygon_;
     PolygonScratch polygon_scratch_;
     size_t polygon_next_ = 0;  // next triangle of polygon_ to emit
+    bool strips_ = false;      // face_ is a tristrips element
+    std::vector<uint64_t> strip_triangles_;  // index triples of the strips read, emitted from strip_next_
+    size_t strip_next_ = 0;
 };
 
 // ---------------- writer ----------------

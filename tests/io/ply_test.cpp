@@ -9,6 +9,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <bit>
 #include <cstdlib>
 #include <cstring>
 
@@ -177,6 +179,45 @@ TEST(PlyReader, AnyCoordinateTypeAndElementsAroundVertexAndFace) {
     test::Soup s = read_soup(dir / "t.ply");
     ASSERT_EQ(s.triangles(), 2u);
     EXPECT_EQ(s.xyz, (std::vector<float>{0, 0, 0, 1, 0, 0, 1, 1, -2.5f, 0, 0, 0, 1, 1, -2.5f, 0, 1, 1000}));
+}
+
+TEST(PlyReader, TriangleStripsWithRestartsKeepOneOrientation) {
+    // A 3 x 2 grid of vertices as one strip (4 triangles), then -1 and a second strip that
+    // repeats an index to stitch (a zero-area joint, dropped), in ASCII and binary big-endian.
+    const std::string header_start = "ply\nformat ";
+    const std::string header_end =
+        " 1.0\nelement vertex 6\nproperty float x\nproperty float y\nproperty float z\n"
+        "element tristrips 1\nproperty list uchar int vertex_indices\nend_header\n";
+    const float v[6][3] = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {0, 1, 0}, {1, 1, 0}, {2, 1, 0}};
+    const int32_t strip[] = {3, 0, 4, 1, 5, 2, -1, 0, 1, 1, 3};  // second: (0 1 1) joint, (1 1 3) joint
+    TempDir dir;
+    test::spit(dir / "a.ply", header_start + "ascii" + header_end + "0 0 0\n1 0 0\n2 0 0\n0 1 0\n1 1 0\n2 1 0\n" +
+                                  "11 3 0 4 1 5 2 -1 0 1 1 3\n");
+    std::string bin = header_start + "binary_big_endian" + header_end;
+    auto put_be = [&](uint32_t x) {
+        for (int s = 24; s >= 0; s -= 8) bin.push_back(static_cast<char>(x >> s));
+    };
+    for (const auto& p : v)
+        for (float c : p) put_be(std::bit_cast<uint32_t>(c));
+    bin.push_back(static_cast<char>(std::size(strip)));
+    for (int32_t i : strip) put_be(static_cast<uint32_t>(i));
+    test::spit(dir / "b.ply", bin);
+    for (const char* file : {"a.ply", "b.ply"}) {
+        SCOPED_TRACE(file);
+        for (size_t capacity : {size_t{1}, size_t{3}, io::TriangleChunk::kDefaultCapacity}) {
+            test::Soup s = read_soup(dir / file, capacity);
+            ASSERT_EQ(s.triangles(), 4u);  // the second strip holds only joints
+            EXPECT_EQ(s.ids, (std::vector<uint64_t>{3, 0, 4, 4, 0, 1, 4, 1, 5, 5, 1, 2}));
+            for (size_t t = 0; t < 4; ++t) {  // all facing +z, as the first
+                const float* a = &s.xyz[9 * t];
+                const float nz = (a[3] - a[0]) * (a[7] - a[1]) - (a[4] - a[1]) * (a[6] - a[0]);
+                EXPECT_GT(nz, 0) << t;
+            }
+            EXPECT_NE(std::find(s.header.notes.begin(), s.header.notes.end(),
+                                std::pair<std::string, std::string>{"tristrips", "1"}),
+                      s.header.notes.end());
+        }
+    }
 }
 
 TEST(PlyReader, ReadsSortedAxisComment) {
