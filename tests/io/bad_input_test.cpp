@@ -197,6 +197,20 @@ TEST(BadInput, RandomBytesUnderEachExtensionAreAnErrorNamingTheFile) {
     }
 }
 
+// Compressed, a stream has no size to test a binary STL's 84 + 50n against: random bytes in a
+// .ply.gz used to read as binary STL ("header promises 1428015842 triangles"); the name wins.
+TEST(BadInput, RandomBytesInGzipAreJudgedByTheInnerExtension) {
+    TempDir dir;
+    std::mt19937 rng(11);
+    std::string bytes(3000, '\0');
+    for (char& c : bytes) c = static_cast<char>(rng());
+    const std::string path = dir / "random.ply.gz";
+    write_file(path, gzip(bytes));
+    io::Error e = error_of([&] { read_path(path); });
+    EXPECT_EQ(e.file(), path);
+    EXPECT_NE(e.message().find("not a PLY file"), std::string::npos) << e.what();
+}
+
 // Random bytes under .obj used to read as an OBJ of unknown statements: zero triangles, exit 0.
 TEST(BadInput, Issue7_ObjStatementKeywordMustBeText) {
     io::Error e = error_of([] { read_with(*io::find_format("obj"), "v 0 0 0\n\x9a\x01\xffq 1 2\n", "junk.obj"); });
