@@ -123,6 +123,8 @@ private:
                 note_comment();
                 continue;
             }
+            // A comment may end a statement's line ("f 1 2 3 # top"), as most readers allow.
+            if (key == "v" || key == "f") rest = rest.substr(0, rest.find('#'));
             if (key == "v") {
                 float xyz[3];
                 for (int a = 0; a < 3; ++a) xyz[a] = parse_float(next_word(rest), a);

@@ -2,7 +2,7 @@
 // vertex table, io/vertex_table.hpp; the writer's welding, io/weld.hpp).
 //
 // Reader: `v x y z` (extra w or colour values ignored), `f` in every form (`1`, `1/2`, `1//3`,
-// `1/2/3`) with negative (relative) indices, polygons triangulated (io/triangulate.hpp: the
+// `1/2/3`) with negative (relative) indices, a `#` comment ending either line, polygons triangulated (io/triangulate.hpp: the
 // fan from the first corner when convex, else ear clipping; n - 2 triangles), `\` line
 // continuations, comments, CRLF; every other statement (vt vn g o s usemtl mtllib l p ...) is
 // skipped. A face may only use vertices defined before it (the OBJ rule), so one pass works.

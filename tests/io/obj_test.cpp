@@ -154,6 +154,16 @@ TEST(ObjReader, EveryFaceFormContinuationsCrlfAndSkippedStatements) {
     EXPECT_EQ(std::vector<float>(s.xyz.end() - 3, s.xyz.end()), (std::vector<float>{1, 1, 0}));
 }
 
+TEST(ObjReader, CommentsMayEndVertexAndFaceLines) {
+    TempDir dir;
+    test::spit(dir / "c.obj", "v 0 0 0 # origin\nv 1 0 0#x\nv 0 1 0#y\nf 1 2 3 # the face\nf 3 2 1#back\n");
+    test::Soup s = read_soup(dir / "c.obj");
+    EXPECT_EQ(s.ids, (std::vector<uint64_t>{0, 1, 2, 2, 1, 0}));
+    // The comment ends the line: "v 1 0 # x" has two coordinates.
+    test::spit(dir / "short.obj", "v 1 0 # x\n");
+    EXPECT_THROW(read_soup(dir / "short.obj"), io::Error);
+}
+
 TEST(ObjReader, BadInputNamesFileLineAndOffset) {
     TempDir dir;
     const std::string head = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
