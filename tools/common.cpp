@@ -2,6 +2,7 @@
 #include "tools/common.hpp"
 
 #include <charconv>
+#include <cstdlib>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -113,9 +114,17 @@ Global& global() {
     return g;
 }
 
+namespace {
+// A bar redraws its line with \r and erases with ESC [K: only on a terminal that has both.
+bool bar_terminal() {
+    const char* term = std::getenv("TERM");
+    return ::isatty(2) && term != nullptr && *term != '\0' && std::string_view(term) != "dumb";
+}
+}  // namespace
+
 Progress::Progress(std::string label, std::optional<uint64_t> total, std::string unit)
     : label_(std::move(label)), total_(total), unit_(std::move(unit)),
-      enabled_(!global().quiet && ::isatty(2)), start_(std::chrono::steady_clock::now()), last_(start_) {}
+      enabled_(!global().quiet && bar_terminal()), start_(std::chrono::steady_clock::now()), last_(start_) {}
 
 Progress::~Progress() { done(); }
 
@@ -125,6 +134,12 @@ void Progress::phase(std::string label, std::optional<uint64_t> total) {
     done_ = 0;
     start_ = std::chrono::steady_clock::now();
     draw(true);
+}
+
+void Progress::status(const std::string& text) {
+    if (!enabled_) return;
+    std::fprintf(stderr, "\r%s\x1b[K", text.c_str());
+    drawn_ = true;
 }
 
 void Progress::update(uint64_t done) {

@@ -66,6 +66,9 @@ public:
     void update(uint64_t done);
     // Starts a new phase (keeps the bar); total may change.
     void phase(std::string label, std::optional<uint64_t> total);
+    // Replaces the bar with one line of text until done() or the next update (a last step
+    // that reports no counts, such as a writer assembling its file).
+    void status(const std::string& text);
     void done();  // clears the line
 
 private:

@@ -41,11 +41,15 @@ void run_convert(const ConvertOptions& opt) {
         out.write(chunk);
         progress.update(done);
     }
-    progress.done();
     if (header.triangle_count && done != *header.triangle_count)
         throw io::Error(in.source->name(), "header promises " + std::to_string(*header.triangle_count) +
                                                " triangles, read " + std::to_string(done));
+    // Whole-mesh formats encode, and spooled or compressed ones copy, only now: can be most of
+    // the run.
+    progress.status("converting: finishing " + std::string(out.format->name) + " output (" + human_count(double(done)) +
+                    " triangles read)");
     out.finish();
+    progress.done();
     Warnings warnings;
     filter.report(warnings);
     warnings.print();
