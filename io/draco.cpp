@@ -54,8 +54,8 @@ public:
         : sink_(sink), options_(options), indexer_(sink.name()) {
         if (options.draco_position_bits < 1 || options.draco_position_bits > 30)
             throw Error(sink.name(), "--draco-qp must be 1-30, got " + std::to_string(options.draco_position_bits));
-        if (options.draco_normal_bits < 1 || options.draco_normal_bits > 30)
-            throw Error(sink.name(), "--draco-qn must be 1-30, got " + std::to_string(options.draco_normal_bits));
+        if (options.draco_normal_bits < 2 || options.draco_normal_bits > 30)
+            throw Error(sink.name(), "--draco-qn must be 2-30, got " + std::to_string(options.draco_normal_bits));
         if (options.draco_level < 0 || options.draco_level > 10)
             throw Error(sink.name(), "--draco-cl must be 0-10, got " + std::to_string(options.draco_level));
         budget_check_up_front(sink.name(), options, kWhy, draco_encode_estimate_bytes);

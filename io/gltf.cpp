@@ -135,8 +135,8 @@ public:
 #endif
         if (options_.draco_position_bits < 1 || options_.draco_position_bits > 30)
             throw Error(sink.name(), "--draco-qp must be 1-30, got " + std::to_string(options_.draco_position_bits));
-        if (options_.draco_normal_bits < 1 || options_.draco_normal_bits > 30)
-            throw Error(sink.name(), "--draco-qn must be 1-30, got " + std::to_string(options_.draco_normal_bits));
+        if (options_.draco_normal_bits < 2 || options_.draco_normal_bits > 30)
+            throw Error(sink.name(), "--draco-qn must be 2-30, got " + std::to_string(options_.draco_normal_bits));
         if (options_.draco_level < 0 || options_.draco_level > 10)
             throw Error(sink.name(), "--draco-cl must be 0-10, got " + std::to_string(options_.draco_level));
         budget_check_up_front(sink.name(), options_, kWhy, options_.draco ? draco_need : plain_need);

@@ -103,9 +103,11 @@ void add_write_flags(CLI::App* cmd, WriteFlags& flags) {
     web->add_flag("--normals", flags.normals, "Draco/glTF: write area-weighted smooth vertex normals");
     web->add_option("--draco-qp", flags.draco_qp, "Draco position quantization bits, 1-30 (default 14)")
         ->check(CLI::Range(1, 30));
-    web->add_option("--draco-qn", flags.draco_qn, "Draco normal quantization bits, 1-30 (default 10)")
-        ->check(CLI::Range(1, 30));
-    web->add_option("--draco-cl", flags.draco_cl, "Draco compression level 0-10 (default 7; 10 = smallest, slowest)")
+    // Draco's octahedral normal coder needs 2 bits or more (1 fails inside its encoder).
+    web->add_option("--draco-qn", flags.draco_qn, "Draco normal quantization bits, 2-30 (default 10)")
+        ->check(CLI::Range(2, 30));
+    web->add_option("--draco-cl", flags.draco_cl, "Draco compression level 0-10 (default 7; higher is slower, "
+                                                  "usually smaller)")
         ->check(CLI::Range(0, 10));
 }
 
