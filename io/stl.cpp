@@ -136,9 +136,10 @@ void facet_normal(const float* v, float* n) {
     float nx = ay * bz - az * by, ny = az * bx - ax * bz, nz = ax * by - ay * bx;
     float length = std::sqrt(nx * nx + ny * ny + nz * nz);
     if (length > 0.0f && std::isfinite(length)) {
-        n[0] = nx / length;
-        n[1] = ny / length;
-        n[2] = nz / length;
+        // + 0.0f turns a -0 into 0: "facet normal 0 -0 1" is correct but looks like a bug.
+        n[0] = nx / length + 0.0f;
+        n[1] = ny / length + 0.0f;
+        n[2] = nz / length + 0.0f;
     } else {
         n[0] = n[1] = n[2] = 0.0f;
     }

@@ -129,3 +129,18 @@ TEST(CliConvert, DroppedVertexColoursAreSaid) {
     EXPECT_EQ(ply.code, 0) << ply.err;
     EXPECT_EQ(ply.err.find("colours"), std::string::npos) << ply.err;
 }
+
+TEST(CliConvert, AsciiStlNormalsHaveNoNegativeZeros) {
+    // "facet normal 0 -0 1" is valid but reads like a bug: 98 of the bunny's normals had one.
+    TempDir dir;
+    ASSERT_EQ(run("convert --to stl-ascii " + kBunny + " " + dir / "b.stl").code, 0);
+    const std::string text = cli_test::slurp(dir / "b.stl");
+    size_t normals = 0;
+    for (size_t at = 0; (at = text.find("facet normal ", at)) != std::string::npos; ++normals) {
+        const size_t end = text.find('\n', at);
+        const std::string line = text.substr(at, end - at) + " ";
+        EXPECT_EQ(line.find(" -0 "), std::string::npos) << line;
+        at = end;
+    }
+    EXPECT_EQ(normals, 69451u);
+}
