@@ -54,6 +54,25 @@ CLI::Validator format_name(bool for_writing) {
 
 }  // namespace
 
+void note_unused_write_flags(const WriteFlags& flags, const io::Format& output, Warnings& warnings) {
+    if (output.name == "draco" || output.name == "glb" || output.name == "gltf") {
+        if (output.name == "draco" && !flags.draco) warnings.note("--no-draco applies to glTF outputs; a .drc is Draco");
+        return;
+    }
+    const WriteFlags defaults;
+    std::string given;
+    auto add = [&](bool set, const char* name) {
+        if (set) given += (given.empty() ? "" : ", ") + std::string(name);
+    };
+    add(flags.normals, "--normals");
+    add(!flags.draco, "--no-draco");
+    add(flags.draco_qp != defaults.draco_qp, "--draco-qp");
+    add(flags.draco_qn != defaults.draco_qn, "--draco-qn");
+    add(flags.draco_cl != defaults.draco_cl, "--draco-cl");
+    if (!given.empty())
+        warnings.note(given + " apply to Draco and glTF outputs only: ignored for " + std::string(output.name));
+}
+
 void require_format_for_stdout(const std::string& output, const WriteFlags& flags) {
     if (output == "-" && flags.to.empty())
         throw UsageError("<stdout>: writing to stdout needs --to (one of: " + format_names(true) + ")");

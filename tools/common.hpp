@@ -49,6 +49,9 @@ struct WriteFlags {
 void add_write_flags(CLI::App* cmd, WriteFlags& flags);
 // Throws UsageError when `output` is stdout ("-") and no --to names its format.
 void require_format_for_stdout(const std::string& output, const WriteFlags& flags);
+class Warnings;
+// Notes Draco/glTF options given for an output of another format (they do nothing there).
+void note_unused_write_flags(const WriteFlags& flags, const io::Format& output, Warnings& warnings);
 
 // Global flags (set by main before a subcommand runs).
 struct Global {

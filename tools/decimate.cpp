@@ -161,6 +161,7 @@ void run_decimate(const DecimateOptions& opt) {
     decimate::print_phase_report(stderr);  // only in builds with MESHSTREAM_PHASE_TIMERS
 
     Warnings warnings;
+    note_unused_write_flags(opt.write, *out.format, warnings);
     filter.report(warnings);
     if (s.forced_writes > 0)
         warnings.note("buffer full of undecimatable triangles: " + std::to_string(s.forced_writes) +

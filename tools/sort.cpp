@@ -289,6 +289,7 @@ void run_sort(const SortOptions& opt) {
     out.finish();
     progress.done();
     Warnings warnings;
+    note_unused_write_flags(opt.write, *out.format, warnings);
     filter.report(warnings);
     warnings.print();
 

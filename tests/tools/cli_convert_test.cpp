@@ -144,3 +144,15 @@ TEST(CliConvert, AsciiStlNormalsHaveNoNegativeZeros) {
     }
     EXPECT_EQ(normals, 69451u);
 }
+
+TEST(CliConvert, DracoOptionsForOtherOutputsAreSaidToDoNothing) {
+    TempDir dir;
+    const std::string cube = std::string(MESHSTREAM_FIXTURES_DIR) + "/cube.bin.stl";
+    cli_test::CliRun ply = run("convert --normals --draco-qp 10 " + cube + " " + dir / "c.ply");
+    EXPECT_EQ(ply.code, 0) << ply.err;
+    EXPECT_NE(ply.err.find("warning: --normals, --draco-qp apply to Draco and glTF outputs only: ignored for ply"),
+              std::string::npos) << ply.err;
+    cli_test::CliRun glb = run("convert --normals --draco-qp 10 " + cube + " " + dir / "c.glb");
+    EXPECT_EQ(glb.code, 0) << glb.err;
+    EXPECT_EQ(glb.err.find("warning"), std::string::npos) << glb.err;
+}
