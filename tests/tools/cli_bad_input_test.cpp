@@ -306,6 +306,7 @@ TEST(CliBadInput, CommandLinesThatCannotWorkExit2BeforeAnyWork) {
         {"decimate --target 1 " + dir / "in.obj" + " " + out, "in.obj: --target needs the input triangle count"},
         {"sort --axis x " + in + " " + dir / "s.glb", "s.glb: Draco compression reorders triangles"},
         {"sort --axis x " + in + " - --to draco", "<stdout>: Draco compression reorders triangles"},
+        {"convert --draco-qn 1 " + in + " " + dir / "c.drc", "--draco-qn: Value 1 not in range 2 to 30"},
     };
     for (const auto& c : cases) {
         CliRun r = run(c.args);
