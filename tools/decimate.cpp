@@ -95,9 +95,9 @@ void run_decimate(const DecimateOptions& opt) {
     options.seed = opt.seed;
     options.weld_eps = weld_epsilon(opt, header, in.source->name());
     options.sorted_axis = opt.sorted_axis ? opt.sorted_axis : header.sorted_axis;
-    std::unique_ptr<decimate::StreamDecimator> buffer;
+    std::unique_ptr<decimate::StreamDecimator> made;  // on the heap only to catch a refused reservation here
     try {
-        buffer = std::make_unique<decimate::StreamDecimator>(options, header.triangle_count);
+        made = std::make_unique<decimate::StreamDecimator>(options, header.triangle_count);
     } catch (const std::bad_alloc&) {
         throw std::runtime_error(
             "--buffer " + std::to_string(opt.buffer) + " reserves " +
@@ -105,7 +105,7 @@ void run_decimate(const DecimateOptions& opt) {
             " of memory (about 500 bytes a triangle), which this system refused: give a smaller --buffer (the "
             "default 400000 reserves " + human_bytes(double(decimate::HalfEdgeBuffer::reserved_bytes(400000))) + ")");
     }
-    decimate::StreamDecimator& decimator = *buffer;
+    decimate::StreamDecimator& decimator = *made;
 
     io::WriteOptions wo = opt.write.options(opt.read);
     // The output count, for whole-mesh writers to refuse a --memory too small before the work.
