@@ -321,6 +321,11 @@ bool ByteSource::at_end() { return window().empty(); }
 
 void ByteSource::fail(const std::string& message) const { throw Error(name_, offset_, 0, message); }
 
+bool is_stream(const std::string& path) {
+    struct stat st;
+    return path == "-" || (::stat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode) && !S_ISDIR(st.st_mode));
+}
+
 // ---------------- ByteSink ----------------
 
 struct ByteSink::Gzip {

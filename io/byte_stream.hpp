@@ -83,6 +83,9 @@ struct SinkOptions {
     int gzip_level = -1;
 };
 
+// True for "-" and existing pipes, devices and sockets: what can be read (or written) once only.
+bool is_stream(const std::string& path);
+
 // The consumer under every writer. Writes go to `<target>.tmp-XXXXXX` in the target's
 // directory; commit() flushes and renames into place, keeping a replaced file's permissions;
 // a sink destroyed without commit() deletes its temporary file. A symbolic link is followed

@@ -98,6 +98,8 @@ struct Format {
 
 // All registered formats, in probe priority order.
 std::span<const Format* const> formats();
+// "draco, glb, ..." of the formats that can be read (or written), for messages.
+std::string format_names(bool for_writing);
 // The format named `name` (exact, case-sensitive), or null.
 const Format* find_format(std::string_view name);
 // The first readable format whose extension matches `path` (".gz" stripped), or null.

@@ -59,6 +59,8 @@ bool has_extension(const Format& f, const std::string& ext) {
     return false;
 }
 
+}  // namespace
+
 std::string format_names(bool for_writing) {
     std::string out;
     for (const Format* f : kFormats) {
@@ -68,8 +70,6 @@ std::string format_names(bool for_writing) {
     }
     return out;
 }
-
-}  // namespace
 
 std::span<const Format* const> formats() { return kFormats; }
 

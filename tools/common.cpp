@@ -32,13 +32,7 @@ uint64_t parse_bytes(const std::string& text) {
 
 namespace {
 
-std::string format_names(bool for_writing) {
-    std::string names;
-    for (const io::Format* f : io::formats())
-        if (for_writing ? f->open_writer != nullptr : f->open_reader != nullptr)
-            names += (names.empty() ? "" : ", ") + std::string(f->name);
-    return names;
-}
+using io::format_names;
 
 // --from/--to take a registered format's name: a typo is a command-line error (exit 2).
 CLI::Validator format_name(bool for_writing) {
@@ -230,11 +224,6 @@ std::string human_bytes(double bytes) {
 bool is_regular_file(const std::string& path) {
     struct stat st;
     return path != "-" && ::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
-}
-
-bool is_stream(const std::string& path) {
-    struct stat st;
-    return path == "-" || (::stat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode) && !S_ISDIR(st.st_mode));
 }
 
 io::Bounds input_bounds(const std::string& path, std::string_view from, const io::ReadOptions& options) {

@@ -106,8 +106,7 @@ std::string human_count(double n, int significant_digits = 0);
 std::string human_bytes(double bytes);
 // True for an existing regular file (not "-", a pipe or a device): one that can be read twice.
 bool is_regular_file(const std::string& path);
-// True for "-" and existing pipes, devices and sockets: what can be read (or written) once only.
-bool is_stream(const std::string& path);
+using io::is_stream;  // "-", pipes, devices: read or written once only
 // The input's bounding box: from its header when the format states it, else from a first pass
 // over the file (finite coordinates only; a progress bar on stderr). An input without finite
 // coordinates gives min = +inf, max = -inf. Throws io::Error like open_input.

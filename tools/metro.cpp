@@ -13,7 +13,6 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
-#include <sys/stat.h>
 
 namespace meshstream::tools {
 namespace {
@@ -531,8 +530,7 @@ EdgeCounts EdgeCounter::finish() {
 MeshSource file_source(const std::string& path, std::string_view from, const io::ReadOptions& options) {
     MeshSource s;
     s.name = path;
-    struct stat st;
-    s.once = path == "-" || (::stat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode));
+    s.once = io::is_stream(path);
     s.open = [path, from = std::string(from), options]() -> std::unique_ptr<io::Reader> {
         return std::make_unique<InputReader>(io::open_input(path, from, options));
     };
