@@ -139,6 +139,7 @@ std::unique_ptr<Writer> open_draco_writer(ByteSink& sink, const WriteOptions& op
 
 const Format kDracoFormat = {
     "draco", "drc", "Draco compressed mesh (whole mesh in memory)", &probe_draco, &open_draco_reader, &open_draco_writer,
+    Format::kAlwaysDraco,
 };
 
 bool probe_draco(std::span<const std::byte> head, std::optional<uint64_t>) {

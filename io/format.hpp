@@ -94,6 +94,16 @@ struct Format {
     std::unique_ptr<Reader> (*open_reader)(ByteSource& source, const ReadOptions& options);
     // May be null (read-only format). Throws io::Error.
     std::unique_ptr<Writer> (*open_writer)(ByteSink& sink, const WriteOptions& options);
+    // What the writer keeps or does beyond positions, for the commands' checks and warnings.
+    enum Trait : uint8_t {
+        kWritesColour = 1,     // vertex colours
+        kAlwaysDraco = 2,      // Draco-compressed (reorders triangles; takes --draco-* and --normals)
+        kDracoUnlessOff = 4,   // the same unless --no-draco (glTF)
+    };
+    uint8_t traits = 0;
+    // For formats without magic bytes: a weaker test, tried only when no probe and no
+    // extension identify the input. May be null.
+    bool (*guess)(std::span<const std::byte> head) = nullptr;
 };
 
 // All registered formats, in probe priority order.

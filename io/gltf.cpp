@@ -913,12 +913,12 @@ std::unique_ptr<Reader> open_gltf_reader(ByteSource& source, const ReadOptions& 
 
 const Format kGlbFormat = {
     "glb", "glb", "binary glTF 2.0 (Draco by default; whole mesh in memory)", &probe_glb, &open_gltf_reader,
-    &open_glb_writer,
+    &open_glb_writer, Format::kDracoUnlessOff,
 };
 
 const Format kGltfFormat = {
     "gltf", "gltf", "glTF 2.0 JSON + .bin (Draco by default; whole mesh in memory)", &probe_gltf_json, &open_gltf_reader,
-    &open_gltf_writer,
+    &open_gltf_writer, Format::kDracoUnlessOff,
 };
 
 bool probe_glb(std::span<const std::byte> head, std::optional<uint64_t>) {

@@ -752,6 +752,7 @@ const Format kPlyFormat = {
     &probe_ply,
     &open_ply_reader,
     &open_ply_writer,
+    Format::kWritesColour,
 };
 
 const Format kPlyAsciiFormat = {
@@ -761,6 +762,7 @@ const Format kPlyAsciiFormat = {
     nullptr,
     &open_ply_reader,
     &open_ply_ascii_writer,
+    Format::kWritesColour,
 };
 
 }  // namespace meshstream::io

@@ -91,16 +91,11 @@ const Format* format_for_extension(std::string_view path, bool for_writing) {
 
 const Format& detect_input_format(ByteSource& source) {
     auto head = source.peek(4096);
-    for (const Format* f : kFormats) {
-        if (!f->open_reader || !f->probe || !f->probe(head, source.size())) continue;
-        // Binary STL has no magic: without a size to check 84 + 50n against (a pipe, gzip), its
-        // probe only says "binary, not ASCII STL", less than a name that says otherwise (random
-        // bytes in a .ply.gz are no STL file).
-        if (f->name == "stl" && !source.size())
-            if (const Format* named = format_for_extension(source.name(), false); named && named != f) return *named;
-        return *f;
-    }
+    for (const Format* f : kFormats)
+        if (f->open_reader && f->probe && f->probe(head, source.size())) return *f;
     if (const Format* f = format_for_extension(source.name(), false)) return *f;
+    for (const Format* f : kFormats)
+        if (f->open_reader && f->guess && f->guess(head)) return *f;
     if (head.empty()) throw Error(source.name(), "file is empty");
     throw Error(source.name(), "unrecognised format (no known magic bytes or extension; use --from, one of: " +
                                    format_names(false) + ")");

@@ -595,9 +595,14 @@ const Format kStlFormat = {
     "stl",
     "stl",
     "STL, binary (reads binary and ASCII STL)",
-    &probe_stl_binary,
+    // Binary STL has no magic: a size that is 84 + 50·n is proof; without a size (a pipe,
+    // gzip) "binary bytes, not ASCII STL" is only a guess, tried after the extension (random
+    // bytes in a .ply.gz are no STL).
+    [](std::span<const std::byte> head, std::optional<uint64_t> size) { return size && probe_stl_binary(head, size); },
     &open_stl_reader,
     &open_stl_writer,
+    0,
+    [](std::span<const std::byte> head) { return probe_stl_binary(head, std::nullopt); },
 };
 
 const Format kStlAsciiFormat = {

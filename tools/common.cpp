@@ -49,8 +49,9 @@ CLI::Validator format_name(bool for_writing) {
 }  // namespace
 
 void note_unused_write_flags(const WriteFlags& flags, const io::Format& output, Warnings& warnings) {
-    if (output.name == "draco" || output.name == "glb" || output.name == "gltf") {
-        if (output.name == "draco" && !flags.draco) warnings.note("--no-draco applies to glTF outputs; a .drc is Draco");
+    if (output.traits & (io::Format::kAlwaysDraco | io::Format::kDracoUnlessOff)) {
+        if ((output.traits & io::Format::kAlwaysDraco) && !flags.draco)
+            warnings.note("--no-draco applies to glTF outputs; a .drc is Draco");
         return;
     }
     const WriteFlags defaults;

@@ -52,8 +52,7 @@ void run_convert(const ConvertOptions& opt) {
     progress.done();
     Warnings warnings;
     note_unused_write_flags(opt.write, *out.format, warnings);
-    // Only PLY writes vertex colours (docs/formats.md).
-    if (header.channels.color && out.format->name != "ply" && out.format->name != "ply-ascii")
+    if (header.channels.color && !(out.format->traits & io::Format::kWritesColour))
         warnings.note("the input's vertex colours are not written: " + std::string(out.format->name) +
                       " output carries geometry only (PLY keeps them)");
     filter.report(warnings);

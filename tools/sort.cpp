@@ -155,7 +155,8 @@ void run_sort(const SortOptions& opt) {
     require_format_for_stdout(opt.output, opt.write);
     // Draco's connectivity coder reorders the triangles: the sorted order would be lost.
     const io::Format* to = opt.write.to.empty() ? io::format_for_extension(opt.output, true) : io::find_format(opt.write.to);
-    if (to != nullptr && (to->name == "draco" || ((to->name == "glb" || to->name == "gltf") && opt.write.draco)))
+    if (to != nullptr && ((to->traits & io::Format::kAlwaysDraco) ||
+                          ((to->traits & io::Format::kDracoUnlessOff) && opt.write.draco)))
         throw UsageError((opt.output == "-" ? std::string("<stdout>") : opt.output) +
                          ": Draco compression reorders triangles, so the sorted order would be lost: write STL, PLY "
                          "or OBJ (or glTF with --no-draco)");
