@@ -15,6 +15,10 @@ namespace meshstream::io {
 namespace {
 
 constexpr size_t kPageBytes = 4096;
+// Residency is accounted in blocks of this size, not pages: on a read fault in a shared file
+// mapping, Linux also maps the neighbouring pages already in the page cache ("fault-around",
+// 64 KiB by default), so one touched page can make sixteen resident.
+constexpr size_t kResidencyBlockBytes = size_t{64} << 10;
 constexpr size_t kTailBytes = size_t{1} << 20;
 
 }  // namespace
@@ -49,10 +53,7 @@ std::unique_ptr<VertexTable> VertexTable::map_input_file(const std::string& path
         throw Error(path, offset, 0, "cannot map the vertex block: " + std::string(std::strerror(errno)));
     }
     t->base_ = static_cast<const std::byte*>(t->map_) + (offset - aligned);
-    if (t->map_bytes_ > budget_bytes) {
-        t->touched_bits_.assign(t->map_bytes_ / kPageBytes / 64 + 2, 0);
-        t->page_limit_ = std::max<uint64_t>(budget_bytes / kPageBytes, 16);
-    }
+    if (t->map_bytes_ > budget_bytes) t->start_accounting();
     return t;
 }
 
@@ -107,7 +108,7 @@ void VertexTable::flush_tail() {
     uint64_t bytes = (mapped_records_ + records) * stride_;
     if (bytes > map_bytes_) map_temp(bytes);
     mapped_records_ += records;
-    touched_bits_.resize(map_bytes_ / kPageBytes / 64 + 2, 0);
+    touched_bits_.resize(block_count() / 64 + 2, 0);
 }
 
 // Maps the temp file with room to grow: a shared mapping longer than the file is valid, and
@@ -123,30 +124,41 @@ void VertexTable::map_temp(uint64_t min_bytes) {
         throw Error(temp_->path(), "cannot map the vertex table: " + std::string(std::strerror(errno)));
     }
     base_ = static_cast<const std::byte*>(map_);
-    page_limit_ = std::max<uint64_t>(budget_bytes_ / kPageBytes, 16);
-    touched_bits_.assign(map_bytes_ / kPageBytes / 64 + 2, 0);
-    touched_pages_ = 0;
+    start_accounting();
+}
+
+size_t VertexTable::block_count() const {
+    const uintptr_t start = reinterpret_cast<uintptr_t>(map_) / kResidencyBlockBytes * kResidencyBlockBytes;
+    return (reinterpret_cast<uintptr_t>(map_) + map_bytes_ - start) / kResidencyBlockBytes + 1;
+}
+
+void VertexTable::start_accounting() {
+    block_limit_ = std::max<uint64_t>(budget_bytes_ / kResidencyBlockBytes, 16);
+    touched_bits_.assign(block_count() / 64 + 2, 0);
+    touched_blocks_ = 0;
 }
 
 const std::byte* VertexTable::record_in_map(uint64_t byte_offset) {
+    const std::byte* record = base_ + byte_offset;
     if (!touched_bits_.empty()) {
-        // Page index relative to the mapping start (base_ may sit inside the first page).
-        uint64_t page = (static_cast<uint64_t>(base_ - static_cast<const std::byte*>(map_)) + byte_offset) / kPageBytes;
-        uint64_t& word = touched_bits_[page >> 6];
-        uint64_t bit = uint64_t{1} << (page & 63);
+        // Fault-around windows are aligned in the address space, so blocks are counted there.
+        const uintptr_t start = reinterpret_cast<uintptr_t>(map_) / kResidencyBlockBytes * kResidencyBlockBytes;
+        const uint64_t block = (reinterpret_cast<uintptr_t>(record) - start) / kResidencyBlockBytes;
+        uint64_t& word = touched_bits_[block >> 6];
+        const uint64_t bit = uint64_t{1} << (block & 63);
         if (!(word & bit)) {
-            // A record can straddle two pages; count the first, the second is at most one more.
+            // A record can straddle two blocks; count the first, the second is at most one more.
             word |= bit;
-            if (++touched_pages_ > page_limit_) {
+            if (++touched_blocks_ > block_limit_) {
                 uint64_t used = mapped_records_ * stride_ + static_cast<uint64_t>(base_ - static_cast<const std::byte*>(map_));
                 ::madvise(map_, static_cast<size_t>(std::min<uint64_t>(used + kPageBytes, map_bytes_)) / kPageBytes * kPageBytes,
                           MADV_DONTNEED);
                 std::fill(touched_bits_.begin(), touched_bits_.end(), 0);
-                touched_pages_ = 0;
+                touched_blocks_ = 0;
             }
         }
     }
-    return base_ + byte_offset;
+    return record;
 }
 
 void VertexTable::get(uint64_t i, float* xyz, uint8_t* rgb) {

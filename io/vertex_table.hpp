@@ -6,10 +6,12 @@
 // block is mapped (map_input_file). emit_polygon, at the end, turns a face into triangles for
 // both readers.
 //
-// Memory: mapped pages count towards RSS once touched, so reads through a mapping larger than
-// the budget track the pages they touch in a bitmap (1 bit per 4 KiB page) and drop them all
-// with madvise(MADV_DONTNEED) when they pass the budget. Resident memory is therefore at most
-// budget + bitmap (1/32768 of the table) + one 1 MiB append buffer, whatever the input size.
+// Memory: mapped pages count towards RSS once touched, and Linux maps up to 64 KiB of cached
+// neighbours with each faulted page (fault-around). So reads through a mapping larger than the
+// budget mark the 64 KiB blocks they touch in a bitmap and drop them all with
+// madvise(MADV_DONTNEED) when the marked blocks pass the budget. Resident memory is therefore
+// at most budget + 64 KiB + bitmap (1/2^22 of the table) + one 1 MiB append buffer, whatever
+// the input size.
 #pragma once
 
 #include "io/byte_stream.hpp"
@@ -80,10 +82,12 @@ private:
     const std::byte* base_ = nullptr;  // first record (map_ plus the page-alignment delta)
     uint64_t mapped_records_ = 0;
     std::vector<std::byte> tail_;
-    // Resident-page accounting for mappings larger than the budget.
+    // Residency accounting for mappings larger than the budget, in 64 KiB blocks.
+    void start_accounting();
+    size_t block_count() const;
     std::vector<uint64_t> touched_bits_;
-    uint64_t touched_pages_ = 0;
-    uint64_t page_limit_ = 0;
+    uint64_t touched_blocks_ = 0;
+    uint64_t block_limit_ = 0;
 };
 
 // What emit_polygon keeps between calls: the current polygon's corners and its triangles. One
