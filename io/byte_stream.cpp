@@ -187,7 +187,9 @@ void unregister_temp_path(int slot) {
 }
 
 void install_cleanup_handlers() {
-    for (int sig : {SIGINT, SIGTERM, SIGHUP}) std::signal(sig, cleanup_and_reraise);
+    // SIGPIPE too: a reader that stops early (`| head`) ends the command mid-output, and it
+    // should die quietly by that signal, as UNIX filters do, but without leaving its spools.
+    for (int sig : {SIGINT, SIGTERM, SIGHUP, SIGPIPE}) std::signal(sig, cleanup_and_reraise);
     // Past a file-size limit (ulimit -f) the kernel sends SIGXFSZ, whose default action kills
     // the process and leaves temporary files; ignored, write() fails with EFBIG instead and
     // the writer throws an io::Error like for a full disk.

@@ -132,7 +132,7 @@ private:
 };
 
 // A temporary file for spills, runs and bodies that are assembled later. Registered so a
-// SIGINT/SIGTERM handler (install_cleanup_handlers) can unlink it; removed by the destructor.
+// signal handler (install_cleanup_handlers) can unlink it; removed by the destructor.
 class TempFile {
 public:
     // Creates the file in `dir` (empty: $TMPDIR or /tmp). Throws io::Error.
@@ -162,7 +162,7 @@ private:
 // (-1 when the table is full or the path too long). Thread-safe.
 int register_temp_path(const std::string& path);
 void unregister_temp_path(int slot);
-// Installs SIGINT/SIGTERM/SIGHUP handlers that unlink every registered path, then re-raise,
+// Installs SIGINT/SIGTERM/SIGHUP/SIGPIPE handlers that unlink every registered path, then re-raise,
 // and ignores SIGXFSZ so a file-size limit surfaces as a write error (EFBIG).
 void install_cleanup_handlers();
 

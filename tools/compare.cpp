@@ -3,6 +3,7 @@
 #include "io/error.hpp"
 #include "tools/commands.hpp"
 #include "tools/common.hpp"
+#include "tools/input_filter.hpp"
 #include "tools/metro.hpp"
 
 #include <nlohmann/json.hpp>
@@ -50,6 +51,30 @@ nlohmann::ordered_json stats_json(const DistanceStats& s, double diagonal) {
     return j;
 }
 
+// compare measures each file as it is; with --strict a NaN/inf or degenerate triangle is an
+// error instead, as in the other commands.
+class StrictReader final : public io::Reader {
+public:
+    StrictReader(std::unique_ptr<io::Reader> in, const std::string& name) : in_(std::move(in)), filter_(name, true) {
+        header_ = in_->header();
+    }
+    bool next(io::TriangleChunk& chunk) override {
+        if (!in_->next(chunk)) return false;
+        filter_.apply(chunk);  // strict: throws at the first bad triangle, removes none
+        return true;
+    }
+
+private:
+    std::unique_ptr<io::Reader> in_;
+    TriangleFilter filter_;
+};
+
+MeshSource source(const std::string& path, const ReadFlags& flags) {
+    MeshSource s = file_source(path, flags.from, flags.options());
+    if (flags.strict) s.open = [open = s.open, path] { return std::make_unique<StrictReader>(open(), path == "-" ? "<stdin>" : path); };
+    return s;
+}
+
 void run_compare(const CompareCliOptions& opt) {
     if (is_stream(opt.a) && is_stream(opt.b))
         throw UsageError("compare cannot read both A and B from stdin or pipes: one of them is read twice");
@@ -68,7 +93,7 @@ void run_compare(const CompareCliOptions& opt) {
         }
         progress.update(done);
     };
-    CompareResult r = compare_meshes(file_source(opt.a, opt.read.from, read), file_source(opt.b, opt.read.from, read), co);
+    CompareResult r = compare_meshes(source(opt.a, opt.read), source(opt.b, opt.read), co);
     progress.done();
 
     double diag = r.diagonal;
@@ -136,6 +161,7 @@ void add_compare(CLI::App& app) {
     cmd->add_option("--seed", opt->seed, "Random seed of the sampling (same seed, same figures)")->capture_default_str();
     cmd->add_flag("--json", opt->json, "Print JSON instead of text");
     add_read_flags(cmd, opt->read);
+    strict_reports_bad_triangles(cmd);
     cmd->callback([opt] { run_compare(*opt); });
 }
 

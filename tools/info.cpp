@@ -3,6 +3,7 @@
 #include "io/error.hpp"
 #include "tools/commands.hpp"
 #include "tools/common.hpp"
+#include "tools/input_filter.hpp"
 #include "tools/topology.hpp"
 #include "tools/order.hpp"
 
@@ -13,6 +14,7 @@
 #include <filesystem>
 #include <limits>
 #include <memory>
+#include <optional>
 
 namespace meshstream::tools {
 namespace {
@@ -74,7 +76,11 @@ void run_info(const InfoOptions& opt) {
     if (opt.order) meter.emplace(opt.read.options().memory_budget_bytes);
     {
         Progress progress("reading", header.triangle_count);
+        // info reports bad triangles; --strict makes the first one an error instead.
+        std::optional<TriangleFilter> strict;
+        if (opt.read.strict) strict.emplace(in.source->name(), true);
         while (in.reader->next(chunk)) {
+            if (strict) strict->apply(chunk);  // throws, removes nothing
             accumulate(chunk, stats);
             if (topology) topology->add(chunk);
             if (meter) meter->add(chunk);
@@ -177,6 +183,7 @@ void add_info(CLI::App& app) {
                   "(exact within --memory, else sampled; see docs/cli.md)");
     cmd->add_option("--buffer", opt->buffer, "With --order: decimation buffer (triangles) to judge (default 400000)");
     add_read_flags(cmd, opt->read);
+    strict_reports_bad_triangles(cmd);
     cmd->callback([opt] { run_info(*opt); });
 }
 

@@ -416,19 +416,37 @@ TEST(CliBadInput, NanAndDegenerateTrianglesAreSkippedWithCountedWarnings) {
                   std::string::npos) << r.err;
         EXPECT_FALSE(fs::exists(dir / "strict.stl"));
     }
+    // info and compare report the file as it is; --strict makes the same triangle an error.
+    for (const std::string& cmd : {"info " + dir / "bad.stl", "compare " + dir / "bad.stl" + " " + dir / "bad.stl"}) {
+        EXPECT_EQ(run(cmd).code, 0) << cmd;
+        CliRun r = run(cmd + " --strict");
+        EXPECT_EQ(r.code, 1) << cmd;
+        EXPECT_NE(r.err.find(dir / "bad.stl" + ": triangle 19 has a NaN or infinite coordinate (--strict)"),
+                  std::string::npos) << r.err;
+    }
 }
 
 TEST(CliBadInput, HelpDescribesTheSkipPolicy) {
-    for (const char* cmd : {"convert", "sort", "decimate"}) {
+    auto help_of = [](const char* cmd) {
         char out_path[] = "/tmp/cli_bad_input_help-XXXXXX";
         ::close(::mkstemp(out_path));
         std::system((std::string(MESHSTREAM_BINARY) + " " + cmd + " --help > " + out_path).c_str());
         std::string help = slurp(out_path);
         ::unlink(out_path);
+        return help;
+    };
+    for (const char* cmd : {"convert", "sort", "decimate"}) {
+        const std::string help = help_of(cmd);
         // CLI11 wraps long descriptions; look for the key words.
         EXPECT_NE(help.find("--strict"), std::string::npos) << cmd;
         EXPECT_NE(help.find("NaN/inf"), std::string::npos) << cmd << help;
         EXPECT_NE(help.find("skipped with a"), std::string::npos) << cmd;
+    }
+    for (const char* cmd : {"info", "compare"}) {  // no skipping there: --strict only adds errors
+        const std::string help = help_of(cmd);
+        EXPECT_NE(help.find("--strict"), std::string::npos) << cmd;
+        EXPECT_EQ(help.find("skipped with a"), std::string::npos) << cmd << help;
+        EXPECT_NE(help.find("an error"), std::string::npos) << cmd << help;
     }
 }
 
@@ -472,6 +490,25 @@ TEST(CliBadInput, SigintDuringConvertSortDecimateLeavesNoFiles) {
         ::close(fds[1]);
         EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGINT) << args << ": status " << status;
         EXPECT_EQ(listing(dir.path), std::vector<std::string>{}) << args;
+    }
+}
+
+// A reader that stops early (`| head`) kills the command with SIGPIPE, mid-output: like Ctrl-C,
+// that must remove the temporary files (a stdout spool, the PLY writer's corner table, sort
+// runs), and the command still dies quietly by the signal, as UNIX filters do.
+TEST(CliBadInput, ClosedOutputPipeLeavesNoTemporaryFiles) {
+    TempDir dir;
+    write_file(dir / "in.stl", binary_stl(grid(200)));  // 80000 triangles, 4 MB
+    fs::create_directory(dir / "t");
+    for (const char* args : {"convert {IN} - --to stl", "convert {IN} - --to ply",
+                             "sort --axis x --memory 1M --tmpdir {T} {IN} - --to stl"}) {
+        const std::string cmdline = expand(expand(args, "{IN}", dir / "in.stl"), "{T}", dir / "t");
+        const std::string status = dir / "status";
+        const std::string sh = "{ TMPDIR=" + dir / "t" + " " + MESHSTREAM_BINARY + " -q " + cmdline + " 2>/dev/null; echo $? > " +
+                               status + "; } | head -c 100 > /dev/null";
+        ASSERT_EQ(std::system(sh.c_str()), 0) << sh;
+        EXPECT_EQ(slurp(status), "141\n") << args;  // 128 + SIGPIPE
+        EXPECT_EQ(listing(dir / "t"), std::vector<std::string>{}) << args;
     }
 }
 
