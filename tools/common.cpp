@@ -68,9 +68,11 @@ void note_unused_write_flags(const WriteFlags& flags, const io::Format& output, 
         warnings.note(given + " apply to Draco and glTF outputs only: ignored for " + std::string(output.name));
 }
 
-void require_format_for_stdout(const std::string& output, const WriteFlags& flags) {
-    if (output == "-" && flags.to.empty())
-        throw UsageError("<stdout>: writing to stdout needs --to (one of: " + format_names(true) + ")");
+void require_output_format(const std::string& output, const WriteFlags& flags) {
+    if (!flags.to.empty()) return;  // checked by its validator
+    if (output == "-") throw UsageError("<stdout>: writing to stdout needs --to (one of: " + format_names(true) + ")");
+    if (io::format_for_extension(output, true) == nullptr)
+        throw UsageError(output + ": cannot tell the output format from the name (use --to, one of: " + format_names(true) + ")");
 }
 
 io::ReadOptions ReadFlags::options() const {
@@ -89,6 +91,12 @@ void add_read_flags(CLI::App* cmd, ReadFlags& flags) {
     cmd->add_option("--tmpdir", flags.tmpdir, "Directory for temporary files (default: $TMPDIR or /tmp)");
     cmd->add_flag("--strict", flags.strict, "Triangles with a NaN/inf coordinate or two corners at the same position are skipped with a "
                    "counted warning; --strict makes them (and faces of fewer than 3 vertices) errors");
+}
+
+void strict_reports_bad_triangles(CLI::App* cmd) {
+    cmd->get_option("--strict")
+        ->description("Make the first triangle with a NaN/inf coordinate or two corners at the same position (or a face "
+                      "of fewer than 3 vertices) an error; without it they are counted as they are");
 }
 
 io::WriteOptions WriteFlags::options(const ReadFlags& read) const {

@@ -35,6 +35,9 @@ struct ReadFlags {
     io::ReadOptions options() const;
 };
 void add_read_flags(CLI::App* cmd, ReadFlags& flags);
+// For commands that measure the input as it is (info, compare): --strict's help says that it
+// makes bad triangles errors, without the skipping that convert, sort and decimate do.
+void strict_reports_bad_triangles(CLI::App* cmd);
 
 // Options every command that writes a mesh accepts.
 struct WriteFlags {
@@ -47,8 +50,9 @@ struct WriteFlags {
 };
 // `with_memory`: false when add_read_flags already added --memory/--tmpdir to `cmd`.
 void add_write_flags(CLI::App* cmd, WriteFlags& flags);
-// Throws UsageError when `output` is stdout ("-") and no --to names its format.
-void require_format_for_stdout(const std::string& output, const WriteFlags& flags);
+// Throws UsageError when no --to is given and `output` is stdout ("-") or a name whose
+// extension is no writable format.
+void require_output_format(const std::string& output, const WriteFlags& flags);
 class Warnings;
 // Notes Draco/glTF options given for an output of another format (they do nothing there).
 void note_unused_write_flags(const WriteFlags& flags, const io::Format& output, Warnings& warnings);

@@ -18,7 +18,7 @@ struct ConvertOptions {
 };
 
 void run_convert(const ConvertOptions& opt) {
-    require_format_for_stdout(opt.output, opt.write);
+    require_output_format(opt.output, opt.write);
     io::Input in = io::open_input(opt.input, opt.read.from, opt.read.options());
     const io::MeshHeader& header = in.reader->header();
     io::WriteOptions wo = opt.write.options(opt.read);

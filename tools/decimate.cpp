@@ -64,7 +64,7 @@ double weld_epsilon(const DecimateOptions& opt, const io::MeshHeader& header, co
 void run_decimate(const DecimateOptions& opt) {
     const auto start = std::chrono::steady_clock::now();
     // Checked before any work: the comparison re-reads both files once the output is done.
-    require_format_for_stdout(opt.output, opt.write);
+    require_output_format(opt.output, opt.write);
     if (opt.report) {
         const bool input_stream = is_stream(opt.input);
         if (input_stream || is_stream(opt.output)) {

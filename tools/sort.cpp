@@ -152,7 +152,7 @@ int longest_axis(const SortOptions& opt, const io::ReadOptions& ro) {
 
 void run_sort(const SortOptions& opt) {
     const auto t0 = std::chrono::steady_clock::now();
-    require_format_for_stdout(opt.output, opt.write);
+    require_output_format(opt.output, opt.write);
     // Draco's connectivity coder reorders the triangles: the sorted order would be lost.
     const io::Format* to = opt.write.to.empty() ? io::format_for_extension(opt.output, true) : io::find_format(opt.write.to);
     if (to != nullptr && ((to->traits & io::Format::kAlwaysDraco) ||
@@ -322,6 +322,8 @@ void add_sort(CLI::App& app) {
         ->check(CLI::IsMember({"x", "y", "z", "auto"}));
     cmd->add_flag("--stats", opt->stats, "Print runs, merge passes, temporary disk, time and peak RSS on stderr");
     add_read_flags(cmd, opt->read);
+    cmd->get_option("--tmpdir")->description("Directory for sort runs and spills (default: the output's directory; $TMPDIR "
+                                             "or /tmp when writing to stdout)");
     add_write_flags(cmd, opt->write);
     cmd->callback([opt] { run_sort(*opt); });
 }

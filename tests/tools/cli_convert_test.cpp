@@ -103,10 +103,16 @@ TEST(CliConvert, QuietWorksAfterTheCommandToo) {
 
 TEST(CliConvert, UnknownOutputExtensionIsAnErrorNamingTheFile) {
     TempDir dir;
-    auto r = run("convert " + kBunny + " " + (dir / "out.xyz"));
-    EXPECT_EQ(r.code, 1);
-    EXPECT_NE(r.err.find("out.xyz: cannot tell the output format"), std::string::npos) << r.err;
-    EXPECT_TRUE(listing(dir.path).empty());
+    // A command line that cannot work: exit 2 before any work, for every writing command.
+    for (const char* cmd : {"convert", "decimate", "sort"}) {
+        auto r = run(std::string(cmd) + " " + kBunny + " " + (dir / "out.xyz"));
+        EXPECT_EQ(r.code, 2) << cmd;
+        EXPECT_NE(r.err.find("out.xyz: cannot tell the output format"), std::string::npos) << r.err;
+        EXPECT_TRUE(listing(dir.path).empty());
+    }
+    auto r = run("convert " + kBunny + " /dev/null");
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.err.find("/dev/null: cannot tell the output format"), std::string::npos) << r.err;
 }
 
 TEST(CliConvert, EveryCommandHasHelp) {
