@@ -178,12 +178,20 @@ TEST(CliBadInput, MemoryBudgetsThatAreNotSizesOrTooSmallAreRefusedClearly) {
                         {"--memory nan", 2, "--memory: expected a size like 64M or 1G, got 'nan'"},
                         {"--memory -5M", 2, "--memory: expected a size like 64M or 1G, got '-5M'"},
                         {"--memory 12Q", 2, "--memory: unknown size suffix in '12Q'"},
+                        // used to be "out of memory" (a run buffer of the budget's size)
+                        {"--memory 100T", 2, "--memory: 100T is more than this machine's memory ("},
                         // used to be "out of memory"
                         {"--memory 1", 2, "in.stl: --memory 1 is too small to sort: give at least 97K"},
                         {"--memory 96K", 2, "in.stl: --memory 96K is too small to sort: give at least 97K"},
                     });
     CliRun ok = run("sort --axis x --memory 97K " + dir / "in.stl" + " " + dir / "out.stl");  // the least, exactly
     EXPECT_EQ(ok.code, 0) << ok.err;
+    for (const std::string& cmd : {"info --topology " + dir / "in.stl", "compare " + dir / "in.stl" + " " + dir / "in.stl",
+                                  "convert " + dir / "in.stl" + " " + dir / "o.ply"}) {
+        CliRun r = run(cmd + " --memory 100T");
+        EXPECT_EQ(r.code, 2) << cmd;
+        EXPECT_NE(r.err.find("--memory: 100T is more than this machine's memory"), std::string::npos) << r.err;
+    }
 }
 
 TEST(CliBadInput, InputWithoutTrianglesGivesAnEmptyOutputAndAWarning) {
