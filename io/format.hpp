@@ -28,7 +28,6 @@ struct MeshHeader {
     std::optional<uint64_t> triangle_count;  // total triangles (an n-gon counts n - 2)
     std::optional<uint64_t> vertex_count;    // indexed formats
     std::optional<int> sorted_axis;          // 0,1,2 when the file says it is sorted (meshstream sort)
-    std::optional<Bounds> bounds;            // when the header states it (glTF accessors)
     Channels channels;                       // channels the reader will fill
     std::string variant;                     // e.g. "binary", "ascii", "binary_big_endian"
     std::vector<std::pair<std::string, std::string>> notes;  // extra facts for `info`

@@ -245,7 +245,6 @@ bool is_regular_file(const std::string& path) {
 
 io::Bounds input_bounds(const std::string& path, std::string_view from, const io::ReadOptions& options) {
     io::Input in = io::open_input(path, from, options);
-    if (in.reader->header().bounds) return *in.reader->header().bounds;
     io::Bounds box;
     box.min.fill(std::numeric_limits<float>::infinity());
     box.max.fill(-std::numeric_limits<float>::infinity());

@@ -34,9 +34,9 @@ struct DecimateOptions {
     WriteFlags write;
 };
 
-// --weld EPS: absolute, or "P%" of the bounding-box diagonal: the box the header states, else
-// one found by a first pass over the input (a regular file only: a stream cannot be read twice).
-double weld_epsilon(const DecimateOptions& opt, const io::MeshHeader& header, const std::string& input_name) {
+// --weld EPS: absolute, or "P%" of the bounding-box diagonal, found by a first pass over the
+// input (a regular file only: a stream cannot be read twice).
+double weld_epsilon(const DecimateOptions& opt, const std::string& input_name) {
     const std::string& text = opt.weld;
     if (text.empty()) return 0;
     const bool percent = text.back() == '%';
@@ -49,10 +49,10 @@ double weld_epsilon(const DecimateOptions& opt, const io::MeshHeader& header, co
     if (!(value >= 0) || !std::isfinite(value))
         throw CLI::ValidationError("--weld", "must be a non-negative number, found '" + text + "'");
     if (!percent) return value;
-    if (!header.bounds && !is_regular_file(opt.input))
-        throw UsageError(input_name + ": --weld " + text + " needs the bounding box, which this format does not state "
-                                       "up front and a stream cannot be read twice for; give an absolute size instead");
-    const io::Bounds box = header.bounds ? *header.bounds : input_bounds(opt.input, opt.read.from, opt.read.options());
+    if (!is_regular_file(opt.input))
+        throw UsageError(input_name + ": --weld " + text + " needs the bounding box, found in a first pass over the "
+                                       "input, which a stream cannot be read twice for; give an absolute size instead");
+    const io::Bounds box = input_bounds(opt.input, opt.read.from, opt.read.options());
     double diag2 = 0;
     for (int i = 0; i < 3; ++i) {
         const double d = double(box.max[i]) - box.min[i];
@@ -93,7 +93,7 @@ void run_decimate(const DecimateOptions& opt) {
     options.buffer_triangles = opt.buffer;
     options.candidates = opt.candidates;
     options.seed = opt.seed;
-    options.weld_eps = weld_epsilon(opt, header, in.source->name());
+    options.weld_eps = weld_epsilon(opt, in.source->name());
     options.sorted_axis = opt.sorted_axis ? opt.sorted_axis : header.sorted_axis;
     std::unique_ptr<decimate::StreamDecimator> made;  // on the heap only to catch a refused reservation here
     try {

@@ -134,8 +134,7 @@ double seconds_since(std::chrono::steady_clock::time_point t) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
 }
 
-// The longest axis of the input's bounding box, from the header when it states the bounds,
-// else from a first reading pass. Precondition: the input can be opened twice.
+// The longest axis of the input's bounding box, from a first reading pass. Precondition: the input can be opened twice.
 int longest_axis(const SortOptions& opt, const io::ReadOptions& ro) {
     const io::Bounds box = input_bounds(opt.input, opt.read.from, ro);
     int best = 2;  // empty or flat input: z, the usual scan axis
