@@ -12,9 +12,11 @@
 namespace meshstream::decimate {
 namespace {
 
-// Consecutive DECIMATE(1) attempts without a valid candidate before the buffer counts as
-// stalled (every draw of 8·candidates half-edges found nothing collapsible).
-constexpr int kStallAttempts = 16;
+// The buffer counts as stalled after this many consecutive DECIMATE(1) calls without a valid
+// candidate: at least 16, and enough calls to have tried 128 candidates, so that a small
+// --candidates does not give up on a mesh that still has collapses to find (with one
+// candidate a call tests one collapse, and 16 invalid draws in a row are common when coarse).
+int stall_attempts(int candidates) { return std::max(16, 128 / std::max(candidates, 1)); }
 
 double choose_ratio(const Options& options, std::optional<uint64_t> input_count) {
     if (!options.target) return options.ratio;
@@ -175,7 +177,7 @@ void StreamDecimator::make_room(const Emit& out) {
         if (decimate_once(buffer_, rng_, options_.candidates, &candidate_memory_)) {
             ++stats_.collapses;
             failures = 0;
-        } else if (++failures >= kStallAttempts) {
+        } else if (++failures >= stall_attempts(options_.candidates)) {
             break;
         }
     }
@@ -203,7 +205,7 @@ void StreamDecimator::finish(const Emit& out) {
         if (decimate_once(buffer_, rng_, options_.candidates, &candidate_memory_)) {
             ++stats_.collapses;
             failures = 0;
-        } else if (++failures >= kStallAttempts) {
+        } else if (++failures >= stall_attempts(options_.candidates)) {
             break;
         }
     }
