@@ -161,6 +161,8 @@ void run_decimate(const DecimateOptions& opt) {
     decimate::print_phase_report(stderr);  // only in builds with MESHSTREAM_PHASE_TIMERS
 
     Warnings warnings;
+    char ratio_text[32];
+    std::snprintf(ratio_text, sizeof ratio_text, "%.6g", decimator.ratio());
     note_unused_write_flags(opt.write, *out.format, warnings);
     filter.report(warnings);
     if (s.forced_writes > 0)
@@ -173,11 +175,11 @@ void run_decimate(const DecimateOptions& opt) {
                                 "read later at those positions are not joined to them (the output has cracks there)"
                           : std::string()) +
                      (options.sorted_axis && s.sort_violations == 0
-                          ? "; the input is sorted, but its width (the triangles held before all their neighbours "
-                            "arrive) is more than the buffer holds: raise --buffer (`meshstream info --order` "
-                            "measures the width; decimate needs about a quarter more)"
-                          : "; the input is not in streaming order: run `meshstream sort` on it first, or raise "
-                            "--buffer"));
+                          ? "; the input is sorted, so the buffer is too small for it at this ratio: raise --buffer "
+                            "(`meshstream info --order --ratio " + std::string(ratio_text) + "` estimates the buffer it needs)"
+                          : "; either the input is not in streaming order (run `meshstream sort` on it first) or the "
+                            "buffer is too small for it at this ratio (raise --buffer): `meshstream info --order "
+                            "--ratio " + std::string(ratio_text) + "` tells which"));
     if (s.sort_violations > 0)
         warnings.note(std::string("the input is not sorted along ") + "xyz"[*options.sorted_axis] +
                      " as stated: " + std::to_string(s.sort_violations) +
@@ -200,7 +202,7 @@ void run_decimate(const DecimateOptions& opt) {
         warnings.note("the target " + std::to_string(s.target_triangles) + " is more than the " +
                       std::to_string(s.triangles_in) + " usable input triangles: nothing was decimated");
     else if (s.triangles_in > 0 && s.triangles_out == s.target_triangles + 1)
-        warnings.note(missed + " (a collapse removes two triangles, and no boundary edge was left to remove the odd one)");
+        warnings.note(missed + " (a collapse removes two triangles, and no boundary edge could be collapsed to remove the odd one)");
     else if (s.triangles_in > 0 && s.triangles_out != s.target_triangles)
         warnings.note(missed + " (too little left that could be decimated)");
     else if (s.triangles_in > 0 && s.target_triangles == 0)

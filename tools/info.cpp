@@ -25,6 +25,7 @@ struct InfoOptions {
     bool topology = false;  // --topology: vertex and edge counts (tools/topology.hpp)
     bool order = false;        // --order: measure the stream's width (tools/order.hpp)
     uint64_t buffer = 400000;  // --buffer: decimation buffer to judge against the width
+    double ratio = 0.1;        // --ratio: the decimation ratio it is judged for
     ReadFlags read;
 };
 
@@ -126,7 +127,7 @@ void run_info(const InfoOptions& opt) {
         }
         if (meter) {
             OrderReport r = meter->finish();
-            BufferVerdict v = buffer_verdict(r, opt.buffer);
+            BufferVerdict v = buffer_verdict(r, opt.buffer, opt.ratio);
             auto& o = j["order"];
             o["width"] = r.width;
             o["width_error"] = r.width_error;
@@ -134,6 +135,8 @@ void run_info(const InfoOptions& opt) {
             o["sample_rate"] = r.sample_rate;
             o["width_at"] = r.width_at;
             o["buffer"] = opt.buffer;
+            o["ratio"] = opt.ratio;
+            o["buffer_needed"] = buffer_needed(r, opt.ratio);
             o["buffer_suffices"] = v == BufferVerdict::kSuffices ? nlohmann::json(true)
                                    : v == BufferVerdict::kTooSmall ? nlohmann::json(false) : nlohmann::json(nullptr);
             o["key_descents"] = {{"x", r.descents[0]}, {"y", r.descents[1]}, {"z", r.descents[2]}};
@@ -165,7 +168,7 @@ void run_info(const InfoOptions& opt) {
                     (unsigned long long)t.edges, (unsigned long long)t.boundary_edges,
                     (unsigned long long)t.non_manifold_edges);
     }
-    if (meter) std::printf("%s", format_order_text(meter->finish(), opt.buffer).c_str());
+    if (meter) std::printf("%s", format_order_text(meter->finish(), opt.buffer, opt.ratio).c_str());
 }
 
 }  // namespace
@@ -182,6 +185,9 @@ void add_info(CLI::App& app) {
                   "Measure the stream's width: triangles held at once until all their vertices' uses were read "
                   "(exact within --memory, else sampled; see docs/cli.md)");
     cmd->add_option("--buffer", opt->buffer, "With --order: decimation buffer (triangles) to judge (default 400000)");
+    cmd->add_option("--ratio", opt->ratio,
+                    "With --order: the decimation ratio to judge it for (default 0.1; the buffer needed grows with it)")
+        ->check(CLI::Range(0.0, 1.0));
     add_read_flags(cmd, opt->read);
     strict_reports_bad_triangles(cmd);
     cmd->callback([opt] { run_info(*opt); });

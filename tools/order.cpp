@@ -220,10 +220,14 @@ OrderReport OrderMeter::finish() {
     return r;
 }
 
-BufferVerdict buffer_verdict(const OrderReport& report, uint64_t buffer_triangles) {
+uint64_t buffer_needed(const OrderReport& report, double ratio) {
+    return static_cast<uint64_t>(std::ceil(buffer_per_width(ratio) * (static_cast<double>(report.width) + report.width_error)));
+}
+
+BufferVerdict buffer_verdict(const OrderReport& report, uint64_t buffer_triangles, double ratio) {
     const double b = static_cast<double>(buffer_triangles);
     const double w = static_cast<double>(report.width);
-    if (kBufferPerWidth * (w + report.width_error) <= b) return BufferVerdict::kSuffices;
+    if (buffer_needed(report, ratio) <= buffer_triangles) return BufferVerdict::kSuffices;
     if (w - report.width_error > b) return BufferVerdict::kTooSmall;
     return BufferVerdict::kUncertain;
 }
@@ -238,20 +242,7 @@ std::optional<OrderReport> measure_file_order(const std::string& path, std::stri
     return meter.finish();
 }
 
-std::optional<std::string> sorting_hint(const OrderReport& report, uint64_t buffer_triangles) {
-    if (buffer_verdict(report, buffer_triangles) == BufferVerdict::kSuffices) return std::nullopt;
-    const int axis = report.best_axis();
-    std::string width = human_count(static_cast<double>(report.width), 3) + " triangles";
-    if (report.descents[axis] == 0)
-        return "the input is already sorted along " + std::string(kAxisNames[axis]) + " but its width is " + width +
-               "; a --buffer of " +
-               std::to_string(static_cast<uint64_t>(std::ceil(kBufferPerWidth * double(report.width)))) +
-               " (a quarter more) would avoid forced writes";
-    return "the input's width is " + width + " (a --buffer of " + std::to_string(buffer_triangles) +
-           " holds fewer): sorting it first would help (meshstream sort --axis " + kAxisNames[axis] + ")";
-}
-
-std::string format_order_text(const OrderReport& r, uint64_t buffer_triangles) {
+std::string format_order_text(const OrderReport& r, uint64_t buffer_triangles, double ratio) {
     std::string out = "width:       " + std::to_string(r.width) + " triangles";
     char buf[160];
     if (r.exact()) {
@@ -269,11 +260,13 @@ std::string format_order_text(const OrderReport& r, uint64_t buffer_triangles) {
     } else {
         out += "\n";
     }
-    BufferVerdict v = buffer_verdict(r, buffer_triangles);
+    const BufferVerdict v = buffer_verdict(r, buffer_triangles, ratio);
+    std::snprintf(buf, sizeof buf, " at --ratio %g (needs about %llu)\n", ratio,
+                  static_cast<unsigned long long>(buffer_needed(r, ratio)));
     out += "buffer:      --buffer " + std::to_string(buffer_triangles) +
-           (v == BufferVerdict::kSuffices  ? " suffices\n"
-            : v == BufferVerdict::kTooSmall ? " is too small (decimate would force-write)\n"
-                                            : " may be too small (decimate needs the width and a quarter more)\n");
+           (v == BufferVerdict::kSuffices  ? " suffices"
+            : v == BufferVerdict::kTooSmall ? " is too small (decimate would force-write)"
+                                            : " may be too small") + buf;
     std::snprintf(buf, sizeof buf, "key descents: x %llu, y %llu, z %llu",
                   static_cast<unsigned long long>(r.descents[0]), static_cast<unsigned long long>(r.descents[1]),
                   static_cast<unsigned long long>(r.descents[2]));

@@ -53,15 +53,19 @@ struct OrderReport {
 };
 
 enum class BufferVerdict { kSuffices, kTooSmall, kUncertain };
-// The buffer decimate needs per triangle of width: the open triangles plus room for the
-// decimated region behind the front. Measured (the least buffer without forced writes, at
-// 10 % and 1 %): 1.2× on the sorted bunny (width 830), 1.18× on a 100 k generated mesh (1 741),
-// 1.2× on the 1 M one (5 858); a quarter more is safe.
-inline constexpr double kBufferPerWidth = 1.25;
-// Whether a decimation buffer of `buffer_triangles` suffices: kSuffices when it holds the
-// width (plus its error) and a quarter more, kTooSmall when it holds less than the width
-// (minus its error), kUncertain in between.
-BufferVerdict buffer_verdict(const OrderReport& report, uint64_t buffer_triangles);
+// The buffer decimate needs per triangle of width at decimation ratio `ratio`: the open
+// triangles plus room for the decimated region behind the front, which grows with the ratio.
+// It also depends on the mesh and the sort axis, so this is an estimate. Measured (the least
+// buffer without forced writes ÷ width) at ratios 0.01 / 0.1 / 0.5 / 0.9: the bunny sorted
+// along x (width 830) 1.08 / 1.31 / 1.64 / 1.93, along y (933) 1.47 / 1.48 / 2.22 / 2.61, the
+// 1 M generated mesh (5 858) 1.06 / 1.18 / 1.60 / 1.91. 1.5 + 1.5·ratio covers them all.
+inline double buffer_per_width(double ratio) { return 1.5 + 1.5 * ratio; }
+// The buffer that suffices for decimating at `ratio`: buffer_per_width × (width + its error).
+uint64_t buffer_needed(const OrderReport& report, double ratio);
+// Whether a decimation buffer of `buffer_triangles` suffices at `ratio`: kSuffices when it
+// holds buffer_needed(), kTooSmall when it holds less than the width (minus its error),
+// kUncertain in between.
+BufferVerdict buffer_verdict(const OrderReport& report, uint64_t buffer_triangles, double ratio);
 
 // Measures a stream chunk by chunk (chunks in, no I/O). Memory: at most `memory_budget_bytes`
 // (at least 1 MiB is used as the floor).
@@ -100,12 +104,8 @@ private:
 std::optional<OrderReport> measure_file_order(const std::string& path, std::string_view from,
                                               const io::ReadOptions& options);
 
-// For `decimate` after it had to force-write: a one-line hint ("sorting would help ..." or
-// "the file is already sorted along z; a --buffer of ... would avoid forced writes"), or
-// nullopt when the buffer is known to suffice (forced writes came from something else).
-std::optional<std::string> sorting_hint(const OrderReport& report, uint64_t buffer_triangles);
-
-// The text lines `info --order` prints ("order:", "buffer:", "key descents:").
-std::string format_order_text(const OrderReport& report, uint64_t buffer_triangles);
+// The text lines `info --order` prints ("width:", "buffer:", "key descents:"), judging
+// `buffer_triangles` for decimation at `ratio`.
+std::string format_order_text(const OrderReport& report, uint64_t buffer_triangles, double ratio);
 
 }  // namespace meshstream::tools

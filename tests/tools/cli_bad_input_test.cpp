@@ -227,7 +227,9 @@ TEST(CliBadInput, ForcedWritesEndWithAWarningThatAdvisesSort) {
     EXPECT_NE(line.find(" of their vertices were evicted from the weld table to make room, so triangles read later at "
                         "those positions are not joined to them (the output has cracks there)"),
               std::string::npos) << line;
-    EXPECT_NE(line.find("run `meshstream sort` on it first, or raise --buffer"), std::string::npos) << line;
+    EXPECT_NE(line.find("either the input is not in streaming order (run `meshstream sort` on it first) or the buffer is "
+                        "too small for it at this ratio (raise --buffer): `meshstream info --order --ratio 0.1` tells which"),
+              std::string::npos) << line;
     EXPECT_NE(line.back(), ')') << line;  // no event count appended
 
     // Sorted input (here in row order, said by --sorted-axis) in a buffer below its width:
@@ -235,8 +237,8 @@ TEST(CliBadInput, ForcedWritesEndWithAWarningThatAdvisesSort) {
     write_file(dir / "rows.stl", binary_stl(tris));
     CliRun s = run("decimate --buffer 40 --sorted-axis y -r 0.1 " + dir / "rows.stl" + " " + dir / "out2.stl");
     EXPECT_EQ(s.code, 0) << s.err;
-    EXPECT_NE(s.err.find("; the input is sorted, but its width (the triangles held before all their neighbours arrive) "
-                         "is more than the buffer holds: raise --buffer"),
+    EXPECT_NE(s.err.find("; the input is sorted, so the buffer is too small for it at this ratio: raise --buffer "
+                         "(`meshstream info --order --ratio 0.1` estimates the buffer it needs)"),
               std::string::npos) << s.err;
     EXPECT_EQ(s.err.find("run `meshstream sort`"), std::string::npos) << s.err;
 }

@@ -121,20 +121,18 @@ TEST(OrderMeter, BufferVerdictAndHint) {
     r.triangles = 1000000;
     r.width = 500000;
     r.descents = {10, 20, 30000};
-    EXPECT_EQ(tools::buffer_verdict(r, 400000), tools::BufferVerdict::kTooSmall);
-    EXPECT_EQ(tools::buffer_verdict(r, 500000), tools::BufferVerdict::kUncertain);  // no room behind the front
-    EXPECT_EQ(tools::buffer_verdict(r, 625000), tools::BufferVerdict::kSuffices);
-    std::optional<std::string> hint = tools::sorting_hint(r, 400000);
-    ASSERT_TRUE(hint);
-    EXPECT_NE(hint->find("sorting it first would help (meshstream sort --axis x)"), std::string::npos) << *hint;
-    EXPECT_FALSE(tools::sorting_hint(r, 625000));
-    r.descents = {10, 0, 5};
-    hint = tools::sorting_hint(r, 400000);
-    ASSERT_TRUE(hint);
-    EXPECT_NE(hint->find("already sorted along y"), std::string::npos) << *hint;
-    EXPECT_NE(hint->find("a --buffer of 625000 (a quarter more) would avoid forced writes"), std::string::npos) << *hint;
+    EXPECT_EQ(tools::buffer_verdict(r, 400000, 0.1), tools::BufferVerdict::kTooSmall);
+    EXPECT_EQ(tools::buffer_verdict(r, 500000, 0.1), tools::BufferVerdict::kUncertain);  // no room behind the front
+    // The room behind the front grows with the ratio: 1.5 + 1.5·ratio times the width.
+    EXPECT_EQ(tools::buffer_needed(r, 0.1), 825000u);
+    EXPECT_EQ(tools::buffer_verdict(r, 825000, 0.1), tools::BufferVerdict::kSuffices);
+    EXPECT_EQ(tools::buffer_verdict(r, 825000, 0.5), tools::BufferVerdict::kUncertain);
+    EXPECT_EQ(tools::buffer_verdict(r, 1125000, 0.5), tools::BufferVerdict::kSuffices);
+    EXPECT_NE(tools::format_order_text(r, 825000, 0.1).find("--buffer 825000 suffices at --ratio 0.1 (needs about 825000)"),
+              std::string::npos) << tools::format_order_text(r, 825000, 0.1);
     r.sample_rate = 1.0 / 16;
     r.width_error = 200000;
-    EXPECT_EQ(tools::buffer_verdict(r, 400000), tools::BufferVerdict::kUncertain);
-    EXPECT_NE(tools::format_order_text(r, 400000).find("may be too small"), std::string::npos);
+    EXPECT_EQ(tools::buffer_verdict(r, 400000, 0.1), tools::BufferVerdict::kUncertain);
+    EXPECT_NE(tools::format_order_text(r, 400000, 0.1).find("may be too small at --ratio 0.1 (needs about 1155000)"),
+              std::string::npos) << tools::format_order_text(r, 400000, 0.1);
 }
