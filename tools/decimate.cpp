@@ -172,7 +172,8 @@ void run_decimate(const DecimateOptions& opt) {
                      (s.orphans_evicted > 0
                           ? "; " + std::to_string(s.orphans_evicted) +
                                 " of their vertices were evicted from the weld table to make room, so triangles "
-                                "read later at those positions are not joined to them (the output has cracks there)"
+                                "read later at those positions are not joined to them (the output has cracks, and may have "
+                                "duplicate back-to-back triangles, there)"
                           : std::string()) +
                      (options.sorted_axis && s.sort_violations == 0
                           ? "; the input is sorted, so the buffer is too small for it at this ratio: raise --buffer "
