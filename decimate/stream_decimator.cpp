@@ -161,8 +161,23 @@ void StreamDecimator::write_one(const Emit& out, bool allow_forced) {
         // (or holes pile up). Write one anyway rather than fail.
         assert(allow_forced);
         (void)allow_forced;
+        // Of a few random faces, the one with the most written corners, then the fewest on
+        // P_in: P_out grows as one front instead of scattering, which would leave written
+        // vertices everywhere (they never collapse) and stall the next rounds as well.
         const FaceSet& live = buffer_.live_faces();
-        f = live.at(static_cast<size_t>(((rng_.next() >> 32) * live.size()) >> 32));
+        int best_score = -1;
+        for (int i = 0; i < options_.candidates; ++i) {
+            const uint32_t g = live.at(static_cast<size_t>(((rng_.next() >> 32) * live.size()) >> 32));
+            int score = 0;
+            for (uint32_t k = 0; k < 3; ++k) {
+                const uint8_t flags = buffer_.vertex(buffer_.corner_vertex(half_edge(g, k))).flags;
+                score += (flags & kFrozen) ? 4 : (flags & kInHash) ? 0 : 1;
+            }
+            if (score > best_score) {
+                best_score = score;
+                f = g;
+            }
+        }
         ++stats_.forced_writes;
     }
     stats_.vertices_moved += write_face(buffer_, f, next_id_, output_, out);

@@ -168,12 +168,13 @@ void run_decimate(const DecimateOptions& opt) {
     if (s.forced_writes > 0)
         warnings.note("buffer full of undecimatable triangles: " + std::to_string(s.forced_writes) +
                      " triangles force-written at full resolution (" +
-                     std::to_string(s.premature_writes) + " written before reaching the target resolution)" +
+                     std::to_string(s.premature_writes) +
+                     " written before reaching the target resolution; near them a few triangles may come out twice, "
+                     "back to back)" +
                      (s.orphans_evicted > 0
                           ? "; " + std::to_string(s.orphans_evicted) +
                                 " of their vertices were evicted from the weld table to make room, so triangles "
-                                "read later at those positions are not joined to them (the output has cracks, and may have "
-                                "duplicate back-to-back triangles, there)"
+                                "read later at those positions are not joined to them (the output has cracks there)"
                           : std::string()) +
                      (options.sorted_axis && s.sort_violations == 0
                           ? "; the input is sorted, so the buffer is too small for it at this ratio: raise --buffer "

@@ -42,7 +42,11 @@ TEST(CliDecimate, SmallBuffersAddNoNonManifoldEdges) {
         ASSERT_EQ(r.code, 0) << options << ": " << r.err;
         const tools::EdgeCounts out = edges_of(dir / "out.stl");
         EXPECT_LE(out.non_manifold_edges, in.non_manifold_edges) << options;
-        EXPECT_EQ(out.boundary_edges, 0u) << options;
+        // Closed input stays closed, except for the cracks evictions leave (said in the
+        // warning; the 1 000-triangle buffer is too small for this mesh at 1 %).
+        if (r.err.find("evicted") == std::string::npos) {
+            EXPECT_EQ(out.boundary_edges, 0u) << options;
+        }
     }
 }
 
@@ -84,4 +88,22 @@ TEST(CliDecimate, AnOddTargetMissedByOneSaysWhy) {
                          "boundary edge could be collapsed to remove the odd one)"),
               std::string::npos) << r.err;
     EXPECT_GT(edges_of(dir / "out.stl").boundary_edges, 0u);
+}
+
+TEST(CliDecimate, ForcedWritesDegradeGracefully) {
+    // The bunny sorted along y has width 933 and needs a buffer of about 1 370 at 1 %. Through
+    // 1 174, forced writes used to pick random faces: written vertices (which never collapse)
+    // scattered over the buffer, every later round stalled too, and 44 118 triangles were
+    // force-written, leaving 46 499 of a target of 695. Forced writes now extend P_out.
+    TempDir dir;
+    const std::string in = std::string(MESHSTREAM_FIXTURES_DIR) + "/bunny_from_draco.bin.stl";
+    ASSERT_EQ(run("sort --axis y " + in + " " + dir / "y.stl").code, 0);
+    CliRun r = run("decimate -r 0.01 --buffer 1174 " + dir / "y.stl" + " " + dir / "out.stl");
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.err.find("force-written"), std::string::npos) << r.err;  // still short of room
+    const uint64_t out = *io::open_input(dir / "out.stl").reader->triangle_count();
+    EXPECT_LT(out, 2 * 695u) << r.err;
+    const tools::EdgeCounts e = edges_of(dir / "out.stl");
+    EXPECT_EQ(e.non_manifold_edges, 0u);
+    EXPECT_LE(e.boundary_edges, 223u);  // the input's own holes, no cracks
 }
