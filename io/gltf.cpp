@@ -697,7 +697,10 @@ void GltfReader::visit(int node, const double* parent, int depth) {
         if (n.mesh >= static_cast<int>(model_.meshes.size()))
             throw Error(name_, "node " + std::to_string(node) + " refers to mesh " + std::to_string(n.mesh) + ", which does not exist");
         Instance inst;
-        std::memcpy(inst.matrix, world, sizeof world);
+        // glTF 2.0 §3.7.3.3: a skinned mesh ignores its node's transform (only joints move it).
+        // Joint transforms are not applied: the mesh is read in its bind pose, as stored.
+        static constexpr double kIdentity[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+        std::memcpy(inst.matrix, n.skin >= 0 ? kIdentity : world, sizeof world);
         inst.mesh = n.mesh;
         instances_.push_back(inst);
     }

@@ -187,6 +187,14 @@ TEST(GltfReader, AppliesNodeTransformsAndFlipsMirroredWinding) {
     EXPECT_EQ(std::vector<float>(s.xyz.begin() + 9, s.xyz.end()), plain);
 }
 
+TEST(GltfReader, SkinnedMeshIgnoresItsNodeTransform) {
+    // glTF 2.0: "only the joint transforms are applied to the skinned mesh; the transform of
+    // the skinned mesh node MUST be ignored". Node 1 is the (untransformed) joint.
+    HandMade doc(R"("skins":[{"joints":[1]}],)", "4", R"([{"mesh":0,"skin":0,"translation":[100,0,0]},{}])", "[0,1]");
+    Soup s = read_soup(doc.path);
+    EXPECT_EQ(s.xyz, (std::vector<float>{0, 0, 0, 1, 0, 0, 0, 1, 0}));
+}
+
 TEST(GltfReader, RefusesPointsAndLinesNamingMeshAndPrimitive) {
     HandMade points("", "0");
     std::string what = error_of(points.path);
