@@ -541,7 +541,7 @@ public:
             while (!err.empty() && (err.back() == '\n' || err.back() == ' ')) err.pop_back();
             throw Error(name_, "invalid glTF: " + (err.empty() ? std::string("tinygltf failed to parse it") : err));
         }
-        bytes = {};
+        bytes = std::vector<unsigned char>();  // the file is parsed: free it (`= {}` keeps the capacity)
         for (const std::string& ext : model_.extensionsRequired)
             if (!extension_supported(ext)) throw_unsupported_extension(ext);
 

@@ -238,6 +238,9 @@ void ExternalSorter::sort_run() {
 void ExternalSorter::write_temp(io::TempFile& file, const void* data, size_t n) {
     try {
         file.write(data, n);
+        // A partial block would wait in the file's buffer until the merge reads, and a full
+        // disk would then be reported without the advice below.
+        file.flush();
     } catch (const io::Error& e) {
         throw io::Error(e.file(), e.byte_offset(), 0,
                         e.message() + " (temporary file of meshstream sort; --tmpdir picks another directory)");

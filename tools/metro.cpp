@@ -507,15 +507,19 @@ EdgeCounts EdgeCounter::finish() {
     EdgeCounts counts;
     if (m.parts.empty()) {
         Impl::count_sorted(m.buffer, counts);
-        m.buffer = {};
+        m.buffer = std::vector<Impl::Key>();  // frees it (`= {}` would keep the capacity)
         return counts;
     }
     m.spill();
-    m.buffer = {};
+    m.buffer = std::vector<Impl::Key>();  // the partitions below reuse this memory
+    // Equal keys share a partition, so each partition is counted on its own. A partition is
+    // about 1/32 of the edges: past 32 × budget it exceeds the budget (stated in docs). One
+    // allocation of the largest, so that growing never holds two copies.
+    uint64_t largest = 0;
+    for (const auto& part : m.parts) largest = std::max<uint64_t>(largest, part->size());
     std::vector<Impl::Key> keys;
+    keys.reserve(static_cast<size_t>(largest / sizeof(Impl::Key)));
     for (auto& part : m.parts) {
-        // Equal keys share a partition, so each partition is counted on its own. A partition
-        // is about 1/32 of the edges: past 32 × budget it exceeds the budget (stated in docs).
         keys.resize(part->size() / sizeof(Impl::Key));
         if (!keys.empty()) part->read_at(0, keys.data(), keys.size() * sizeof(Impl::Key));
         Impl::count_sorted(keys, counts);
@@ -652,7 +656,7 @@ CompareResult compare_meshes(const MeshSource& a, const MeshSource& b, const Com
             });
             if (options.progress && i % 65536 == 0) options.progress("bounding samples", i, n);
         }
-        reservoir = {};
+        reservoir = std::vector<float>();  // freed before pass 2 (`= {}` would keep it)
         samples.build(std::move(bound2));
     }
     triangles.build();

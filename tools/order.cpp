@@ -123,8 +123,9 @@ int OrderReport::best_axis() const {
 OrderMeter::OrderMeter(uint64_t memory_budget_bytes) : budget_bytes_(std::max(memory_budget_bytes, kMinBudgetBytes)) {
     // Half the budget for the table (while it grows it briefly holds its old copy too, at most
     // another quarter) and a fifth for the samples, reserved up front so they never
-    // reallocate; finish() needs 16 bytes per sample more. A sample brings up to three
-    // vertices (48 bytes each at load 1/2), so the table is the scarcer of the two.
+    // reallocate; finish() needs 16 bytes per sample more. A sample brings up to three new
+    // vertices (48 bytes each at load 1/2), but on a closed mesh about half a vertex, so there
+    // the samples run out first: exact up to about budget / 240 triangles (docs/cli.md).
     table_ = std::make_unique<Table>(budget_bytes_ / 2 / sizeof(Table::Slot));
     max_samples_ = budget_bytes_ / 5 / sizeof(Sample);
     samples_.reserve(max_samples_);
@@ -215,7 +216,7 @@ OrderReport OrderMeter::finish() {
     r.width = static_cast<uint64_t>(std::llround(static_cast<double>(best) / r.sample_rate));
     r.width_at = best_at;
     if (!r.exact()) r.width_error = 3 * std::sqrt(static_cast<double>(r.width) * (1 - r.sample_rate) / r.sample_rate);
-    samples_ = {};
+    samples_ = std::vector<Sample>();  // frees it (`= {}` would keep the capacity)
     table_ = std::make_unique<Table>(1024);
     return r;
 }
