@@ -6,8 +6,11 @@
 // replacement selection): one write and one read of the data when it spills.
 //
 // Memory: the buffer (<= budget_bytes) while pushing; while merging, one block per run
-// (merge_budget_bytes / runs, at least 16 KiB). A single merge level covers
-// budget × merge_budget / 16 KiB bytes of records (64 MiB each: 256 GiB).
+// (merge_budget_bytes / runs, at least 16 KiB). When more runs than merge_budget / 16 KiB
+// remain, groups of that many are first merged into longer runs in a new temporary file
+// (one more write and read of the data per level), so the blocks stay within the merge
+// budget: a single level covers budget × merge_budget / 16 KiB bytes of records (64 MiB
+// each: 256 GiB).
 #pragma once
 
 #include "io/byte_stream.hpp"
@@ -56,13 +59,9 @@ public:
         }
         if (!buffer_.empty()) spill();
         std::vector<T>().swap(buffer_);
-        size_t block = static_cast<size_t>(
-            std::max<uint64_t>(merge_budget_bytes / runs_.size() / sizeof(T), (16 * 1024) / sizeof(T) + 1));
-        for (size_t r = 0; r < runs_.size(); ++r) {
-            runs_[r].block.resize(block);
-            refill(r);
-            heap_.push(r);
-        }
+        const size_t fan_in = static_cast<size_t>(std::max<uint64_t>(merge_budget_bytes / min_block_bytes(), 2));
+        while (runs_.size() > fan_in) merge_level(fan_in, merge_budget_bytes);
+        start_merge(0, runs_.size(), merge_budget_bytes);
     }
 
     // Pulls the next record in order; false when all have been read.
@@ -84,6 +83,13 @@ public:
     }
 
     uint64_t size() const { return count_; }
+    // Bytes of the merge's read blocks: within finish_input's merge budget unless that holds
+    // fewer than two blocks of 16 KiB.
+    uint64_t merge_block_bytes() const {
+        uint64_t bytes = 0;
+        for (const Run& run : runs_) bytes += run.block.capacity() * sizeof(T);
+        return bytes;
+    }
     // True when records went to disk.
     bool spilled() const { return !runs_.empty(); }
 
@@ -112,6 +118,58 @@ private:
         run.end_record = written_;
         runs_.push_back(std::move(run));
         buffer_.clear();
+    }
+
+    static constexpr uint64_t kMinBlockBytes = 16 * 1024;
+    static constexpr uint64_t min_block_bytes() { return (kMinBlockBytes / sizeof(T) + 1) * sizeof(T); }
+
+    // Gives runs [first, last) a block each from the merge budget and puts them on the heap.
+    void start_merge(size_t first, size_t last, uint64_t merge_budget_bytes) {
+        const size_t block = static_cast<size_t>(std::max<uint64_t>(
+            merge_budget_bytes / (last - first) / sizeof(T), kMinBlockBytes / sizeof(T) + 1));
+        for (size_t r = first; r < last; ++r) {
+            runs_[r].block.resize(block);
+            refill(r);
+            if (runs_[r].at < runs_[r].filled) heap_.push(r);
+        }
+    }
+
+    // One intermediate merge level: every `fan_in` consecutive runs become one run of a new
+    // temporary file, which then replaces the old one.
+    void merge_level(size_t fan_in, uint64_t merge_budget_bytes) {
+        auto out = std::make_unique<TempFile>(tmpdir_, "meshstream-sort");
+        std::vector<Run> merged;
+        std::vector<T> staging;
+        staging.reserve(static_cast<size_t>(kMinBlockBytes / sizeof(T) + 1));
+        uint64_t written = 0;
+        for (size_t first = 0; first < runs_.size(); first += fan_in) {
+            const size_t last = std::min(runs_.size(), first + fan_in);
+            Run run;
+            run.next_record = written;
+            start_merge(first, last, merge_budget_bytes);
+            while (!heap_.empty()) {
+                const size_t r = heap_.top();
+                heap_.pop();
+                Run& from = runs_[r];
+                staging.push_back(from.block[from.at++]);
+                if (from.at == from.filled) refill(r);
+                if (from.at < from.filled) heap_.push(r);
+                if (staging.size() == staging.capacity()) {
+                    out->write(staging.data(), staging.size() * sizeof(T));
+                    written += staging.size();
+                    staging.clear();
+                }
+            }
+            out->write(staging.data(), staging.size() * sizeof(T));
+            written += staging.size();
+            staging.clear();
+            for (size_t r = first; r < last; ++r) std::vector<T>().swap(runs_[r].block);
+            run.end_record = written;
+            merged.push_back(std::move(run));
+        }
+        file_ = std::move(out);
+        runs_ = std::move(merged);
+        written_ = written;
     }
 
     void refill(size_t r) {

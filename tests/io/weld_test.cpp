@@ -119,3 +119,27 @@ TEST(RecordSorter, SortsAcrossSpilledRuns) {
         EXPECT_EQ(out, expect);
     }
 }
+
+TEST(RecordSorter, MergesInLevelsWhenRunsOutnumberTheMergeBudget) {
+    // 15 runs of 2 048 records, and a merge budget of 64 KiB, three blocks of the least size
+    // (16 KiB): merged three at a time (15 → 5 → 2) before the last merge, instead of giving
+    // all 15 runs a block of at least 16 KiB each (240 KiB).
+    struct Less {
+        bool operator()(uint64_t a, uint64_t b) const { return a < b; }
+    };
+    std::mt19937_64 rng(7);
+    std::vector<uint64_t> values(30000);
+    for (auto& v : values) v = rng() % 100000;
+    test::TempDir dir;
+    io::RecordSorter<uint64_t, Less> sorter(16 << 10, dir.path());
+    for (uint64_t v : values) sorter.push(v);
+    sorter.finish_input(64 << 10);
+    EXPECT_TRUE(sorter.spilled());
+    EXPECT_LE(sorter.merge_block_bytes(), uint64_t{64} << 10);
+    EXPECT_EQ(dir.entries().size(), 1u);  // the earlier levels' files are gone
+    std::vector<uint64_t> out;
+    uint64_t v;
+    while (sorter.next(v)) out.push_back(v);
+    std::sort(values.begin(), values.end());
+    EXPECT_EQ(out, values);
+}
