@@ -204,6 +204,9 @@ bool collapse_valid(HalfEdgeBuffer& buffer, uint32_t h, const double target[3]) 
         }
     }
     if (count != vp.face_count) return false;
+    // A tetrahedron attached to the rest only at q (q joins a second fan, so the check above,
+    // which counts all of q's faces, missed it) would collapse to two faces back to back.
+    if (!boundary && vp.face_count == 3 && use_ring && q_count == 3) return false;
     if (use_ring && q_count != vq.face_count) {
         // q's faces are not all in the fan around h's face (q joins two fans, which is rare):
         // gather its neighbours from its corner list instead.
