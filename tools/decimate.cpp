@@ -232,7 +232,8 @@ void add_decimate(CLI::App& app) {
     CLI::App* cmd = app.add_subcommand(
         "decimate", "Decimate a mesh of any size in one streaming pass (Wu & Kobbelt 2003) with a fixed memory buffer.\n"
                     "Output size is round(ratio x input), or --target: exactly, unless the mesh cannot get there\n"
-                    "(one more for an odd target on a closed mesh; a warning says so).");
+                    "(one more for an odd target when no boundary edge is left in the buffer to remove a single\n"
+                    "triangle; a warning says so).");
     cmd->add_option("input", opt->input, "Input mesh ('-' = stdin)")->required();
     cmd->add_option("output", opt->output, "Output mesh ('-' = stdout, needs --to)")->required();
     // CLI::Range would say "Value 0 not in range 0.000000 to 1.000000" for the open end.

@@ -222,7 +222,8 @@ OrderReport OrderMeter::finish() {
 }
 
 uint64_t buffer_needed(const OrderReport& report, double ratio) {
-    return static_cast<uint64_t>(std::ceil(buffer_per_width(ratio) * (static_cast<double>(report.width) + report.width_error)));
+    const double needed = buffer_per_width(ratio) * (static_cast<double>(report.width) + report.width_error);
+    return static_cast<uint64_t>(std::ceil(needed * (1 - 1e-12)));  // 2.4 × 500000 is not 1200001
 }
 
 BufferVerdict buffer_verdict(const OrderReport& report, uint64_t buffer_triangles, double ratio) {
@@ -243,7 +244,7 @@ std::optional<OrderReport> measure_file_order(const std::string& path, std::stri
     return meter.finish();
 }
 
-std::string format_order_text(const OrderReport& r, uint64_t buffer_triangles, double ratio) {
+std::string format_order_text(const OrderReport& r, uint64_t buffer_triangles, double ratio, bool flagged_sorted) {
     std::string out = "width:       " + std::to_string(r.width) + " triangles";
     char buf[160];
     if (r.exact()) {
@@ -262,12 +263,16 @@ std::string format_order_text(const OrderReport& r, uint64_t buffer_triangles, d
         out += "\n";
     }
     const BufferVerdict v = buffer_verdict(r, buffer_triangles, ratio);
-    std::snprintf(buf, sizeof buf, " at --ratio %g (needs about %llu)\n", ratio,
+    std::snprintf(buf, sizeof buf, " at --ratio %g (needs about %llu)", ratio,
                   static_cast<unsigned long long>(buffer_needed(r, ratio)));
     out += "buffer:      --buffer " + std::to_string(buffer_triangles) +
            (v == BufferVerdict::kSuffices  ? " suffices"
             : v == BufferVerdict::kTooSmall ? " is too small (decimate would force-write)"
                                             : " may be too small") + buf;
+    if (v == BufferVerdict::kSuffices && !flagged_sorted)
+        out += ", unless the surface has holes: the file is not flagged as sorted, so their rims stay open to the "
+               "end (`meshstream sort` flags it)";
+    out += "\n";
     std::snprintf(buf, sizeof buf, "key descents: x %llu, y %llu, z %llu",
                   static_cast<unsigned long long>(r.descents[0]), static_cast<unsigned long long>(r.descents[1]),
                   static_cast<unsigned long long>(r.descents[2]));

@@ -58,8 +58,11 @@ enum class BufferVerdict { kSuffices, kTooSmall, kUncertain };
 // It also depends on the mesh and the sort axis, so this is an estimate. Measured (the least
 // buffer without forced writes ÷ width) at ratios 0.01 / 0.1 / 0.5 / 0.9: the bunny sorted
 // along x (width 830) 1.08 / 1.31 / 1.64 / 1.93, along y (933) 1.47 / 1.48 / 2.22 / 2.61, the
-// 1 M generated mesh (5 858) 1.06 / 1.18 / 1.60 / 1.91. 1.5 + 1.5·ratio covers them all.
-inline double buffer_per_width(double ratio) { return 1.5 + 1.5 * ratio; }
+// 1 M generated mesh (5 858) 1.06 / 1.18 / 1.60 / 1.91; open 600 × 600 height-field patches
+// (720 000 triangles), flagged as sorted (1 203) 2.15 / 2.15 / 2.66 / 3.83, sorted by
+// `meshstream sort` after a shuffle (1 791) 1.91 / 1.91 / 1.91 / 2.66. 2.2 + 2·ratio covers
+// them all (generously for closed meshes at small ratios).
+inline double buffer_per_width(double ratio) { return 2.2 + 2 * ratio; }
 // The buffer that suffices for decimating at `ratio`: buffer_per_width × (width + its error).
 uint64_t buffer_needed(const OrderReport& report, double ratio);
 // Whether a decimation buffer of `buffer_triangles` suffices at `ratio`: kSuffices when it
@@ -105,7 +108,9 @@ std::optional<OrderReport> measure_file_order(const std::string& path, std::stri
                                               const io::ReadOptions& options);
 
 // The text lines `info --order` prints ("width:", "buffer:", "key descents:"), judging
-// `buffer_triangles` for decimation at `ratio`.
-std::string format_order_text(const OrderReport& report, uint64_t buffer_triangles, double ratio);
+// `buffer_triangles` for decimation at `ratio`. `flagged_sorted`: the file says it is sorted
+// (else a "suffices" warns that hole rims stay open to the end, which the width cannot tell).
+std::string format_order_text(const OrderReport& report, uint64_t buffer_triangles, double ratio,
+                              bool flagged_sorted = true);
 
 }  // namespace meshstream::tools

@@ -123,16 +123,16 @@ TEST(OrderMeter, BufferVerdictAndHint) {
     r.descents = {10, 20, 30000};
     EXPECT_EQ(tools::buffer_verdict(r, 400000, 0.1), tools::BufferVerdict::kTooSmall);
     EXPECT_EQ(tools::buffer_verdict(r, 500000, 0.1), tools::BufferVerdict::kUncertain);  // no room behind the front
-    // The room behind the front grows with the ratio: 1.5 + 1.5·ratio times the width.
-    EXPECT_EQ(tools::buffer_needed(r, 0.1), 825000u);
-    EXPECT_EQ(tools::buffer_verdict(r, 825000, 0.1), tools::BufferVerdict::kSuffices);
-    EXPECT_EQ(tools::buffer_verdict(r, 825000, 0.5), tools::BufferVerdict::kUncertain);
-    EXPECT_EQ(tools::buffer_verdict(r, 1125000, 0.5), tools::BufferVerdict::kSuffices);
-    EXPECT_NE(tools::format_order_text(r, 825000, 0.1).find("--buffer 825000 suffices at --ratio 0.1 (needs about 825000)"),
-              std::string::npos) << tools::format_order_text(r, 825000, 0.1);
+    // The room behind the front grows with the ratio: 2.2 + 2·ratio times the width.
+    EXPECT_EQ(tools::buffer_needed(r, 0.1), 1200000u);
+    EXPECT_EQ(tools::buffer_verdict(r, 1200000, 0.1), tools::BufferVerdict::kSuffices);
+    EXPECT_EQ(tools::buffer_verdict(r, 1200000, 0.5), tools::BufferVerdict::kUncertain);
+    EXPECT_EQ(tools::buffer_verdict(r, 1600000, 0.5), tools::BufferVerdict::kSuffices);
+    EXPECT_NE(tools::format_order_text(r, 1200000, 0.1).find("--buffer 1200000 suffices at --ratio 0.1 (needs about 1200000)"),
+              std::string::npos) << tools::format_order_text(r, 1200000, 0.1);
     r.sample_rate = 1.0 / 16;
     r.width_error = 200000;
     EXPECT_EQ(tools::buffer_verdict(r, 400000, 0.1), tools::BufferVerdict::kUncertain);
-    EXPECT_NE(tools::format_order_text(r, 400000, 0.1).find("may be too small at --ratio 0.1 (needs about 1155000)"),
+    EXPECT_NE(tools::format_order_text(r, 400000, 0.1).find("may be too small at --ratio 0.1 (needs about 1680000)"),
               std::string::npos) << tools::format_order_text(r, 400000, 0.1);
 }

@@ -260,7 +260,12 @@ TEST(InfoOrder, DistinguishesShuffledFromSorted) {
     EXPECT_GT(w_shuffled, 69451u / 2) << shuffled.out;
     EXPECT_LT(w_sorted, 69451u / 10) << sorted.out;
     EXPECT_NE(shuffled.out.find("--buffer 20000 is too small"), std::string::npos) << shuffled.out;
-    EXPECT_NE(sorted.out.find("--buffer 20000 suffices"), std::string::npos) << sorted.out;
+    EXPECT_NE(sorted.out.find("--buffer 20000 suffices at --ratio 0.1 (needs about "), std::string::npos) << sorted.out;
+    EXPECT_EQ(sorted.out.find("unless the surface has holes"), std::string::npos) << sorted.out;  // flagged sorted
+    // Not flagged as sorted: holes would stay open to the end, which the width cannot tell.
+    CliRun big = run("info --order --buffer 200000 " + dir / "shuffled.stl", dir);
+    EXPECT_NE(big.out.find("--buffer 200000 suffices at --ratio 0.1 (needs about "), std::string::npos) << big.out;
+    EXPECT_NE(big.out.find(", unless the surface has holes: the file is not flagged as sorted"), std::string::npos) << big.out;
     EXPECT_NE(sorted.out.find("(sorted along y by minimum coordinate)"), std::string::npos) << sorted.out;
     EXPECT_NE(sorted.out.find("(exact)"), std::string::npos) << sorted.out;
     // --json carries the same numbers.
