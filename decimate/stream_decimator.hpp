@@ -32,7 +32,7 @@ struct Options {
     uint64_t seed = 1;
     double weld_eps = 0;                // 0: exact welding; > 0: grid cell size (absolute)
     std::optional<int> sorted_axis;     // 0,1,2 when the input is sorted on it (either direction)
-    size_t output_chunk_triangles = io::TriangleChunk::kDefaultCapacity;
+    size_t output_chunk_triangles = io::TriangleChunk::kDefaultCapacity;  // ≥ 1
 };
 
 struct Stats {

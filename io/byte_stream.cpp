@@ -390,7 +390,8 @@ void ByteSink::write_raw(const void* data, size_t n) {
     while (zs.avail_in > 0) {
         zs.next_out = reinterpret_cast<Bytef*>(gz_->out.data());
         zs.avail_out = static_cast<uInt>(gz_->out.size());
-        deflate(&zs, Z_NO_FLUSH);
+        // Z_STREAM_ERROR (a finished stream) consumes nothing: looping on would never end.
+        if (deflate(&zs, Z_NO_FLUSH) == Z_STREAM_ERROR) throw Error(name_, offset_, 0, "gzip stream error");
         write_all(fd_, gz_->out.data(), gz_->out.size() - zs.avail_out, name_, offset_);
     }
 }
@@ -402,6 +403,7 @@ void ByteSink::flush_buffer() {
 }
 
 void ByteSink::write(const void* data, size_t n) {
+    if (committed_) throw Error(name_, offset_, 0, "write after the output was finished");
     if (buf_.size() + n > kBufferBytes) {
         flush_buffer();
         if (n >= kBufferBytes) {
@@ -433,6 +435,7 @@ void ByteSink::patch(uint64_t offset, const void* data, size_t n) {
 }
 
 void ByteSink::commit() {
+    if (committed_) throw Error(name_, offset_, 0, "the output was already finished");
     flush_buffer();
     if (gz_) {
         z_stream& zs = gz_->zs;
@@ -442,6 +445,7 @@ void ByteSink::commit() {
             zs.next_out = reinterpret_cast<Bytef*>(gz_->out.data());
             zs.avail_out = static_cast<uInt>(gz_->out.size());
             rc = deflate(&zs, Z_FINISH);
+            if (rc == Z_STREAM_ERROR) throw Error(name_, offset_, 0, "gzip stream error");
             write_all(fd_, gz_->out.data(), gz_->out.size() - zs.avail_out, name_, offset_);
         } while (rc != Z_STREAM_END);
     }

@@ -109,7 +109,8 @@ public:
     bool patchable() const;
     // Overwrites bytes at `offset` (< offset() - n + 1). Precondition: patchable().
     void patch(uint64_t offset, const void* data, size_t n);
-    // Flushes, closes and renames into place. Throws io::Error (e.g. disk full).
+    // Flushes, closes and renames into place. Throws io::Error (e.g. disk full). Once only:
+    // write() or commit() after it throw io::Error.
     void commit();
     const std::string& name() const { return name_; }
 

@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <cstring>
 #include <span>
+#include <stdexcept>
 #include <vector>
 
 namespace meshstream::io {
@@ -29,9 +30,10 @@ class TriangleChunk {
 public:
     static constexpr size_t kDefaultCapacity = 16384;  // 576 KiB of positions
 
+    // Throws std::invalid_argument for a capacity of 0 (readers could then never make progress).
     explicit TriangleChunk(size_t capacity = kDefaultCapacity, Channels channels = {})
         : capacity_(capacity), channels_(channels) {
-        assert(capacity > 0);
+        if (capacity == 0) throw std::invalid_argument("TriangleChunk: capacity must be at least 1");
         xyz_.resize(9 * capacity);
         if (channels.color) rgb_.resize(9 * capacity);
         if (channels.normal) normal_.resize(9 * capacity);

@@ -269,3 +269,11 @@ TEST(StreamDecimator, BadTopologyIsFrozenAndPassedThrough) {
     EXPECT_LE(d.triangle_count(), 1368u);
     EXPECT_GE(d.triangle_count(), 684u);
 }
+
+// A chunk that holds nothing would make every reader and writer spin or crash: refused.
+TEST(StreamDecimator, AnOutputChunkOfNoTrianglesIsRefused) {
+    EXPECT_THROW(meshstream::io::TriangleChunk(0), std::invalid_argument);
+    Options options;
+    options.output_chunk_triangles = 0;
+    EXPECT_THROW(StreamDecimator(options, std::nullopt), std::invalid_argument);
+}

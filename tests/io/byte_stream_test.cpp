@@ -212,6 +212,23 @@ TEST_F(ByteStreamTest, SinkWithoutCommitLeavesNoFile) {
     EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()), 1);
 }
 
+// A sink is finished once: more writes or a second commit are errors, not a hang (a finished
+// gzip stream consumes no input, and the compression loop used to wait for it forever).
+TEST_F(ByteStreamTest, SinkUsedAfterCommitThrows) {
+    for (int level : {-1, 6}) {
+        auto sink = io::ByteSink::open(path("done.bin"), {level});
+        sink->write("abc");
+        sink->commit();
+        EXPECT_THROW(sink->write("def"), io::Error) << level;
+        EXPECT_THROW(sink->commit(), io::Error) << level;
+        auto source = io::ByteSource::open(path("done.bin"));
+        EXPECT_EQ(source->gzip(), level >= 0);
+        std::string got(8, '\0');
+        got.resize(source->read(got.data(), got.size()));
+        EXPECT_EQ(got, "abc") << level;
+    }
+}
+
 TEST_F(ByteStreamTest, SinkErrorsNameTheTarget) {
     try {
         io::ByteSink::open(path("no/such/dir/x.stl"));
