@@ -8,6 +8,8 @@
 
 #include <algorithm>
 #include <cassert>
+#include <stdexcept>
+#include <string>
 
 namespace meshstream::decimate {
 namespace {
@@ -18,9 +20,21 @@ namespace {
 // candidate a call tests one collapse, and 16 invalid draws in a row are common when coarse).
 int stall_attempts(int candidates) { return std::max(16, 128 / std::max(candidates, 1)); }
 
+// The options, checked before anything is allocated (std::invalid_argument: the command line
+// checks them itself, with its own messages, so these only reach library callers).
+const Options& checked(const Options& options, std::optional<uint64_t> input_count) {
+    auto refuse = [](const char* what) { throw std::invalid_argument(std::string("decimate::Options: ") + what); };
+    if (options.target ? !input_count.has_value() : !(options.ratio > 0 && options.ratio <= 1))
+        refuse(options.target ? "target needs the input triangle count" : "ratio must be in (0, 1]");
+    if (options.buffer_triangles < 16) refuse("buffer_triangles must be at least 16");
+    if (options.candidates < 1 || options.candidates > 64) refuse("candidates must be 1 to 64");
+    if (options.sorted_axis && (*options.sorted_axis < 0 || *options.sorted_axis > 2)) refuse("sorted_axis must be 0, 1 or 2");
+    if (options.output_chunk_triangles == 0) refuse("output_chunk_triangles must be at least 1");
+    return options;
+}
+
 double choose_ratio(const Options& options, std::optional<uint64_t> input_count) {
     if (!options.target) return options.ratio;
-    assert(input_count.has_value() && "Options::target needs the input triangle count");
     if (*input_count == 0) return 1.0;
     return std::min(1.0, double(*options.target) / double(*input_count));
 }
@@ -28,15 +42,11 @@ double choose_ratio(const Options& options, std::optional<uint64_t> input_count)
 }  // namespace
 
 StreamDecimator::StreamDecimator(const Options& options, std::optional<uint64_t> input_triangle_count)
-    : options_(options),
+    : options_(checked(options, input_triangle_count)),
       ratio_(choose_ratio(options, input_triangle_count)),
       buffer_(options.buffer_triangles, options.weld_eps),
       rng_(options.seed),
       output_(options.output_chunk_triangles) {
-    assert(ratio_ > 0 && ratio_ <= 1);
-    assert(options.buffer_triangles >= 16);
-    assert(options.candidates >= 1 && options.candidates <= 64);
-    assert(!options.sorted_axis || (*options.sorted_axis >= 0 && *options.sorted_axis <= 2));
     stats_.buffer_capacity = options.buffer_triangles;
     if (options.sorted_axis) {
         sweep_capacity_ = 3 * options.buffer_triangles + 3;
@@ -49,7 +59,7 @@ uint64_t StreamDecimator::expected_output(double ratio, uint64_t input_triangle_
 }
 
 void StreamDecimator::push(const io::TriangleChunk& in, const Emit& out) {
-    assert(!finished_);
+    if (finished_) throw std::logic_error("StreamDecimator::push after finish()");
     assert(std::all_of(in.xyz().begin(), in.xyz().end(), [](float v) { return std::isfinite(v); }) &&
            "StreamDecimator::push needs finite coordinates");
     const std::span<const float> xyz = in.xyz();
@@ -207,7 +217,7 @@ void StreamDecimator::make_room(const Emit& out) {
 }
 
 void StreamDecimator::finish(const Emit& out) {
-    assert(!finished_);
+    if (finished_) throw std::logic_error("StreamDecimator::finish called twice");
     finished_ = true;
     // No more input: whatever is still open is true boundary.
     buffer_.finalize_all();

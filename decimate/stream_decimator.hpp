@@ -57,9 +57,9 @@ struct Stats {
 
 class StreamDecimator {
 public:
-    // `input_triangle_count` is the reader's count when known; Options::target needs it
-    // (asserted). Allocates every buffer once; see halfedge_buffer.hpp for the bound
-    // (about 470 bytes reserved per buffer triangle).
+    // `input_triangle_count` is the reader's count when known; Options::target needs it.
+    // Options outside their ranges throw std::invalid_argument. Allocates every buffer once;
+    // see halfedge_buffer.hpp for the bound (about 470 bytes reserved per buffer triangle).
     StreamDecimator(const Options& options, std::optional<uint64_t> input_triangle_count);
 
     // Reads every triangle of `in` (positions only; other channels are ignored), decimating
@@ -68,7 +68,7 @@ public:
     // first with tools::TriangleFilter).
     void push(const io::TriangleChunk& in, const Emit& out);
     // End of input: decimates to the exact target, writes the rest, flushes `out`.
-    // Call once; push() must not follow.
+    // Call once; push() or finish() after it throw std::logic_error.
     void finish(const Emit& out);
 
     const Stats& stats() const { return stats_; }

@@ -270,10 +270,35 @@ TEST(StreamDecimator, BadTopologyIsFrozenAndPassedThrough) {
     EXPECT_GE(d.triangle_count(), 684u);
 }
 
-// A chunk that holds nothing would make every reader and writer spin or crash: refused.
-TEST(StreamDecimator, AnOutputChunkOfNoTrianglesIsRefused) {
+// Options out of range and calls out of order are errors for library callers, not crashes
+// (candidates 0 crashed, output chunks of 0 triangles crashed, pushing after finish() wrote
+// more output).
+TEST(StreamDecimator, BadOptionsAndCallOrderThrow) {
     EXPECT_THROW(meshstream::io::TriangleChunk(0), std::invalid_argument);
+    auto refused = [](auto change, std::optional<uint64_t> count = std::nullopt) {
+        Options options;
+        change(options);
+        EXPECT_THROW(StreamDecimator(options, count), std::invalid_argument);
+    };
+    refused([](Options& o) { o.output_chunk_triangles = 0; });
+    refused([](Options& o) { o.candidates = 0; });
+    refused([](Options& o) { o.candidates = 65; });
+    refused([](Options& o) { o.buffer_triangles = 15; });
+    refused([](Options& o) { o.ratio = 0; });
+    refused([](Options& o) { o.sorted_axis = 3; });
+    refused([](Options& o) { o.target = 10; });  // without the input count
     Options options;
-    options.output_chunk_triangles = 0;
-    EXPECT_THROW(StreamDecimator(options, std::nullopt), std::invalid_argument);
+    options.ratio = 1;
+    StreamDecimator decimator(options, std::nullopt);
+    meshstream::io::TriangleChunk chunk(4);
+    const float tri[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    std::copy(tri, tri + 9, chunk.push_slot());
+    size_t written = 0;
+    auto out = [&](const meshstream::io::TriangleChunk& c) { written += c.size(); };
+    decimator.push(chunk, out);
+    decimator.finish(out);
+    EXPECT_EQ(written, 1u);
+    EXPECT_THROW(decimator.push(chunk, out), std::logic_error);
+    EXPECT_THROW(decimator.finish(out), std::logic_error);
+    EXPECT_EQ(written, 1u);
 }
