@@ -8,8 +8,9 @@
 // Memory: the buffer (<= budget_bytes) while pushing; while merging, one block per run
 // (merge_budget_bytes / runs, at least 16 KiB). When more runs than merge_budget / 16 KiB
 // remain, groups of that many are first merged into longer runs in a new temporary file
-// (one more write and read of the data per level), so the blocks stay within the merge
-// budget: a single level covers budget × merge_budget / 16 KiB bytes of records (64 MiB
+// (one more write and read of the data per level, and twice the data on disk until the level
+// ends and the old file goes), so the blocks stay within the merge budget: a single level
+// covers budget × merge_budget / 16 KiB bytes of records (64 MiB
 // each: 256 GiB).
 #pragma once
 
