@@ -60,9 +60,10 @@ uint64_t StreamDecimator::expected_output(double ratio, uint64_t input_triangle_
 
 void StreamDecimator::push(const io::TriangleChunk& in, const Emit& out) {
     if (finished_) throw std::logic_error("StreamDecimator::push after finish()");
-    assert(std::all_of(in.xyz().begin(), in.xyz().end(), [](float v) { return std::isfinite(v); }) &&
-           "StreamDecimator::push needs finite coordinates");
     const std::span<const float> xyz = in.xyz();
+    // NaN/inf corners can be neither welded nor finalized (the commands drop them first).
+    if (!std::all_of(xyz.begin(), xyz.end(), [](float v) { return std::isfinite(v); }))
+        throw std::invalid_argument("StreamDecimator::push needs finite coordinates");
     // Welding reads a random hash slot and then a random vertex per corner; prefetching them
     // a few triangles ahead overlaps those misses (hints only: results do not change). Each
     // corner's slot is hashed once, kept in a small ring until the triangle is read.

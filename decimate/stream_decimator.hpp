@@ -63,9 +63,9 @@ public:
     StreamDecimator(const Options& options, std::optional<uint64_t> input_triangle_count);
 
     // Reads every triangle of `in` (positions only; other channels are ignored), decimating
-    // and writing to `out` as the schedule demands. Precondition (asserted): every coordinate
-    // is finite; NaN/inf corners can be neither welded nor finalized (the commands drop them
-    // first with tools::TriangleFilter).
+    // and writing to `out` as the schedule demands. Every coordinate must be finite, else it
+    // throws std::invalid_argument before reading any: NaN/inf corners can be neither welded
+    // nor finalized (the commands drop them first with tools::TriangleFilter).
     void push(const io::TriangleChunk& in, const Emit& out);
     // End of input: decimates to the exact target, writes the rest, flushes `out`.
     // Call once; push() or finish() after it throw std::logic_error.

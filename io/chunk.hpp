@@ -65,13 +65,13 @@ public:
     std::span<uint64_t> vertex_ids() { return {id_.data(), channels_.vertex_id ? 3 * size_ : 0}; }
 
     // Appends one triangle (positions only; channel slots of the new triangle are zeroed).
-    // Precondition: !full().
+    // Throws std::length_error when full().
     void push(const float (&tri)[9]) { std::memcpy(push_slot(), tri, sizeof tri); }
 
     // Appends one triangle and returns its 9 position floats to fill in place. Channel slots
-    // of the new triangle are zeroed. Precondition: !full().
+    // of the new triangle are zeroed. Throws std::length_error when full().
     float* push_slot() {
-        assert(!full());
+        if (full()) throw std::length_error("TriangleChunk: push into a full chunk");
         size_t i = size_++;
         if (channels_.color) std::memset(&rgb_[9 * i], 0, 9);
         if (channels_.normal) std::memset(&normal_[9 * i], 0, 9 * sizeof(float));
