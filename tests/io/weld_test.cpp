@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include <functional>
 #include <random>
 
 using namespace meshstream;
@@ -100,14 +101,11 @@ TEST(Welder, EmptyInput) {
 }
 
 TEST(RecordSorter, SortsAcrossSpilledRuns) {
-    struct Less {
-        bool operator()(uint64_t a, uint64_t b) const { return a < b; }
-    };
     std::mt19937_64 rng(42);
     std::vector<uint64_t> values(30000);
     for (auto& v : values) v = rng() % 5000;
     for (uint64_t budget : {uint64_t{1} << 30, uint64_t{16} << 10}) {
-        io::RecordSorter<uint64_t, Less> sorter(budget, {});
+        io::RecordSorter<uint64_t, std::less<uint64_t>> sorter(budget, {});
         for (uint64_t v : values) sorter.push(v);
         sorter.finish_input(budget);
         EXPECT_EQ(sorter.spilled(), budget < (1u << 20));
@@ -124,14 +122,11 @@ TEST(RecordSorter, MergesInLevelsWhenRunsOutnumberTheMergeBudget) {
     // 15 runs of 2 048 records, and a merge budget of 64 KiB, three blocks of the least size
     // (16 KiB): merged three at a time (15 → 5 → 2) before the last merge, instead of giving
     // all 15 runs a block of at least 16 KiB each (240 KiB).
-    struct Less {
-        bool operator()(uint64_t a, uint64_t b) const { return a < b; }
-    };
     std::mt19937_64 rng(7);
     std::vector<uint64_t> values(30000);
     for (auto& v : values) v = rng() % 100000;
     test::TempDir dir;
-    io::RecordSorter<uint64_t, Less> sorter(16 << 10, dir.path());
+    io::RecordSorter<uint64_t, std::less<uint64_t>> sorter(16 << 10, dir.path());
     for (uint64_t v : values) sorter.push(v);
     sorter.finish_input(64 << 10);
     EXPECT_TRUE(sorter.spilled());
