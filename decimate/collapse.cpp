@@ -42,26 +42,49 @@ bool boundary_eligible(const HalfEdgeBuffer& buffer, uint32_t h) {
 // any of its faces other than `skip0`/`skip1`?
 bool moves_keep_faces_valid(const HalfEdgeBuffer& buffer, uint32_t v, const double from[3],
                             const double to[3], uint32_t skip0, uint32_t skip1) {
+    // The area-weighted normal of the sound faces before the move, and the new normals of the
+    // faces that were degenerate before it (they have no normal of their own to keep).
+    double fan[3] = {0, 0, 0};
+    constexpr int kMaxRevived = 8;
+    double revived[kMaxRevived][3];
+    int revived_count = 0;
     for (uint32_t c = buffer.vertex(v).first_corner; c != kNoIndex; c = buffer.next_corner(c)) {
         const uint32_t f = face_of(c);
         if (f == skip0 || f == skip1) continue;
         double a[3], b[3];
         buffer.position(buffer.corner_vertex(next_in_face(c)), a);
         buffer.position(buffer.corner_vertex(prev_in_face(c)), b);
-        double ea[3], eb[3], n_old[3], n_new[3];
-        sub(a, from, ea); sub(b, from, eb); cross(ea, eb, n_old);
-        sub(a, to, ea); sub(b, to, eb); cross(ea, eb, n_new);
-        const double old_len2 = dot(n_old, n_old), new_len2 = dot(n_new, n_new);
-        double ab[3];
+        double ea[3], eb[3], n_old[3], n_new[3], ab[3];
         sub(a, b, ab);
-        const double edges2 = dot(ea, ea) + dot(eb, eb) + dot(ab, ab);
-        const bool was_degenerate = old_len2 <= kMinShapeQuality * edges2 * edges2 || old_len2 == 0;
-        if (was_degenerate) continue;  // nothing to preserve; do not let it block the mesh
-        if (new_len2 <= kMinShapeQuality * edges2 * edges2) return false;
+        const double ab2 = dot(ab, ab);
+        // Each shape is judged by its own edges, the old one by the old edges: judged by the
+        // new, longer ones, a small sound face looked degenerate, was let through and flipped
+        // (a flat disc decimated to 10 % had 26 faces upside down).
+        sub(a, from, ea); sub(b, from, eb); cross(ea, eb, n_old);
+        const double old_edges2 = dot(ea, ea) + dot(eb, eb) + ab2;
+        sub(a, to, ea); sub(b, to, eb); cross(ea, eb, n_new);
+        const double new_edges2 = dot(ea, ea) + dot(eb, eb) + ab2;
+        const double old_len2 = dot(n_old, n_old), new_len2 = dot(n_new, n_new);
+        const bool was_degenerate = old_len2 <= kMinShapeQuality * old_edges2 * old_edges2 || old_len2 == 0;
+        const bool degenerate = new_len2 <= kMinShapeQuality * new_edges2 * new_edges2;
+        if (was_degenerate) {
+            // Nothing to preserve, and it must not block the mesh; but if it comes out sound, it
+            // must face the way its neighbours did (checked below), or a sliver turned over
+            // becomes a real face upside down.
+            if (!degenerate) {
+                if (revived_count == kMaxRevived) return false;
+                std::copy(n_new, n_new + 3, revived[revived_count++]);
+            }
+            continue;
+        }
+        if (degenerate) return false;
         // cos(turn) ≤ kMinNormalCos, without a square root.
         const double d = dot(n_old, n_new);
         if (d <= 0 || d * d <= kMinNormalCos * kMinNormalCos * old_len2 * new_len2) return false;
+        for (int i = 0; i < 3; ++i) fan[i] += n_old[i];
     }
+    for (int i = 0; i < revived_count; ++i)
+        if (!(dot(fan, revived[i]) > 0)) return false;
     return true;
 }
 

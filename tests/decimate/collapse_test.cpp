@@ -224,6 +224,29 @@ TEST(Collapse, FlipIsRefused) {
     EXPECT_FALSE(collapse_valid(buffer, half_edge(buffer, centre, east)));
 }
 
+TEST(Collapse, SmallFaceMovedFarIsJudgedByItsOwnShape) {
+    // A small sound face (v, a, b) on z = 0; moving v far out across the edge ab turns it over.
+    // Judged by the new, long edges the old face looked degenerate and the move was allowed.
+    HalfEdgeBuffer buffer(64, 0);
+    add_indexed(buffer, {{0, 0, 0}, {1e-3f, 0, 0}, {0, 1e-3f, 0}}, {{0, 1, 2}});
+    const uint32_t v = vertex_at(buffer, {0, 0, 0});
+    const double from[3] = {0, 0, 0}, across[3] = {10, 10, 0}, near[3] = {-1e-3, -1e-3, 0};
+    EXPECT_FALSE(moves_keep_faces_valid(buffer, v, from, across, kNoIndex, kNoIndex));
+    EXPECT_TRUE(moves_keep_faces_valid(buffer, v, from, near, kNoIndex, kNoIndex));
+}
+
+TEST(Collapse, DegenerateFaceMayNotComeOutUpsideDown) {
+    // v lies on the segment ab, so (v, a, b) has no area; its neighbours (v, b, c) and (v, c, a)
+    // face +z. Moving v towards c makes (v, a, b) a sound face facing +z, as its neighbours;
+    // moving it away from c makes it a sound face facing −z while the neighbours stay sound.
+    HalfEdgeBuffer buffer(64, 0);
+    add_indexed(buffer, {{0, 0, 0}, {1, 0, 0}, {-1, 0, 0}, {0, -1, 0}}, {{0, 1, 2}, {0, 2, 3}, {0, 3, 1}});
+    const uint32_t v = vertex_at(buffer, {0, 0, 0});
+    const double from[3] = {0, 0, 0}, towards_c[3] = {0, -0.2, 0}, away[3] = {0, 0.2, 0};
+    EXPECT_TRUE(moves_keep_faces_valid(buffer, v, from, towards_c, kNoIndex, kNoIndex));
+    EXPECT_FALSE(moves_keep_faces_valid(buffer, v, from, away, kNoIndex, kNoIndex));
+}
+
 TEST(Collapse, DecimateOnceReducesAClosedMesh) {
     HalfEdgeBuffer buffer(256, 0);
     add_indexed(buffer, octahedron_points(), octahedron_faces());

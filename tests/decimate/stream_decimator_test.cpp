@@ -107,6 +107,42 @@ TEST(StreamDecimator, BunnyAtTenPercentIsWithinAQuarterOfGarlandHeckbert) {
     EXPECT_LE(rms_percent, 1.25 * kCgalRmsPercent);
 }
 
+TEST(StreamDecimator, FlatDiscWithAHighValenceCentreKeepsEveryFaceUp) {
+    // A flat polar disc: a centre fan of 500 thin triangles and 95 rings, all facing +z. Before
+    // the fold check judged each face by its own edges, 26 faces came out upside down at 10 %.
+    constexpr int kSegments = 500, kRings = 95;
+    auto point = [&](int ring, int s) {
+        const double r = double(ring) / kRings, a = 2 * M_PI * s / kSegments;
+        return std::array<float, 3>{float(r * std::cos(a)), float(r * std::sin(a)), 0.0f};
+    };
+    std::vector<float> soup;
+    auto add = [&](std::array<float, 3> a, std::array<float, 3> b, std::array<float, 3> c) {
+        for (const auto& p : {a, b, c}) soup.insert(soup.end(), p.begin(), p.end());
+    };
+    for (int s = 0; s < kSegments; ++s) add(point(0, 0), point(1, s), point(1, s + 1));
+    for (int ring = 1; ring < kRings; ++ring)
+        for (int s = 0; s < kSegments; ++s) {
+            add(point(ring, s), point(ring + 1, s), point(ring + 1, s + 1));
+            add(point(ring, s), point(ring + 1, s + 1), point(ring, s + 1));
+        }
+    for (double ratio : {0.1, 0.01}) {
+        Options options;
+        options.ratio = ratio;
+        const Decimated out = run_decimator(soup, options);
+        EXPECT_EQ(out.triangle_count(), StreamDecimator::expected_output(ratio, soup.size() / 9));
+        size_t down = 0;
+        double area = 0;
+        for (size_t f = 0; f < out.triangle_count(); ++f) {
+            double n[3];
+            triangle_normal(&out.xyz[9 * f], n);
+            down += n[2] <= 0;
+            area += std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]) / 2;
+        }
+        EXPECT_EQ(down, 0u) << "ratio " << ratio;
+        EXPECT_NEAR(area, M_PI, 0.01) << "ratio " << ratio;  // no part covered twice (folds add area)
+    }
+}
+
 TEST(StreamDecimator, SameSeedSameOutputWhateverTheChunking) {
     Options options;
     options.ratio = 0.05;
