@@ -9,6 +9,17 @@
 using namespace meshstream::decimate;
 using namespace meshstream::decimate::test;
 
+TEST(HalfEdgeBuffer, NextAndPrevInFaceCycleThroughTheThreeCorners) {
+    for (uint32_t f : {0u, 1u, 12345u, (1u << 30) - 2}) {
+        for (uint32_t k = 0; k < 3; ++k) {
+            const uint32_t h = half_edge(f, k);
+            EXPECT_EQ(next_in_face(h), half_edge(f, (k + 1) % 3));
+            EXPECT_EQ(prev_in_face(h), half_edge(f, (k + 2) % 3));
+            EXPECT_EQ(prev_in_face(next_in_face(h)), h);
+        }
+    }
+}
+
 TEST(HalfEdgeBuffer, TwoTrianglesShareAnEdge) {
     HalfEdgeBuffer buffer(64, 0);
     const size_t free_before = buffer.free_vertex_count();
