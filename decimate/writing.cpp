@@ -98,8 +98,8 @@ bool place_vertex(HalfEdgeBuffer& buffer, uint32_t v) {
         if (!buffer.partner_position(v, far_end)) return false;
         double error = q.error(old);
         bool found = false;
-        const double mid[3] = {0.5 * (old[0] + far_end[0]), 0.5 * (old[1] + far_end[1]),
-                               0.5 * (old[2] + far_end[2])};
+        double mid[3] = {0.5 * (old[0] + far_end[0]), 0.5 * (old[1] + far_end[1]), 0.5 * (old[2] + far_end[2])};
+        buffer.round_position(mid);
         const double* candidates[2] = {far_end, mid};
         for (const double* candidate : candidates) {
             const double e = q.error(candidate);
@@ -111,6 +111,10 @@ bool place_vertex(HalfEdgeBuffer& buffer, uint32_t v) {
         }
         if (!found) return false;
     }
+    // Judged where the vertex will really be: its float position. Far from the origin a float
+    // step is large (0.25 m at 4 000 000, as in UTM coordinates), and the unrounded optimum
+    // of a slope moved vertices up to 9 cm off it when stored.
+    buffer.round_position(best);
     double reach2 = 0;
     for (uint32_t c = x.first_corner; c != kNoIndex; c = buffer.next_corner(c)) {
         double w[3];

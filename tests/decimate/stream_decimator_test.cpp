@@ -143,6 +143,34 @@ TEST(StreamDecimator, FlatDiscWithAHighValenceCentreKeepsEveryFaceUp) {
     }
 }
 
+TEST(StreamDecimator, FarFromTheOriginVerticesStayOnTheSurface) {
+    // A 45° slope with 2 mm of relief at UTM-like coordinates (500 000, 4 000 000), where a float
+    // step in y is 0.25 m: every input position is a float, but a write-time move to the
+    // unrounded quadric optimum put vertices up to 9 cm off the slope once stored.
+    constexpr int n = 40;
+    auto point = [](int i, int j) {
+        return std::array<float, 3>{float(500000 + 0.5 * i), float(4000000 + 0.5 * j),
+                                    float(100 + 0.5 * j + 0.002 * std::sin(0.7 * i) * std::cos(0.9 * j))};
+    };
+    std::vector<float> soup;
+    auto add = [&](std::array<float, 3> a, std::array<float, 3> b, std::array<float, 3> c) {
+        for (const auto& p : {a, b, c}) soup.insert(soup.end(), p.begin(), p.end());
+    };
+    for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i) {
+            add(point(i, j), point(i + 1, j), point(i + 1, j + 1));
+            add(point(i, j), point(i + 1, j + 1), point(i, j + 1));
+        }
+    Options options;
+    options.ratio = 0.1;
+    const Decimated out = run_decimator(soup, options);
+    ASSERT_EQ(out.triangle_count(), 320u);
+    double worst = 0;
+    for (size_t i = 0; i < out.xyz.size(); i += 3)
+        worst = std::max(worst, std::abs((double(out.xyz[i + 2]) - 100) - (double(out.xyz[i + 1]) - 4000000)) / std::sqrt(2.0));
+    EXPECT_LT(worst, 0.005) << "metres off the slope";
+}
+
 TEST(StreamDecimator, SameSeedSameOutputWhateverTheChunking) {
     Options options;
     options.ratio = 0.05;
