@@ -263,9 +263,20 @@ struct TriangleIndex {
 // streamed mesh. Leaf boxes are the samples inflated by their initial upper bound, so a
 // triangle that can lower a sample's distance always overlaps the sample's box.
 struct SampleIndex {
-    std::vector<float> xyz;     // 3 floats per sample, in BVH order
+    // Samples are kept as floats relative to `origin` (a corner of the held mesh): absolute
+    // floats far from the origin round by up to half a float step, 0.125 m at 4 000 000 as in
+    // UTM coordinates, which showed as error in a mesh compared with itself.
+    double origin[3] = {0, 0, 0};
+    std::vector<float> xyz;     // 3 floats per sample relative to origin, in BVH order
     std::vector<double> best2;  // running minimum squared distance
     std::vector<BvhNode> nodes;
+
+    void add(const double p[3]) {
+        xyz.insert(xyz.end(), {float(p[0] - origin[0]), float(p[1] - origin[1]), float(p[2] - origin[2])});
+    }
+    void position(size_t i, double p[3]) const {
+        for (int a = 0; a < 3; ++a) p[a] = double(xyz[3 * i + a]) + origin[a];
+    }
 
     void build(std::vector<double> bound2) {
         std::vector<uint32_t> order;
@@ -290,9 +301,18 @@ struct SampleIndex {
         for (size_t i = 0; i < order.size(); ++i) best2[i] = bound2[order[i]];
     }
 
-    // Lowers best2 of every sample that triangle t (bounding box lo..hi) is closer to.
-    void update(const float* t, const float lo[3], const float hi[3]) {
+    // Lowers best2 of every sample that triangle t (absolute bounding box abs_lo..abs_hi) is
+    // closer to.
+    void update(const float* t, const float abs_lo[3], const float abs_hi[3]) {
         if (nodes.empty()) return;
+        float lo[3], hi[3];  // the box relative to origin, rounded outwards
+        for (int a = 0; a < 3; ++a) {
+            const double l = double(abs_lo[a]) - origin[a], h = double(abs_hi[a]) - origin[a];
+            lo[a] = float(l);
+            hi[a] = float(h);
+            if (double(lo[a]) > l) lo[a] = std::nextafter(lo[a], -INFINITY);
+            if (double(hi[a]) < h) hi[a] = std::nextafter(hi[a], INFINITY);
+        }
         uint32_t stack[128];
         int top = 0;
         stack[top++] = 0;
@@ -307,10 +327,11 @@ struct SampleIndex {
                 continue;
             }
             for (uint32_t i = n.first; i < n.first + n.count; ++i) {
-                double p[3] = {xyz[3 * size_t{i}], xyz[3 * size_t{i} + 1], xyz[3 * size_t{i} + 2]};
+                double p[3];
+                position(i, p);
                 double box2 = 0;
                 for (int a = 0; a < 3; ++a) {
-                    double d = std::max({double(lo[a]) - p[a], 0.0, p[a] - double(hi[a])});
+                    double d = std::max({double(abs_lo[a]) - p[a], 0.0, p[a] - double(abs_hi[a])});
                     box2 += d * d;
                 }
                 if (box2 >= best2[i]) continue;
@@ -624,6 +645,7 @@ CompareResult compare_meshes(const MeshSource& a, const MeshSource& b, const Com
 
     // Samples on the held mesh, with upper bounds from the reservoir.
     SampleIndex samples;
+    std::copy(triangles.xyz.begin(), triangles.xyz.begin() + 3, samples.origin);
     {
         double density = held_summary.area > 0 ? double(held_samples) / held_summary.area : 0;
         size_t n_tri = triangles.xyz.size() / 9;
@@ -634,7 +656,7 @@ CompareResult compare_meshes(const MeshSource& a, const MeshSource& b, const Com
             for (uint64_t j = 0; j < k; ++j) {
                 double p[3];
                 point_in_triangle(t, rng, p);
-                samples.xyz.insert(samples.xyz.end(), {float(p[0]), float(p[1]), float(p[2])});
+                samples.add(p);
             }
         }
         std::vector<uint32_t> order;
@@ -648,7 +670,8 @@ CompareResult compare_meshes(const MeshSource& a, const MeshSource& b, const Com
         size_t n = samples.xyz.size() / 3;
         std::vector<double> bound2(n);
         for (size_t i = 0; i < n; ++i) {
-            double p[3] = {samples.xyz[3 * i], samples.xyz[3 * i + 1], samples.xyz[3 * i + 2]};
+            double p[3];
+            samples.position(i, p);
             bound2[i] = bvh_nearest(points, p, kInf, [&](uint32_t r) {
                 double d[3] = {p[0] - reservoir[3 * size_t{r}], p[1] - reservoir[3 * size_t{r} + 1],
                                p[2] - reservoir[3 * size_t{r} + 2]};

@@ -112,6 +112,22 @@ TEST(Metro, MeshAgainstItselfIsZero) {
     EXPECT_NEAR(r.b_to_a.samples, 100'000, 2'000);
 }
 
+TEST(Metro, MeshFarFromTheOriginAgainstItselfIsStillZero) {
+    // The same sphere at UTM-like coordinates: a 0.25 m float step in y there. Held samples
+    // stored as absolute floats were off their own triangles by up to half a step.
+    std::vector<float> s = sphere(4);
+    for (size_t i = 0; i < s.size(); i += 3) {
+        s[i] = float(500000 + 10 * double(s[i]));
+        s[i + 1] = float(4000000 + 10 * double(s[i + 1]));
+        s[i + 2] = float(100 + 10 * double(s[i + 2]));
+    }
+    CompareOptions options;
+    options.samples = 50'000;
+    CompareResult r = compare_meshes(memory_source("a", s), memory_source("b", s), options);
+    EXPECT_LT(r.hausdorff(), 1e-5);  // 1e-6 of the size; 0.09 m before
+    EXPECT_LT(r.rms(), 1e-6);
+}
+
 TEST(Metro, TranslatedSphereHausdorffIsTheOffset) {
     // A closed surface translated by d is within d of the original everywhere (p - d lies on
     // it), and at the facets facing the translation the distance is d·cos(angle between facet
