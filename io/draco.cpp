@@ -18,6 +18,7 @@
 #include <draco/mesh/mesh.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 
 namespace meshstream::io {
@@ -158,6 +159,26 @@ DracoEncoded encode_draco(const IndexedMesh& mesh, const std::vector<float>* nor
                           const std::string& file_name) {
     if (mesh.triangle_count() == 0)
         throw Error(file_name, "no triangles to write: Draco cannot encode an empty mesh");
+    {
+        // Draco quantizes positions with a float step of range / (2^bits − 1), the range being
+        // the largest extent in float; it overflows for boxes wider than the largest float
+        // (libdraco then crashed) and its inverse overflows for tiny boxes (every vertex then
+        // decoded to one point far away). Refused, as Draco's own encoder cannot do them.
+        const Bounds box = mesh.bounds();
+        float range = 0;
+        for (int a = 0; a < 3; ++a) range = std::max(range, box.max[a] - box.min[a]);
+        const float max_q = float((uint32_t{1} << options.draco_position_bits) - 1);
+        if (!std::isfinite(range))
+            throw Error(file_name, "the mesh is wider along an axis than a float can hold (3.4e38): Draco cannot "
+                                   "quantize it; write it without Draco (--no-draco for glTF, or another format)");
+        if (range > 0 && !std::isfinite(max_q / range)) {
+            std::string extent;
+            append_number(extent, range);
+            throw Error(file_name, "the mesh is too small for Draco's " + std::to_string(options.draco_position_bits) +
+                                       "-bit quantization (largest extent " + extent +
+                                       "): write it with fewer --draco-qp bits, or without Draco");
+        }
+    }
     draco::Mesh dm;
     dm.set_num_points(static_cast<uint32_t>(mesh.vertex_count()));
     int pos_att = add_float3_attribute(dm, draco::GeometryAttribute::POSITION, mesh.positions);

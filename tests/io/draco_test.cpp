@@ -205,6 +205,35 @@ TEST(DracoWriter, RefusesEmptyMeshAndNonFiniteCoordinates) {
     EXPECT_TRUE(fs::is_empty(dir.path()));
 }
 
+TEST(DracoWriter, RefusesExtentsItsQuantizerCannotStepThrough) {
+    // Draco's quantization step is the largest extent / (2^bits − 1) in float. Wider than the
+    // largest float, libdraco crashed (and left a temporary file); so small that the inverse
+    // step overflows, every vertex decoded to one point far away. Both are refused, for .drc
+    // and for Draco glTF alike, and nothing is left behind.
+    TempDir dir;
+    Soup huge;
+    huge.xyz = {-2e38f, 0, 0, 2e38f, 0, 0, 0, 1, 0};
+    Soup tiny;
+    tiny.xyz = {0, 0, 0, 1e-35f, 0, 0, 0, 1e-35f, 0};
+    for (const char* name : {"x.drc", "x.glb"}) {
+        for (const auto& [soup, words] : {std::pair{&huge, "wider along an axis than a float can hold"},
+                                          std::pair{&tiny, "too small for Draco's 14-bit quantization"}}) {
+            try {
+                write_soup(*soup, dir / name);
+                ADD_FAILURE() << name << ": no error";
+            } catch (const io::Error& e) {
+                EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
+            }
+            EXPECT_TRUE(fs::is_empty(dir.path())) << name;
+        }
+    }
+    // Fewer bits step through the tiny mesh exactly (its corners are the box's corners).
+    io::WriteOptions o;
+    o.draco_position_bits = 8;
+    write_soup(tiny, dir / "tiny.drc", o);
+    EXPECT_EQ(read_soup(dir / "tiny.drc").xyz, tiny.xyz);
+}
+
 TEST(DracoWriter, RejectsOutOfRangeSettings) {
     TempDir dir;
     io::WriteOptions o;
