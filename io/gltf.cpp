@@ -5,6 +5,7 @@
 // copied into tinygltf's model. See gltf.hpp for the contract.
 #include "io/gltf.hpp"
 
+#include "io/byte_stream.hpp"
 #include "io/error.hpp"
 #include "io/mesh_index.hpp"
 #include "io/text_number.hpp"
@@ -85,21 +86,52 @@ std::string bin_path_for(std::string path) {
     return path + ".bin";
 }
 
-// The .bin beside a .gltf output is replaced when the .gltf is written. When it exists but the
-// .gltf does not, it is not this output's earlier buffer but someone else's (another glTF's,
-// perhaps the input's): refused before any work instead of breaking that file silently.
-void check_side_file(const std::string& gltf_path) {
-    const std::string bin = bin_path_for(gltf_path);
-    struct stat st;
-    if (::stat(bin.c_str(), &st) == 0 && ::stat(gltf_path.c_str(), &st) != 0)
-        throw Error(gltf_path, "its buffer would replace " + bin +
-                                   ", which exists but belongs to no earlier " + gltf_path +
-                                   " (another glTF's buffer?): move it, choose another name, or write .glb");
-}
-
 std::string base_name(const std::string& path) {
     size_t slash = path.find_last_of('/');
     return slash == std::string::npos ? path : path.substr(slash + 1);
+}
+
+// True when the glTF document at `gltf_path` names `bin_name` as the URI of one of its buffers
+// (URI-encoded, as this writer puts it, or plain). Unreadable or not a glTF document: false.
+bool gltf_uses_buffer(const std::string& gltf_path, const std::string& bin_name) {
+    std::string text;
+    try {
+        const std::unique_ptr<ByteSource> source = ByteSource::open(gltf_path);
+        char buf[1 << 16];
+        constexpr size_t kMaxBytes = size_t{64} << 20;  // a glTF's JSON; more is not one
+        for (size_t n; (n = source->read(buf, sizeof buf)) > 0;) {
+            text.append(buf, n);
+            if (text.size() > kMaxBytes) return false;
+        }
+    } catch (const Error&) {
+        return false;
+    }
+    const nlohmann::json doc = nlohmann::json::parse(text, nullptr, false);
+    if (!doc.is_object() || !doc.contains("buffers") || !doc["buffers"].is_array()) return false;
+    for (const auto& buffer : doc["buffers"]) {
+        if (!buffer.is_object() || !buffer.contains("uri") || !buffer["uri"].is_string()) continue;
+        const std::string& uri = buffer["uri"].get_ref<const std::string&>();
+        if (uri == uri_encode(bin_name) || uri == bin_name) return true;
+    }
+    return false;
+}
+
+// The .bin beside a .gltf output is replaced when the .gltf is written. Unless the .gltf there
+// already uses it as its buffer (an earlier output, replaced as a pair), it is someone else's
+// (another glTF's, perhaps the input's): refused before any work instead of breaking that
+// file silently.
+void check_side_file(const std::string& gltf_path) {
+    const std::string bin = bin_path_for(gltf_path);
+    struct stat st;
+    if (::stat(bin.c_str(), &st) != 0) return;
+    if (::stat(gltf_path.c_str(), &st) != 0)
+        throw Error(gltf_path, "its buffer would replace " + bin +
+                                   ", which exists but belongs to no earlier " + gltf_path +
+                                   " (another glTF's buffer?): move it, choose another name, or write .glb");
+    if (!gltf_uses_buffer(gltf_path, base_name(bin)))
+        throw Error(gltf_path, "its buffer would replace " + bin + ", which the existing " + gltf_path +
+                                   " does not use as its buffer (another glTF's buffer?): move it, choose another "
+                                   "name, or write .glb");
 }
 
 // Smallest glTF index component type whose range holds indices 0..vertex_count-1 without the

@@ -309,8 +309,19 @@ TEST(GltfWriter, RefusesToReplaceAnotherFilesBuffer) {
     }
     EXPECT_EQ(slurp(dir / "scene.bin"), "not mine");
     EXPECT_FALSE(fs::exists(dir / "scene.gltf"));
+    // scene.gltf exists too but does not use scene.bin (it has no buffers): still someone
+    // else's, for example the buffer of the very glTF being converted.
+    std::ofstream(dir / "scene.gltf") << R"({"asset":{"version":"2.0"},"scenes":[{}],"scene":0})";
+    try {
+        write_soup(cube, dir / "scene.gltf", o);
+        ADD_FAILURE() << "no error";
+    } catch (const io::Error& e) {
+        EXPECT_NE(std::string(e.what()).find("scene.bin, which the existing"), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(slurp(dir / "scene.bin"), "not mine");
     // A pair written earlier is replaced as a pair.
     fs::remove(dir / "scene.bin");
+    fs::remove(dir / "scene.gltf");
     write_soup(cube, dir / "scene.gltf", o);
     write_soup(cube, dir / "scene.gltf", o);
     EXPECT_EQ(read_soup(dir / "scene.gltf").xyz, cube.xyz);
