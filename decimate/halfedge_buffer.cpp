@@ -363,6 +363,7 @@ void HalfEdgeBuffer::finalize_vertex(uint32_t v) {
             const Quadric penalty = Quadric::from_boundary_edge(pa, pb, pc);
             slots_[a].quadric += penalty;
             slots_[b].quadric += penalty;
+            ++boundary_edges_;
         }
     }
     hash_erase(v);

@@ -286,6 +286,9 @@ public:
     // Running counts for Stats.
     uint64_t vertices_merged() const { return vertices_merged_; }
     uint64_t nonmanifold_edges() const { return nonmanifold_edges_; }
+    // Edges left without a partner when their vertices left P_in: true boundary (hole rims,
+    // open borders, cracks between triangles that share no corner).
+    uint64_t boundary_edges() const { return boundary_edges_; }
     size_t peak_vertices() const { return vertex_used_peak_; }
 
 private:
@@ -334,7 +337,7 @@ private:
     RawArray<Stub> stubs_;  // a == kNoIndex: empty; linear probing
     size_t stub_mask_, stub_count_ = 0;
 
-    uint64_t vertices_merged_ = 0, nonmanifold_edges_ = 0;
+    uint64_t vertices_merged_ = 0, nonmanifold_edges_ = 0, boundary_edges_ = 0;
     uint64_t edits_ = 0;
 };
 

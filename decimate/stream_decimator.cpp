@@ -243,6 +243,7 @@ void StreamDecimator::finish(const Emit& out) {
     stats_.peak_vertices = buffer_.peak_vertices();
     stats_.vertices_merged = buffer_.vertices_merged();
     stats_.nonmanifold_edges = buffer_.nonmanifold_edges();
+    stats_.boundary_edges = buffer_.boundary_edges();
 }
 
 }  // namespace meshstream::decimate

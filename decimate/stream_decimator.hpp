@@ -47,6 +47,7 @@ struct Stats {
     uint64_t premature_writes = 0;       // written before R reached p (decimation stalled)
     uint64_t degenerate_passed = 0;      // corners welded together: passed through
     uint64_t nonmanifold_edges = 0;      // half-edges frozen as non-manifold
+    uint64_t boundary_edges = 0;         // edges without a partner: holes, borders, cracks
     uint64_t vertices_merged = 0;        // vertices that absorbed other positions (--weld)
     uint64_t vertices_finalized_by_sweep = 0;
     int sweep_direction = 0;             // sorted input: +1 ascending, −1 descending, 0 not yet seen

@@ -197,7 +197,17 @@ void run_decimate(const DecimateOptions& opt) {
         warnings.note("--weld " + opt.weld + " welded the corners of " +
                       std::to_string(s.degenerate_passed * 100 / s.triangles_in) +
                       " % of the triangles together: it is coarser than the mesh; weld on a smaller size");
-    // (An input without triangles: the filter's report says so.)
+    // Triangles that share no corners exactly (cracks from float round-off, a soup written
+    // triangle by triangle) leave every edge open: decimation then eats the surface from every
+    // crack and still lands on its count. A mesh has far fewer open edges than triangles (a
+    // strip one triangle wide about one per triangle); a soup has three. (A few loose triangles
+    // are no surface to warn about.)
+    if (s.triangles_in >= 100 && s.boundary_edges * 2 > s.triangles_in * 3)
+        warnings.note(std::to_string(s.boundary_edges) + " edges had no partner, " +
+                      std::to_string(s.boundary_edges / s.triangles_in) + "." +
+                      std::to_string(s.boundary_edges * 10 / s.triangles_in % 10) +
+                      " per triangle: the triangles share few corners exactly (an unwelded surface?), and "
+                      "decimation removes surface along every open edge; --weld EPS joins corners closer than EPS");
     const std::string missed = "output has " + std::to_string(s.triangles_out) + " triangles instead of the target " +
                                std::to_string(s.target_triangles);
     if (s.triangles_in > 0 && s.target_triangles > s.triangles_in)

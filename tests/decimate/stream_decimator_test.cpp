@@ -171,6 +171,20 @@ TEST(StreamDecimator, FarFromTheOriginVerticesStayOnTheSurface) {
     EXPECT_LT(worst, 0.005) << "metres off the slope";
 }
 
+TEST(StreamDecimator, CountsTheEdgesLeftWithoutPartner) {
+    // 100 triangles sharing no corner: 300 open edges. A closed octahedron: none.
+    std::vector<float> soup;
+    for (int t = 0; t < 100; ++t)
+        soup.insert(soup.end(), {float(3 * t), 0, 0, float(3 * t + 1), 0, 0, float(3 * t), 1, 0});
+    Options options;
+    options.ratio = 0.5;
+    EXPECT_EQ(run_decimator(soup, options).stats.boundary_edges, 300u);
+    std::vector<float> octahedron;
+    for (const auto& f : octahedron_faces())
+        for (int k : f) octahedron.insert(octahedron.end(), octahedron_points()[k].begin(), octahedron_points()[k].end());
+    EXPECT_EQ(run_decimator(octahedron, options).stats.boundary_edges, 0u);
+}
+
 TEST(StreamDecimator, SameSeedSameOutputWhateverTheChunking) {
     Options options;
     options.ratio = 0.05;
