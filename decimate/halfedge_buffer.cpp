@@ -87,9 +87,15 @@ bool HalfEdgeBuffer::same_key(const float a[3], const float b[3]) const {
                float_key(a[2]) == float_key(b[2]);
     }
     for (int i = 0; i < 3; ++i)
-        if (std::floor(double(a[i]) / weld_eps_) != std::floor(double(b[i]) / weld_eps_))
-            return false;
+        if (weld_cell(a[i]) != weld_cell(b[i])) return false;
     return true;
+}
+
+double HalfEdgeBuffer::weld_cell(float x) const {
+    // The nearest point of the grid, not the cell below: the cells' borders then lie halfway
+    // between grid points. With ⌊x/EPS⌋, coordinates on a multiple of EPS (a floor at z = 0, a
+    // CAD part on round numbers) sat on a border, and round-off on either side split them.
+    return std::floor(double(x) / weld_eps_ + 0.5);
 }
 
 size_t HalfEdgeBuffer::hash_slot(const float p[3]) const {
@@ -108,7 +114,7 @@ size_t HalfEdgeBuffer::hash_slot(const float p[3]) const {
         // The cell index as the bits of the (integral) double: an int64 cast overflows for
         // huge coordinates or tiny cells (fuzz finding, FuzzRegression.Issue7_WeldHugeCoordinate).
         k[i] = weld_eps_ == 0 ? float_key(p[i])
-                              : std::bit_cast<uint64_t>(std::floor(double(p[i]) / weld_eps_) + 0.0);
+                              : std::bit_cast<uint64_t>(weld_cell(p[i]) + 0.0);
     return mix64(k[0] * 0x9e3779b97f4a7c15ull ^ mix64(k[1] + 0x632be59bd9b4e019ull) ^
                  (k[2] * 0xc2b2ae3d27d4eb4full)) &
            hash_mask_;

@@ -141,7 +141,7 @@ private:
 class HalfEdgeBuffer {
 public:
     // `triangle_capacity` ≥ 4. `weld_eps` = 0: weld on exact float position (−0 equals +0);
-    // > 0: weld positions falling into the same cell of a grid of that size.
+    // > 0: weld positions nearest to the same point of a grid of that size.
     HalfEdgeBuffer(size_t triangle_capacity, double weld_eps);
     // The address space the constructor reserves for `triangle_capacity` (about 500 bytes a
     // triangle); the hash and stub tables of it are resident at once, the pools when touched.
@@ -298,6 +298,7 @@ private:
     void hash_erase(uint32_t v);
     size_t hash_slot(const float p[3]) const;
     bool same_key(const float a[3], const float b[3]) const;
+    double weld_cell(float x) const;  // grid index (an integral double) of a coordinate
     bool take_written_stub(uint32_t a, uint32_t b);
 
     size_t face_capacity_, vertex_capacity_;

@@ -207,7 +207,7 @@ void run_decimate(const DecimateOptions& opt) {
                       std::to_string(s.boundary_edges / s.triangles_in) + "." +
                       std::to_string(s.boundary_edges * 10 / s.triangles_in % 10) +
                       " per triangle: the triangles share few corners exactly (an unwelded surface?), and "
-                      "decimation removes surface along every open edge; --weld EPS joins corners closer than EPS");
+                      "decimation removes surface along every open edge; --weld EPS snaps corners to a grid of EPS");
     const std::string missed = "output has " + std::to_string(s.triangles_out) + " triangles instead of the target " +
                                std::to_string(s.target_triangles);
     if (s.triangles_in > 0 && s.target_triangles > s.triangles_in)

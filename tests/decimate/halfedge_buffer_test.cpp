@@ -100,6 +100,21 @@ TEST(HalfEdgeBuffer, WeldGridMergesNearbyPositionsAndCounts) {
     EXPECT_EQ(buffer.free_vertex_count(), 3 * 64 + 3 - 4u);
 }
 
+TEST(HalfEdgeBuffer, WeldGridRoundsToTheNearestPointSoRoundNumbersWeld) {
+    // A floor at z = 0 with round-off on either side: with cells ⌊z/EPS⌋ the border at 0 split
+    // it (cells −1 and 0); cells around the nearest grid point keep it together. Corners just
+    // either side of a half step (0.00005 with EPS 0.0001) are split, as a grid must split
+    // somewhere.
+    HalfEdgeBuffer buffer(64, 1e-4);
+    add_indexed(buffer, {{0, 0, 1e-9f}, {1, 0, -1e-9f}, {0, 1, 1e-9f}, {1, 0, 1e-9f}, {1, 1, -1e-9f}, {0, 1, -1e-9f}},
+                {{0, 1, 2}, {3, 4, 5}});
+    EXPECT_EQ(buffer.vertices_merged(), 2u);  // (1, 0) and (0, 1) each absorbed the other sign
+    EXPECT_EQ(buffer.free_vertex_count(), 3 * 64 + 3 - 4u);
+    HalfEdgeBuffer split(64, 1e-4);
+    add_indexed(split, {{0, 0, 0.000051f}, {1, 0, 0.000049f}, {0, 1, 0}, {0, 0, 0.000049f}}, {{0, 1, 2}, {3, 1, 2}});
+    EXPECT_EQ(split.free_vertex_count(), 3 * 64 + 3 - 4u);
+}
+
 TEST(HalfEdgeBuffer, FreezingMarksNeighbourFacesAsFrontier) {
     HalfEdgeBuffer buffer(64, 0);
     add_indexed(buffer, octahedron_points(), octahedron_faces());

@@ -316,6 +316,7 @@ TEST(CliBadInput, AnUnweldedSurfaceIsSaidToBeOne) {
     CliRun welded = run("decimate -r 0.1 " + dir / "welded.stl" + " " + dir / "out.stl");
     EXPECT_EQ(welded.code, 0) << welded.err;
     EXPECT_EQ(welded.err.find("had no partner"), std::string::npos) << welded.err;
+    EXPECT_NE(cracked.err.find("--weld EPS snaps corners to a grid of EPS\n"), std::string::npos) << cracked.err;
 }
 
 TEST(CliBadInput, CommandLinesThatCannotWorkExit2BeforeAnyWork) {
