@@ -143,3 +143,27 @@ TEST(CliDecimate, ForcedWritesDegradeGracefully) {
     EXPECT_EQ(e.non_manifold_edges, 0u);
     EXPECT_LE(e.boundary_edges, 223u);  // the input's own holes, no cracks
 }
+
+// The --memory a refused plain glTF output asks for is enough for a closed mesh (the case the
+// up-front figure is computed for): the running estimate counted vectors' spare capacity and
+// refused 200 k triangles at the 8M it had asked for. A .gltf on stdout counts its base64 copies.
+TEST(CliDecimate, TheMemoryAskedForAPlainGltfSuffices) {
+    TempDir dir;
+    const std::string mesh = dir / "closed.stl";
+    ASSERT_EQ(std::system((std::string(MESHSTREAM_GEN_BINARY) + " -q -n 200000 " + mesh).c_str()), 0);
+    for (const std::string& out : {dir / "out.glb", std::string("- --to gltf")}) {
+        CliRun refused = run("convert --no-draco --memory 1M " + mesh + " " + out + " > " + dir / "stdout");
+        ASSERT_EQ(refused.code, 1) << refused.err;
+        const size_t at = refused.err.find("give --memory ");
+        ASSERT_NE(at, std::string::npos) << refused.err;
+        const std::string asked = refused.err.substr(at + 14, refused.err.find(' ', at + 14) - at - 14);
+        CliRun ok = run("convert --no-draco --memory " + asked + " " + mesh + " " + out + " > " + dir / "stdout");
+        EXPECT_EQ(ok.code, 0) << out << " at --memory " << asked << ": " << ok.err;
+    }
+    // Inline base64 costs: the .gltf on stdout asks for more than the .glb.
+    auto asked_for = [&](const std::string& out) {
+        CliRun r = run("convert --no-draco --memory 1M " + mesh + " " + out + " > " + dir / "stdout");
+        return std::stoi(r.err.substr(r.err.find("give --memory ") + 14));
+    };
+    EXPECT_GT(asked_for("- --to gltf"), asked_for(dir / "out.glb"));
+}
