@@ -32,6 +32,9 @@ struct MeshHeader {
     std::string variant;                     // e.g. "binary", "ascii", "binary_big_endian"
     std::vector<std::pair<std::string, std::string>> notes;  // extra facts for `info`
 };
+// The note a reader adds when it rounded the file's double coordinates to float (PLY): the
+// commands repeat it as a warning when anything moved.
+inline constexpr const char* kPrecisionNote = "coordinates";
 
 class Reader {
 public:

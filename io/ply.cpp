@@ -504,6 +504,12 @@ private:
             return;
         }
         table_ = std::make_unique<VertexTable>(budget, options_.tmpdir, has_color_);
+        // meshstream's chunks hold float coordinates: double ones are rounded, which far from
+        // the origin moves them by a lot (0.25 m at 4 000 000); the largest change is said.
+        bool doubles = false;
+        for (int s = 0; s < 3; ++s)
+            doubles |= e.props[static_cast<size_t>(vertex_props_[s])].type == PlyType::kFloat64;
+        double worst_rounding = 0, worst_at = 0;
         double values[6] = {0, 0, 0, 0, 0, 0};
         float xyz[3];
         uint8_t rgb[3];
@@ -520,7 +526,7 @@ private:
                     int slot = -1;
                     for (int s = 0; s < 6; ++s)
                         if (vertex_props_[s] == static_cast<int>(p)) slot = s;
-                    if (slot >= 0 && slot < 3 && encoding_ == Encoding::kAscii)
+                    if (slot >= 0 && slot < 3 && encoding_ == Encoding::kAscii && prop.type != PlyType::kFloat64)
                         values[slot] = parse_float(token());  // decimal -> float directly: no double rounding
                     else if (slot >= 0)
                         values[slot] = read_scalar(prop.type);
@@ -528,6 +534,12 @@ private:
                 }
             }
             for (int a = 0; a < 3; ++a) xyz[a] = static_cast<float>(values[a]);
+            if (doubles)
+                for (int a = 0; a < 3; ++a)
+                    if (std::fabs(double(xyz[a]) - values[a]) > worst_rounding) {
+                        worst_rounding = std::fabs(double(xyz[a]) - values[a]);
+                        worst_at = values[a];
+                    }
             if (has_color_)
                 for (int a = 0; a < 3; ++a)
                     rgb[a] = to_color(values[3 + a], e.props[static_cast<size_t>(vertex_props_[3 + a])].type);
@@ -536,6 +548,16 @@ private:
         header_.notes.emplace_back("vertex table", table_->storage() == VertexTable::Storage::kMemory
                                                        ? "in memory"
                                                        : "temporary file, mapped");
+        if (doubles) {
+            std::string text = "double, rounded to float: moved by up to ";
+            append_number(text, static_cast<float>(worst_rounding));
+            if (worst_rounding > 0) {
+                text += " (at ";
+                append_number(text, worst_at);
+                text += ")";
+            }
+            header_.notes.emplace_back(kPrecisionNote, text);
+        }
     }
 
     // ---- faces ----

@@ -48,6 +48,12 @@ CLI::Validator format_name(bool for_writing) {
 
 }  // namespace
 
+void note_input_changes(const io::MeshHeader& header, const std::string& input_name, Warnings& warnings) {
+    for (const auto& [key, text] : header.notes)
+        if (key == io::kPrecisionNote && !text.ends_with("up to 0"))
+            warnings.note(input_name + ": coordinates are " + text + "; meshstream works in float (32-bit)");
+}
+
 void note_unused_write_flags(const WriteFlags& flags, const io::Format& output, Warnings& warnings) {
     if (output.traits & (io::Format::kAlwaysDraco | io::Format::kDracoUnlessOff)) {
         if ((output.traits & io::Format::kAlwaysDraco) && !flags.draco)

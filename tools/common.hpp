@@ -56,6 +56,8 @@ void require_output_format(const std::string& output, const WriteFlags& flags);
 class Warnings;
 // Notes Draco/glTF options given for an output of another format (they do nothing there).
 void note_unused_write_flags(const WriteFlags& flags, const io::Format& output, Warnings& warnings);
+// Repeats as warnings what the reader noted that changes the data (double coordinates rounded).
+void note_input_changes(const io::MeshHeader& header, const std::string& input_name, Warnings& warnings);
 
 // Global flags (set by main before a subcommand runs).
 struct Global {

@@ -56,6 +56,7 @@ void run_convert(const ConvertOptions& opt) {
         warnings.note("the input's vertex colours are not written: " + std::string(out.format->name) +
                       " output carries geometry only (PLY keeps them)");
     filter.report(warnings);
+    note_input_changes(in.reader->header(), in.source->name(), warnings);
     warnings.print();
 }
 

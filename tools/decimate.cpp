@@ -165,6 +165,7 @@ void run_decimate(const DecimateOptions& opt) {
     std::snprintf(ratio_text, sizeof ratio_text, "%.6g", decimator.ratio());
     note_unused_write_flags(opt.write, *out.format, warnings);
     filter.report(warnings);
+    note_input_changes(in.reader->header(), in.source->name(), warnings);
     if (s.forced_writes > 0)
         warnings.note("buffer full of undecimatable triangles: " + std::to_string(s.forced_writes) +
                      " triangles force-written at full resolution (" +

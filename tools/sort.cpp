@@ -291,6 +291,7 @@ void run_sort(const SortOptions& opt) {
     Warnings warnings;
     note_unused_write_flags(opt.write, *out.format, warnings);
     filter.report(warnings);
+    note_input_changes(in.reader->header(), in.source->name(), warnings);
     warnings.print();
 
     if (opt.stats) {

@@ -159,6 +159,30 @@ TEST(PlyReader, FillsColourFromUcharAndFloatChannels) {
     EXPECT_EQ(s.rgb, (std::vector<uint8_t>{255, 0, 128, 0, 255, 0, 0, 0, 255}));
 }
 
+TEST(PlyReader, DoubleCoordinatesRoundedToFloatAreNoted) {
+    // Chunks hold floats: double coordinates are rounded, which at UTM-like coordinates moves
+    // them by up to 0.125 m. The header note says by how much (the commands warn with it); when
+    // every double is a float exactly, by 0.
+    TempDir dir;
+    auto note = [](const test::Soup& s) {
+        for (const auto& [k, v] : s.header.notes)
+            if (k == io::kPrecisionNote) return v;
+        return std::string("<none>");
+    };
+    const std::string header = "ply\nformat ascii 1.0\nelement vertex 3\nproperty double x\nproperty double y\n"
+                               "property double z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
+    test::spit(dir / "utm.ply", header + "500000 4000000.12 100\n500001 4000000 100\n500000 4000001 100.5\n3 0 1 2\n");
+    test::Soup utm = read_soup(dir / "utm.ply");
+    EXPECT_EQ(utm.xyz[1], 4000000.0f);
+    EXPECT_EQ(note(utm), "double, rounded to float: moved by up to 0.12 (at 4000000.12)");
+    test::spit(dir / "exact.ply", header + "0 0 0\n1 0 0\n0 1 0.5\n3 0 1 2\n");
+    EXPECT_EQ(note(read_soup(dir / "exact.ply")), "double, rounded to float: moved by up to 0");
+    test::spit(dir / "float.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                                  "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+                                  "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+    EXPECT_EQ(note(read_soup(dir / "float.ply")), "<none>");
+}
+
 TEST(PlyReader, AnyCoordinateTypeAndElementsAroundVertexAndFace) {
     TempDir dir;
     // An element before the vertices, int16 coordinates, a uint index list with a uint16

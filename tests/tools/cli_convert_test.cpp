@@ -162,3 +162,22 @@ TEST(CliConvert, DracoOptionsForOtherOutputsAreSaidToDoNothing) {
     EXPECT_EQ(glb.code, 0) << glb.err;
     EXPECT_EQ(glb.err.find("warning"), std::string::npos) << glb.err;
 }
+
+// Double coordinates rounded to float are said when they moved, and only then.
+TEST(CliConvert, RoundedDoubleCoordinatesAreAWarning) {
+    TempDir dir;
+    const std::string header = "ply\nformat ascii 1.0\nelement vertex 3\nproperty double x\nproperty double y\n"
+                               "property double z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
+    write_file(dir / "utm.ply", header + "500000 4000000.12 100\n500001 4000000 100\n500000 4000001 100.5\n3 0 1 2\n");
+    write_file(dir / "exact.ply", header + "0 0 0\n1 0 0\n0 1 0.5\n3 0 1 2\n");
+    auto r = run("convert " + dir / "utm.ply" + " " + dir / "utm.stl");
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.err.find("warning: " + dir / "utm.ply" +
+                         ": coordinates are double, rounded to float: moved by up to 0.12 (at 4000000.12); meshstream "
+                         "works in float (32-bit)"),
+              std::string::npos)
+        << r.err;
+    auto e = run("convert " + dir / "exact.ply" + " " + dir / "exact.stl");
+    EXPECT_EQ(e.code, 0) << e.err;
+    EXPECT_EQ(e.err.find("rounded to float"), std::string::npos) << e.err;
+}
