@@ -188,6 +188,7 @@ void run_sort(const SortOptions& opt) {
 
     io::Input in = io::open_input(opt.input, opt.read.from, ro);
     const io::MeshHeader header = in.reader->header();
+    const std::string input_name = in.source->name();  // `in` is released before the merge
     sort::SorterOptions so;
     so.axis = axis;
     so.tmpdir = tmpdir;
@@ -291,7 +292,7 @@ void run_sort(const SortOptions& opt) {
     Warnings warnings;
     note_unused_write_flags(opt.write, *out.format, warnings);
     filter.report(warnings);
-    note_input_changes(in.reader->header(), in.source->name(), warnings);
+    note_input_changes(header, input_name, warnings);
     warnings.print();
 
     if (opt.stats) {
