@@ -41,7 +41,10 @@ struct DracoEncoded {
     int position_id = -1;          // attribute unique ids (for KHR_draco_mesh_compression)
     int normal_id = -1;            // -1 without normals
     Bounds decoded_bounds;         // exact min/max of the dequantized positions
+    uint64_t flattened = 0;        // triangles of nonzero area whose dequantized corners have none
 };
+// The note a writer gives when quantization flattened triangles (empty when none did).
+std::string draco_flattened_note(const DracoEncoded& encoded, uint64_t triangles, const WriteOptions& options);
 
 // Encodes `mesh` (and `normals`, 3 floats per vertex, when non-null) with the Draco settings
 // of `options`. Throws io::Error naming `file_name` when Draco refuses (e.g. an empty mesh).

@@ -59,6 +59,9 @@ public:
     // Completes the output (footer, header counts). The caller then commits the ByteSink;
     // a writer destroyed without finish() leaves output that is discarded.
     virtual void finish() = 0;
+    // After finish(): what the user should know about the output written (lossy encodings
+    // that lost something), one sentence each. The commands print them as warnings.
+    virtual std::vector<std::string> notes() const { return {}; }
 };
 
 struct ReadOptions {

@@ -204,8 +204,12 @@ public:
     }
 
     void finish() override;
+    std::vector<std::string> notes() const override {
+        return note_.empty() ? std::vector<std::string>{} : std::vector<std::string>{sink_.name() + ": " + note_};
+    }
 
 private:
+    std::string note_;
     std::string document_json(tinygltf::Model& model, uint64_t buffer_bytes, const std::string& buffer_uri);
 
     ByteSink& sink_;
@@ -250,6 +254,7 @@ void GltfWriter::finish() {
 #if MESHSTREAM_WITH_DRACO
         if (options_.draco) {
             DracoEncoded enc = encode_draco(mesh, options_.normals ? &normals : nullptr, options_, sink_.name());
+            note_ = draco_flattened_note(enc, mesh.triangle_count(), options_);
             append_bytes(bin, enc.bytes.data(), enc.bytes.size());
             tinygltf::BufferView view;
             view.buffer = 0;

@@ -52,6 +52,7 @@ void run_convert(const ConvertOptions& opt) {
     progress.done();
     Warnings warnings;
     note_unused_write_flags(opt.write, *out.format, warnings);
+    for (const std::string& note : out.writer->notes()) warnings.note(note);
     if (header.channels.color && !(out.format->traits & io::Format::kWritesColour))
         warnings.note("the input's vertex colours are not written: " + std::string(out.format->name) +
                       " output carries geometry only (PLY keeps them)");

@@ -164,6 +164,7 @@ void run_decimate(const DecimateOptions& opt) {
     char ratio_text[32];
     std::snprintf(ratio_text, sizeof ratio_text, "%.6g", decimator.ratio());
     note_unused_write_flags(opt.write, *out.format, warnings);
+    for (const std::string& note : out.writer->notes()) warnings.note(note);
     filter.report(warnings);
     note_input_changes(in.reader->header(), in.source->name(), warnings);
     if (s.forced_writes > 0)

@@ -234,6 +234,35 @@ TEST(DracoWriter, RefusesExtentsItsQuantizerCannotStepThrough) {
     EXPECT_EQ(read_soup(dir / "tiny.drc").xyz, tiny.xyz);
 }
 
+TEST(DracoWriter, SaysWhenQuantizationFlattensTriangles) {
+    // A closed box 1000 × 0.02 × 0.02: at 14 bits the step (1000 / 16383 ≈ 0.06) is wider than
+    // the box is thick, so every triangle decodes with zero area. Within the documented error
+    // bound, but the file renders as nothing: the writer says so. At 20 bits it does not.
+    TempDir dir;
+    Soup box;
+    const float x[2] = {0, 1000}, y[2] = {0, 0.02f}, z[2] = {0, 0.02f};
+    auto corner = [&](int i) { return std::array<float, 3>{x[i & 1], y[(i >> 1) & 1], z[(i >> 2) & 1]}; };
+    const int faces[12][3] = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
+                              {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
+    for (const auto& f : faces)
+        for (int k : f) {
+            const auto c = corner(k);
+            box.xyz.insert(box.xyz.end(), c.begin(), c.end());
+        }
+    for (const char* name : {"box.drc", "box.glb"}) {
+        const std::vector<std::string> notes = write_soup(box, dir / name);
+        ASSERT_EQ(notes.size(), 1u) << name;
+        EXPECT_NE(notes[0].find(std::string(name) + ": 12 of the 12 triangles have zero area once decoded: thinner than "
+                                "Draco's 14-bit quantization step"),
+                  std::string::npos)
+            << notes[0];
+    }
+    io::WriteOptions fine;
+    fine.draco_position_bits = 20;
+    EXPECT_TRUE(write_soup(box, dir / "fine.drc", fine).empty());
+    EXPECT_TRUE(write_soup(read_soup(fixture("bunny_from_draco.bin.stl")), dir / "bunny.drc").empty());
+}
+
 TEST(DracoWriter, RejectsOutOfRangeSettings) {
     TempDir dir;
     io::WriteOptions o;

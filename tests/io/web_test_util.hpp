@@ -60,7 +60,8 @@ inline Soup read_soup(const std::string& path, size_t capacity = io::TriangleChu
     return s;
 }
 
-inline void write_soup(const Soup& soup, const std::string& path, const io::WriteOptions& options = {}) {
+// Writes `soup` to `path`; returns the writer's notes.
+inline std::vector<std::string> write_soup(const Soup& soup, const std::string& path, const io::WriteOptions& options = {}) {
     io::Output out = io::open_output(path, {}, options);
     io::TriangleChunk chunk(1000);
     for (size_t t = 0; t < soup.triangles(); ++t) {
@@ -74,6 +75,7 @@ inline void write_soup(const Soup& soup, const std::string& path, const io::Writ
     }
     if (!chunk.empty()) out.write(chunk);
     out.finish();
+    return out.writer->notes();
 }
 
 inline std::string slurp(const std::string& path) {
