@@ -348,8 +348,14 @@ void apply_collapse(HalfEdgeBuffer& buffer, uint32_t h) {
 
 void apply_collapse(HalfEdgeBuffer& buffer, uint32_t h, const double target[3]) {
     const uint32_t q = buffer.corner_vertex(next_in_face(h));
+    double at[3];
+    buffer.position(q, at);
     apply_collapse(buffer, h);
-    buffer.set_position(q, target);
+    // Only a real move is stored: a float coordinate far smaller than the origin's (4.8e-17
+    // beside an origin of 0.5) does not survive the trip through relative doubles, so storing
+    // q's own position back changed it, even for a written q, whose triangles then no longer
+    // met (zero-width cracks in a closed cylinder decimated through a small buffer).
+    if (at[0] != target[0] || at[1] != target[1] || at[2] != target[2]) buffer.set_position(q, target);
 }
 
 bool decimate_once(HalfEdgeBuffer& buffer, Rng& rng, int candidates, CandidateMemory* memory) {

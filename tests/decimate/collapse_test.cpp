@@ -247,6 +247,27 @@ TEST(Collapse, DegenerateFaceMayNotComeOutUpsideDown) {
     EXPECT_FALSE(moves_keep_faces_valid(buffer, v, from, away, kNoIndex, kNoIndex));
 }
 
+TEST(Collapse, ACollapseThatDoesNotMoveTheTargetLeavesItsFloatsAlone) {
+    // Positions are held relative to the first vertex read, here (10, 10.5, 10). A coordinate
+    // of 4.8e-17 does not survive the trip through relative doubles (10.5 + 4.8e-17 is 10.5), so
+    // storing the target's own position back turned it into 0: for a written target, its later
+    // triangles no longer met its earlier ones.
+    HalfEdgeBuffer buffer(64, 0);
+    add_indexed(buffer, {{10, 10.5f, 10}, {11, 10.5f, 10}, {10, 11.5f, 10}}, {{0, 1, 2}});
+    std::vector<std::array<float, 3>> points = octahedron_points();
+    const float tiny = 4.7696769e-17f;
+    for (auto& p : points)
+        if (p == std::array<float, 3>{1, 0, 0}) p[1] = tiny;
+    add_indexed(buffer, points, octahedron_faces());
+    const uint32_t top = vertex_at(buffer, {0, 0, 1}), east = vertex_at(buffer, {1, tiny, 0});
+    const uint32_t h = half_edge(buffer, top, east);
+    double target[3];
+    buffer.position(east, target);
+    ASSERT_TRUE(collapse_valid(buffer, h, target));
+    apply_collapse(buffer, h, target);
+    EXPECT_EQ(buffer.vertex(east).pos[1], tiny);
+}
+
 TEST(Collapse, DecimateOnceReducesAClosedMesh) {
     HalfEdgeBuffer buffer(256, 0);
     add_indexed(buffer, octahedron_points(), octahedron_faces());
