@@ -268,6 +268,20 @@ TEST(Collapse, ACollapseThatDoesNotMoveTheTargetLeavesItsFloatsAlone) {
     EXPECT_EQ(buffer.vertex(east).pos[1], tiny);
 }
 
+TEST(Collapse, AMovedFaceMustStillRoughlyFaceItsFansWay) {
+    // v's fan: four flat faces facing +z and one steep face. Moving v to t turns every face by
+    // less than 84° (the steep one by 76°), but leaves the steep face 135° from the fan's
+    // normal: turns add up that way over successive collapses, so it is refused.
+    HalfEdgeBuffer buffer(64, 0);
+    add_indexed(buffer, {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {-1, 0, 0}, {0, -1, 0}, {0.1f, 0.2f, 0.2f}, {-0.1f, -0.9f, -0.5f}},
+                {{0, 5, 6}, {0, 1, 2}, {0, 2, 3}, {0, 3, 4}, {0, 4, 1}});  // steep face first: v stays open
+    const uint32_t v = vertex_at(buffer, {0, 0, 0});
+    ASSERT_EQ(buffer.vertex(v).face_count, 5u);
+    const double from[3] = {0, 0, 0}, t[3] = {-0.3, 0.1, 0.4}, gentle[3] = {0.05, 0.05, 0};
+    EXPECT_FALSE(moves_keep_faces_valid(buffer, v, from, t, kNoIndex, kNoIndex));
+    EXPECT_TRUE(moves_keep_faces_valid(buffer, v, from, gentle, kNoIndex, kNoIndex));
+}
+
 TEST(Collapse, DecimateOnceReducesAClosedMesh) {
     HalfEdgeBuffer buffer(256, 0);
     add_indexed(buffer, octahedron_points(), octahedron_faces());
