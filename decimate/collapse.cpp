@@ -58,30 +58,33 @@ bool moves_keep_faces_valid(const HalfEdgeBuffer& buffer, uint32_t v, const doub
     double moved[kMaxMoved][3];
     int moved_count = 0;
     bool overflow = false;
-    auto new_normal = [&](uint32_t c, double n_new[3], double n_old[3], bool& was_degenerate, bool& degenerate) {
-        double a[3], b[3];
-        buffer.position(buffer.corner_vertex(next_in_face(c)), a);
-        buffer.position(buffer.corner_vertex(prev_in_face(c)), b);
-        double ea[3], eb[3], ab[3];
-        sub(a, b, ab);
-        const double ab2 = dot(ab, ab);
-        // Each shape is judged by its own edges, the old one by the old edges: judged by the
-        // new, longer ones, a small sound face looked degenerate, was let through and flipped
-        // (a flat disc decimated to 10 % had 26 faces upside down).
-        sub(a, from, ea); sub(b, from, eb); cross(ea, eb, n_old);
-        const double old_edges2 = dot(ea, ea) + dot(eb, eb) + ab2;
-        sub(a, to, ea); sub(b, to, eb); cross(ea, eb, n_new);
-        const double new_edges2 = dot(ea, ea) + dot(eb, eb) + ab2;
-        const double old_len2 = dot(n_old, n_old), new_len2 = dot(n_new, n_new);
-        was_degenerate = old_len2 <= kMinShapeQuality * old_edges2 * old_edges2 || old_len2 == 0;
-        degenerate = new_len2 <= kMinShapeQuality * new_edges2 * new_edges2;
+    // Calls visit(n_old, n_new, was_degenerate, degenerate) for each face of v but the skipped
+    // ones, until it returns false; returns whether every call returned true.
+    auto each_face = [&](auto&& visit) {
+        for (uint32_t c = buffer.vertex(v).first_corner; c != kNoIndex; c = buffer.next_corner(c)) {
+            const uint32_t f = face_of(c);
+            if (f == skip0 || f == skip1) continue;
+            double a[3], b[3];
+            buffer.position(buffer.corner_vertex(next_in_face(c)), a);
+            buffer.position(buffer.corner_vertex(prev_in_face(c)), b);
+            double ea[3], eb[3], ab[3], n_old[3], n_new[3];
+            sub(a, b, ab);
+            const double ab2 = dot(ab, ab);
+            // Each shape is judged by its own edges, the old one by the old edges: judged by the
+            // new, longer ones, a small sound face looked degenerate, was let through and flipped
+            // (a flat disc decimated to 10 % had 26 faces upside down).
+            sub(a, from, ea); sub(b, from, eb); cross(ea, eb, n_old);
+            const double old_edges2 = dot(ea, ea) + dot(eb, eb) + ab2;
+            sub(a, to, ea); sub(b, to, eb); cross(ea, eb, n_new);
+            const double new_edges2 = dot(ea, ea) + dot(eb, eb) + ab2;
+            const double old_len2 = dot(n_old, n_old), new_len2 = dot(n_new, n_new);
+            const bool was_degenerate = old_len2 <= kMinShapeQuality * old_edges2 * old_edges2 || old_len2 == 0;
+            const bool degenerate = new_len2 <= kMinShapeQuality * new_edges2 * new_edges2;
+            if (!visit(n_old, n_new, was_degenerate, degenerate)) return false;
+        }
+        return true;
     };
-    for (uint32_t c = buffer.vertex(v).first_corner; c != kNoIndex; c = buffer.next_corner(c)) {
-        const uint32_t f = face_of(c);
-        if (f == skip0 || f == skip1) continue;
-        double n_new[3], n_old[3];
-        bool was_degenerate, degenerate;
-        new_normal(c, n_new, n_old, was_degenerate, degenerate);
+    const bool turns_ok = each_face([&](const double* n_old, const double* n_new, bool was_degenerate, bool degenerate) {
         if (!was_degenerate) {
             if (degenerate) return false;
             // cos(turn) ≤ kMinNormalCos, without a square root.
@@ -90,13 +93,15 @@ bool moves_keep_faces_valid(const HalfEdgeBuffer& buffer, uint32_t v, const doub
             for (int i = 0; i < 3; ++i) fan[i] += n_old[i];
             largest_old2 = std::max(largest_old2, dot(n_old, n_old));
         } else if (degenerate) {
-            continue;  // nothing to preserve, and it must not block the mesh
+            return true;  // nothing to preserve, and it must not block the mesh
         }
         // Sound after the move (a degenerate face too: a sliver turned over must not become a
         // real face upside down): checked against the fan below.
         if (moved_count < kMaxMoved) std::copy(n_new, n_new + 3, moved[moved_count++]);
         else overflow = true;
-    }
+        return true;
+    });
+    if (!turns_ok) return false;
     // cos(angle to the fan's normal) > kMinFanCos, without a square root. A fan whose normals
     // nearly cancel (a knife edge, a thin plate's rim) has no direction to keep: then only the
     // per-face turn applies.
@@ -107,19 +112,11 @@ bool moves_keep_faces_valid(const HalfEdgeBuffer& buffer, uint32_t v, const doub
     };
     for (int i = 0; i < moved_count; ++i)
         if (!faces_fan(moved[i])) return false;
-    if (overflow) {
-        int seen = 0;
-        for (uint32_t c = buffer.vertex(v).first_corner; c != kNoIndex; c = buffer.next_corner(c)) {
-            const uint32_t f = face_of(c);
-            if (f == skip0 || f == skip1) continue;
-            double n_new[3], n_old[3];
-            bool was_degenerate, degenerate;
-            new_normal(c, n_new, n_old, was_degenerate, degenerate);
-            if (was_degenerate && degenerate) continue;
-            if (++seen > kMaxMoved && !faces_fan(n_new)) return false;
-        }
-    }
-    return true;
+    // The faces past `moved`'s size, met in the same order on a second walk.
+    int seen = 0;
+    return !overflow || each_face([&](const double*, const double* n_new, bool was_degenerate, bool degenerate) {
+        return (was_degenerate && degenerate) || ++seen <= kMaxMoved || faces_fan(n_new);
+    });
 }
 
 CollapsePlacement collapse_placement(const HalfEdgeBuffer& buffer, uint32_t h) {
