@@ -203,7 +203,7 @@ void run_decimate(const DecimateOptions& opt) {
     // triangle by triangle) leave every edge open: decimation then eats the surface from every
     // crack and still lands on its count. A mesh has far fewer open edges than triangles (a
     // strip one triangle wide about one per triangle); a soup has three. (A few loose triangles
-    // are no surface to warn about.)
+    // are no surface to warn about; an input without triangles: the filter's report says so.)
     if (s.triangles_in >= 100 && s.boundary_edges * 2 > s.triangles_in * 3)
         warnings.note(std::to_string(s.boundary_edges) + " edges had no partner, " +
                       std::to_string(s.boundary_edges / s.triangles_in) + "." +
