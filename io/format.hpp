@@ -31,9 +31,11 @@ struct MeshHeader {
     Channels channels;                       // channels the reader will fill
     std::string variant;                     // e.g. "binary", "ascii", "binary_big_endian"
     std::vector<std::pair<std::string, std::string>> notes;  // extra facts for `info`
+    // Set by readers of double coordinates (PLY) once they are read: the largest change that
+    // rounding them to float made (0: none). The commands warn when it is above 0.
+    std::optional<double> coordinate_rounding;
 };
-// The note a reader adds when it rounded the file's double coordinates to float (PLY): the
-// commands repeat it as a warning when anything moved.
+// The note such a reader adds for `info`, saying the same in words.
 inline constexpr const char* kPrecisionNote = "coordinates";
 
 class Reader {

@@ -557,6 +557,7 @@ private:
                 text += ")";
             }
             header_.notes.emplace_back(kPrecisionNote, text);
+            header_.coordinate_rounding = static_cast<float>(worst_rounding);  // as the note prints it
         }
     }
 

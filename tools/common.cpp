@@ -49,8 +49,9 @@ CLI::Validator format_name(bool for_writing) {
 }  // namespace
 
 void note_input_changes(const io::MeshHeader& header, const std::string& input_name, Warnings& warnings) {
+    if (header.coordinate_rounding.value_or(0) <= 0) return;
     for (const auto& [key, text] : header.notes)
-        if (key == io::kPrecisionNote && !text.ends_with("up to 0"))
+        if (key == io::kPrecisionNote)
             warnings.note(input_name + ": coordinates are " + text + "; meshstream works in float (32-bit)");
 }
 

@@ -175,12 +175,17 @@ TEST(PlyReader, DoubleCoordinatesRoundedToFloatAreNoted) {
     test::Soup utm = read_soup(dir / "utm.ply");
     EXPECT_EQ(utm.xyz[1], 4000000.0f);
     EXPECT_EQ(note(utm), "double, rounded to float: moved by up to 0.12 (at 4000000.12)");
+    EXPECT_EQ(utm.header.coordinate_rounding, double(0.12f));
     test::spit(dir / "exact.ply", header + "0 0 0\n1 0 0\n0 1 0.5\n3 0 1 2\n");
-    EXPECT_EQ(note(read_soup(dir / "exact.ply")), "double, rounded to float: moved by up to 0");
+    const test::Soup exact = read_soup(dir / "exact.ply");
+    EXPECT_EQ(note(exact), "double, rounded to float: moved by up to 0");
+    EXPECT_EQ(exact.header.coordinate_rounding, 0.0);
     test::spit(dir / "float.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
                                   "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
                                   "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
-    EXPECT_EQ(note(read_soup(dir / "float.ply")), "<none>");
+    const test::Soup single = read_soup(dir / "float.ply");
+    EXPECT_EQ(note(single), "<none>");
+    EXPECT_FALSE(single.header.coordinate_rounding.has_value());
 }
 
 TEST(PlyReader, AnyCoordinateTypeAndElementsAroundVertexAndFace) {
