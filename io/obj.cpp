@@ -20,6 +20,10 @@ namespace {
 
 constexpr std::string_view kSortMarker = "meshstream sorted-axis=";
 
+constexpr const char* kCarriageReturnOnly =
+    "carriage return inside a line: lines ending in CR alone (classic Mac OS) are not supported "
+    "(tr '\\r' '\\n' converts them)";
+
 bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
 
 // Splits off the next blank-separated word of `rest`.
@@ -88,6 +92,7 @@ private:
             }
             if (!nl && w.size() >= ByteSource::kBufferBytes) {
                 line_no_ = physical_lines_ + 1;
+                if (std::memchr(p, '\r', w.size())) fail(kCarriageReturnOnly);
                 fail("line longer than 1 MiB");
             }
             size_t len = nl ? static_cast<size_t>(static_cast<const char*>(nl) - p) : w.size();
@@ -95,6 +100,9 @@ private:
             src_.consume(nl ? len + 1 : len);
             ++physical_lines_;
             while (!view.empty() && is_space(view.back())) view.remove_suffix(1);
+            // A CR inside a line: a file whose lines end in CR alone would otherwise read as one
+            // line (its first statement only).
+            if (std::memchr(view.data(), '\r', view.size())) fail(kCarriageReturnOnly);
             if (!view.empty() && view.back() == '\\') {  // continuation: join with the next line
                 view.remove_suffix(1);
                 scratch_.append(view);
@@ -128,6 +136,13 @@ private:
             if (key == "v") {
                 float xyz[3];
                 for (int a = 0; a < 3; ++a) xyz[a] = parse_float(next_word(rest), a);
+                // What may follow x y z: w, colour (r g b), or both; numbers only, so that a
+                // lost line end ("v 0 0 0 v 1 0 0") is an error instead of a dropped vertex.
+                int extra = 0;
+                for (std::string_view tok = next_word(rest); !tok.empty(); tok = next_word(rest), ++extra)
+                    parse_number(tok, "a number (w or colour) after 'v x y z'");
+                if (extra == 2 || extra > 4)
+                    fail("'v' with " + std::to_string(3 + extra) + " numbers (x y z, then w and/or r g b)");
                 table_.append(xyz, nullptr);
                 continue;
             }
@@ -155,13 +170,17 @@ private:
 
     float parse_float(std::string_view tok, int axis) const {
         if (tok.empty()) fail("'v' needs 3 coordinates, found " + std::to_string(axis));
+        return parse_number(tok, "a coordinate");
+    }
+
+    float parse_number(std::string_view tok, const char* what) const {
         const char* b = tok.data();
         const char* e = b + tok.size();
         if (*b == '+') ++b;
         float v = 0;
         auto [p, ec] = std::from_chars(b, e, v);
         if (ec == std::errc::result_out_of_range) v = std::strtof(std::string(tok).c_str(), nullptr);
-        else if (ec != std::errc() || p != e) fail("expected a coordinate, found " + quote_token(tok));
+        else if (ec != std::errc() || p != e) fail(std::string("expected ") + what + ", found " + quote_token(tok));
         return v;
     }
 

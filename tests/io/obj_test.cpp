@@ -179,6 +179,14 @@ TEST(ObjReader, BadInputNamesFileLineAndOffset) {
         {head + "v 1 2\n", "'v' needs 3 coordinates, found 2", 4, head.size()},
         {head + "f 1 2 a/1\n", "expected a vertex index, found 'a/1'", 4, head.size()},
         {head + "f 1 \\\n 2 \\\n 9\n", "vertex index 9 refers past", 4, head.size()},
+        // Anything after x y z but w and r g b: a lost line end used to drop the second vertex
+        // (and shift every later index), junk was ignored.
+        {head + "v 0 0 0 v 1 0 0\nf 1 2 3\n", "expected a number (w or colour) after 'v x y z', found 'v'", 4, head.size()},
+        {head + "v 0 0 0 foo\n", "found 'foo'", 4, head.size()},
+        {head + "v 1 2 3 4 5\n", "'v' with 5 numbers (x y z, then w and/or r g b)", 4, head.size()},
+        {head + "v 1 2 3 4 5 6 7 8\n", "'v' with 8 numbers", 4, head.size()},
+        // Lines ending in CR alone read as one line: they used to give its first vertex only.
+        {"v 0 0 0\rv 1 0 0\rv 0 1 0\rf 1 2 3\r", "lines ending in CR alone", 1, 0},
     };
     for (const Case& c : cases) {
         SCOPED_TRACE(c.message);
