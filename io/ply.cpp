@@ -215,6 +215,11 @@ private:
                 } else {
                     bad("expected 'property <type> <name>' or 'property list <count type> <type> <name>'");
                 }
+                // Which x is meant when there are two? (The last one used to win silently.)
+                for (const Property& before : elements_.back().props)
+                    if (before.name == prop.name)
+                        bad("property " + quote_token(prop.name) + " declared twice in element " +
+                            quote_token(elements_.back().name));
                 elements_.back().props.push_back(std::move(prop));
             } else {
                 bad("unknown keyword " + quote_token(key));

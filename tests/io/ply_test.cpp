@@ -434,7 +434,11 @@ TEST(PlyReader, BadInputNamesFileElementItemAndOffset) {
              {"ply\nformat ascii 1.0\nelement vertex 1\nproperty float128 x\nend_header\n", "unknown property type"},
              {"ply\nformat ascii 1.0\nelement face 1\nproperty list uchar int vertex_indices\nelement vertex 3\n"
               "property float x\nproperty float y\nproperty float z\nend_header\n",
-              "face element before the vertex element"}}) {
+              "face element before the vertex element"},
+             // Which x is meant? The last one used to win silently.
+             {"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n"
+              "property float x\nend_header\n0 0 0 9\n",
+              "property 'x' declared twice in element 'vertex'"}}) {
         test::spit(dir / "hdr.ply", bytes);
         EXPECT_NE(read_error(dir / "hdr.ply").message().find(message), std::string::npos) << message;
     }
