@@ -15,6 +15,7 @@
 #include <cassert>
 #include <charconv>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <string>
 #include <string_view>
@@ -232,12 +233,10 @@ bool parse_float(std::string_view token, float& out) {
     }
     auto [ptr, ec] = std::from_chars(first, last, out);
     if (ec == std::errc::result_out_of_range) {
-        // Below float's range (e.g. 1e-50): round through double to 0 or a denormal.
-        double wide = 0;
-        auto result = std::from_chars(first, last, wide);
-        if (result.ec != std::errc()) return false;
-        out = static_cast<float>(wide);
-        ptr = result.ptr;
+        // Past float's range: 1e-50 is 0 (or a denormal), 1e400 infinite, as in the OBJ and
+        // PLY readers (which then count the triangle as non-finite); 1e400 used to be "not a
+        // number" here alone.
+        out = std::strtof(std::string(first, last).c_str(), nullptr);
         ec = std::errc();
     }
     return ec == std::errc() && ptr == last;

@@ -448,8 +448,8 @@ TEST(StlReader, AsciiBadInputNamesLine) {
          "bad.stl:6: expected 'vertex', found 'endloop'"},
         {"solid x\nfacet normal 0 0 1 7 8\nouter loop\n", "bad.stl:2: expected 'outer', found '7'"},
         {"solid x\nfacet normal 0 0 1\nouter loop\nvertex 1 +-2 3\n", "bad.stl:4: expected a number, found '+-2'"},
-        {"solid x\nfacet normal 0 0 1\nouter loop\nvertex 1 2 1e999\n",
-         "bad.stl:4: expected a number, found '1e999'"},
+        {"solid x\nfacet normal 0 0 1\nouter loop\nvertex 1 2 1e999z\n",
+         "bad.stl:4: expected a number, found '1e999z'"},
         {"solid x\nfacet normal 0 0 1\nouter\n", "bad.stl:4: expected 'loop', found end of file"},
         // Every facet complete but no endsolid: a cut file, not a shorter mesh.
         {"solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\n",
@@ -490,6 +490,14 @@ TEST(StlReader, AsciiAcceptsCaseWhitespaceSignsAndSeveralSolids) {
     EXPECT_EQ(mesh.header.notes.at(0).second, "Part One");
     // A hex-looking token is not a decimal number.
     EXPECT_THROW(read_memory("solid x\nfacet normal\nouter loop\nvertex 0x1 0 0\n", "hex.stl", true), io::Error);
+    // Past float's range is infinite, as in OBJ and PLY (1e400 used to be "not a number" here,
+    // while 1e39 was read as inf); the commands then count the triangle as non-finite.
+    Mesh huge = read_memory("solid x\nfacet normal 0 0 0\nouter loop\nvertex 1e400 -1e999 1e39\nvertex 0 0 0\n"
+                            "vertex 1 1 1\nendloop\nendfacet\nendsolid\n",
+                            "huge.stl", true);
+    const float inf = std::numeric_limits<float>::infinity();
+    EXPECT_EQ(std::vector<float>(huge.xyz.begin(), huge.xyz.begin() + 3), (std::vector<float>{inf, -inf, inf}));
+    EXPECT_THROW(read_memory("solid x\nfacet normal\nouter loop\nvertex 1e400x 0 0\n", "junk.stl", true), io::Error);
 }
 
 TEST(StlReader, LineLongerThanTheBufferFailsLoudly) {
