@@ -816,9 +816,13 @@ AccessorView GltfReader::view(int accessor, const std::string& what) const {
     const size_t elem = csize * v.components;
     v.stride = bv.byteStride ? bv.byteStride : elem;
     uint64_t end = uint64_t{bv.byteOffset} + a.byteOffset + (a.count ? (a.count - 1) * uint64_t{v.stride} + elem : 0);
-    if (bv.byteOffset + bv.byteLength > data.size() || end > bv.byteOffset + bv.byteLength)
+    if (uint64_t{bv.byteOffset} + bv.byteLength > data.size())
+        throw Error(name_, where_acc + ": bufferView " + std::to_string(a.bufferView) + " ends at byte " +
+                               std::to_string(uint64_t{bv.byteOffset} + bv.byteLength) + ", past the end of buffer " +
+                               std::to_string(bv.buffer) + " (" + std::to_string(data.size()) + " bytes)");
+    if (end > uint64_t{bv.byteOffset} + bv.byteLength)
         throw Error(name_, where_acc + " reaches byte " + std::to_string(end) + " of a buffer view ending at " +
-                               std::to_string(std::min<uint64_t>(bv.byteOffset + bv.byteLength, data.size())));
+                               std::to_string(uint64_t{bv.byteOffset} + bv.byteLength));
     v.base = data.data() + bv.byteOffset + a.byteOffset;
     return v;
 }

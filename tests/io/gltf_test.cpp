@@ -216,6 +216,20 @@ TEST(GltfReader, RefusesAccessorsOutsideTheirBufferView) {
     EXPECT_NE(what.find("mesh 0 'tri' primitive 0 POSITION (accessor 0) reaches byte 72"), std::string::npos) << what;
 }
 
+TEST(GltfReader, NamesABufferViewPastTheEndOfItsBuffer) {
+    // The message used to clamp the view's end to the buffer: "reaches byte 36 of a buffer view
+    // ending at 36".
+    TempDir dir;
+    const float tri[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    std::ofstream(dir / "v.bin", std::ios::binary).write(reinterpret_cast<const char*>(tri), sizeof tri);
+    std::ofstream(dir / "v.gltf") << R"({"asset":{"version":"2.0"},"buffers":[{"uri":"v.bin","byteLength":36}],)"
+                                  << R"("bufferViews":[{"buffer":0,"byteLength":400}],)"
+                                  << R"("accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3"}],)"
+                                  << R"("meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],"nodes":[{"mesh":0}]})";
+    std::string what = error_of(dir / "v.gltf");
+    EXPECT_NE(what.find("bufferView 0 ends at byte 400, past the end of buffer 0 (36 bytes)"), std::string::npos) << what;
+}
+
 TEST(GltfReader, RefusesTruncatedGlbAtEveryLength) {
     TempDir dir;
     std::string bytes = slurp(fixture("gltf/BoxTextured_draco_transcoder.glb"));
