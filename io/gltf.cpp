@@ -488,6 +488,7 @@ struct PrimitiveGeometry {
 struct Instance {
     double matrix[16];  // column-major world transform
     int mesh;
+    const std::vector<double>* weights;  // morph target weights: the node's, else the mesh's
 };
 
 void mat_mul(const double* a, const double* b, double* out) {
@@ -728,6 +729,7 @@ void GltfReader::collect_instances() {
             Instance inst;
             std::memcpy(inst.matrix, identity, sizeof identity);
             inst.mesh = static_cast<int>(m);
+            inst.weights = &model_.meshes[m].weights;
             instances_.push_back(inst);
         }
         return;
@@ -755,6 +757,7 @@ void GltfReader::visit(int node, const double* parent, int depth) {
         static constexpr double kIdentity[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
         std::memcpy(inst.matrix, n.skin >= 0 ? kIdentity : world, sizeof world);
         inst.mesh = n.mesh;
+        inst.weights = n.weights.empty() ? &model_.meshes[n.mesh].weights : &n.weights;
         instances_.push_back(inst);
     }
     for (int child : n.children) visit(child, world, depth + 1);
@@ -928,9 +931,32 @@ void GltfReader::load_current() {
     // A mirroring transform reverses the winding (glTF 2.0 §3.7.4); swap two corners back.
     flip_ = det3(m) < 0;
     const auto& src = current_->positions;
+    // Morph targets at the default weights (glTF 2.0 §3.7.2.2): the pose a viewer shows.
+    std::vector<double> morphed;
+    const tinygltf::Primitive& p = model_.meshes[inst.mesh].primitives[prim_];
+    for (size_t t = 0; t < p.targets.size() && t < inst.weights->size(); ++t) {
+        const double w = (*inst.weights)[t];
+        auto target = p.targets[t].find("POSITION");
+        if (w == 0 || target == p.targets[t].end()) continue;
+        const std::string at = where(inst.mesh, static_cast<int>(prim_)) + " morph target " + std::to_string(t);
+        if (is_draco(p)) {  // Draco reorders the vertices the target's displacements refer to
+            std::string weight;
+            append_number(weight, w);
+            throw Error(name_, at + " has weight " + weight +
+                                   ": morph targets of KHR_draco_mesh_compression primitives are not supported");
+        }
+        const AccessorView d = view(target->second, at + " POSITION");
+        if (d.components != 3 || d.count != src.size() / 3)
+            throw Error(name_, at + " POSITION must be VEC3 with as many elements as POSITION (" +
+                                   std::to_string(src.size() / 3) + ")");
+        if (morphed.empty()) morphed.assign(src.begin(), src.end());
+        for (size_t i = 0; i < d.count; ++i)
+            for (int c = 0; c < 3; ++c) morphed[3 * i + c] += w * d.get(i, c);
+    }
     world_.resize(src.size());
     for (size_t i = 0; i < src.size(); i += 3) {
         double x = src[i], y = src[i + 1], z = src[i + 2];
+        if (!morphed.empty()) x = morphed[i], y = morphed[i + 1], z = morphed[i + 2];
         for (int r = 0; r < 3; ++r) world_[i + r] = static_cast<float>(m[r] * x + m[4 + r] * y + m[8 + r] * z + m[12 + r]);
     }
     tri_ = 0;

@@ -216,6 +216,43 @@ TEST(GltfReader, RefusesAccessorsOutsideTheirBufferView) {
     EXPECT_NE(what.find("mesh 0 'tri' primitive 0 POSITION (accessor 0) reaches byte 72"), std::string::npos) << what;
 }
 
+TEST(GltfReader, AppliesMorphTargetsAtTheirDefaultWeights) {
+    // A viewer shows base + Σ weight·target; the mesh's weights are the default, a node's
+    // replace them. The targets used to be ignored (z = 0 below, with no word said).
+    TempDir dir;
+    const float data[18] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 5, 0, 0, 5, 2, 0, 5};
+    std::ofstream(dir / "m.bin", std::ios::binary).write(reinterpret_cast<const char*>(data), sizeof data);
+    auto write = [&](const std::string& nodes) {
+        std::ofstream(dir / "m.gltf")
+            << R"({"asset":{"version":"2.0"},"buffers":[{"uri":"m.bin","byteLength":72}],)"
+            << R"("bufferViews":[{"buffer":0,"byteLength":36},{"buffer":0,"byteOffset":36,"byteLength":36}],)"
+            << R"("accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3"},)"
+            << R"({"bufferView":1,"componentType":5126,"count":3,"type":"VEC3"}],)"
+            << R"("meshes":[{"primitives":[{"attributes":{"POSITION":0},"targets":[{"POSITION":1}]}],"weights":[1.0]}],)"
+            << R"("nodes":)" << nodes << R"(,"scenes":[{"nodes":[0]}],"scene":0})";
+    };
+    write(R"([{"mesh":0}])");
+    EXPECT_EQ(read_soup(dir / "m.gltf").xyz, (std::vector<float>{0, 0, 5, 1, 0, 5, 2, 1, 5}));
+    write(R"([{"mesh":0,"weights":[0.5],"translation":[0,0,1]}])");
+    EXPECT_EQ(read_soup(dir / "m.gltf").xyz, (std::vector<float>{0, 0, 3.5, 1, 0, 3.5, 1, 1, 3.5}));
+    write(R"([{"mesh":0,"weights":[0]}])");
+    EXPECT_EQ(read_soup(dir / "m.gltf").xyz, (std::vector<float>{0, 0, 0, 1, 0, 0, 0, 1, 0}));
+
+    // Draco reorders vertices, so a target cannot be matched to them: refused by name.
+    const std::string engine = fixture("gltf/2CylinderEngine_draco/2CylinderEngine");
+    std::filesystem::copy_file(engine + ".bin", dir / "2CylinderEngine.bin");
+    json doc = json::parse(slurp(engine + ".gltf"));
+    json& prim = doc["meshes"][0]["primitives"][0];
+    prim["targets"] = json::array({{{"POSITION", prim["attributes"]["POSITION"]}}});
+    doc["meshes"][0]["weights"] = json::array({0.25});
+    std::ofstream(dir / "engine.gltf") << doc.dump();
+    const std::string what = error_of(dir / "engine.gltf");
+    EXPECT_NE(what.find("primitive 0 morph target 0 has weight 0.25: morph targets of KHR_draco_mesh_compression "
+                        "primitives are not supported"),
+              std::string::npos)
+        << what;
+}
+
 TEST(GltfReader, NamesABufferViewPastTheEndOfItsBuffer) {
     // The message used to clamp the view's end to the buffer: "reaches byte 36 of a buffer view
     // ending at 36".
