@@ -55,7 +55,11 @@ void note_input_changes(const io::MeshHeader& header, const std::string& input_n
             warnings.note(input_name + ": coordinates are " + text + "; meshstream works in float (32-bit)");
 }
 
-void note_unused_write_flags(const WriteFlags& flags, const io::Format& output, Warnings& warnings) {
+void note_unused_write_flags(const WriteFlags& flags, const io::Format& output, const std::string& output_path,
+                             Warnings& warnings) {
+    if (flags.gzip_level != WriteFlags{}.gzip_level && (output_path == "-" || !io::wants_gzip(output_path)))
+        warnings.note("--gzip-level applies to outputs named *.gz: ignored for " +
+                      (output_path == "-" ? std::string("<stdout> (pipe it through gzip)") : output_path));
     if (output.traits & (io::Format::kAlwaysDraco | io::Format::kDracoUnlessOff)) {
         if ((output.traits & io::Format::kAlwaysDraco) && !flags.draco)
             warnings.note("--no-draco applies to glTF outputs; a .drc is Draco");

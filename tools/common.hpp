@@ -54,8 +54,10 @@ void add_write_flags(CLI::App* cmd, WriteFlags& flags);
 // extension is no writable format.
 void require_output_format(const std::string& output, const WriteFlags& flags);
 class Warnings;
-// Notes Draco/glTF options given for an output of another format (they do nothing there).
-void note_unused_write_flags(const WriteFlags& flags, const io::Format& output, Warnings& warnings);
+// Notes Draco/glTF options given for an output of another format, and --gzip-level for an
+// output not named *.gz (they do nothing there).
+void note_unused_write_flags(const WriteFlags& flags, const io::Format& output, const std::string& output_path,
+                             Warnings& warnings);
 // Repeats as warnings what the reader noted that changes the data (double coordinates rounded).
 void note_input_changes(const io::MeshHeader& header, const std::string& input_name, Warnings& warnings);
 

@@ -51,7 +51,7 @@ void run_convert(const ConvertOptions& opt) {
     out.finish();
     progress.done();
     Warnings warnings;
-    note_unused_write_flags(opt.write, *out.format, warnings);
+    note_unused_write_flags(opt.write, *out.format, opt.output, warnings);
     for (const std::string& note : out.writer->notes()) warnings.note(note);
     if (header.channels.color && !(out.format->traits & io::Format::kWritesColour))
         warnings.note("the input's vertex colours are not written: " + std::string(out.format->name) +

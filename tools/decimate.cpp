@@ -12,6 +12,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <map>
 #include <memory>
 #include <new>
@@ -72,6 +73,12 @@ void run_decimate(const DecimateOptions& opt) {
                                                   : (opt.output == "-" ? "<stdout>" : opt.output);
             throw UsageError(name + ": --report needs to re-read both files; it does not work with '-' or a pipe");
         }
+        // Replaced in place, the input is gone when the comparison reads it: the output would be
+        // compared with itself (an error of 0).
+        std::error_code ec;
+        if (std::filesystem::equivalent(opt.input, opt.output, ec))
+            throw UsageError(opt.output + ": --report compares the output against the input, which this output "
+                             "replaces: write the output to another file");
     }
     io::Input in = io::open_input(opt.input, opt.read.from, opt.read.options());
     const io::MeshHeader& header = in.reader->header();
@@ -163,7 +170,10 @@ void run_decimate(const DecimateOptions& opt) {
     Warnings warnings;
     char ratio_text[32];
     std::snprintf(ratio_text, sizeof ratio_text, "%.6g", decimator.ratio());
-    note_unused_write_flags(opt.write, *out.format, warnings);
+    // The command that judges this run's buffer (info assumes the default one).
+    const std::string order_command = "`meshstream info --order --ratio " + std::string(ratio_text) +
+                                      (opt.buffer != DecimateOptions{}.buffer ? " --buffer " + std::to_string(opt.buffer) : "") + "`";
+    note_unused_write_flags(opt.write, *out.format, opt.output, warnings);
     for (const std::string& note : out.writer->notes()) warnings.note(note);
     filter.report(warnings);
     note_input_changes(in.reader->header(), in.source->name(), warnings);
@@ -179,11 +189,10 @@ void run_decimate(const DecimateOptions& opt) {
                                 "read later at those positions are not joined to them (the output has cracks there)"
                           : std::string()) +
                      (options.sorted_axis && s.sort_violations == 0
-                          ? "; the input is sorted, so the buffer is too small for it at this ratio: raise --buffer "
-                            "(`meshstream info --order --ratio " + std::string(ratio_text) + "` estimates the buffer it needs)"
+                          ? "; the input is sorted, so the buffer is too small for it at this ratio: raise --buffer (" +
+                                order_command + " estimates the buffer it needs)"
                           : "; either the input is not in streaming order (run `meshstream sort` on it first) or the "
-                            "buffer is too small for it at this ratio (raise --buffer): `meshstream info --order "
-                            "--ratio " + std::string(ratio_text) + "` tells which"));
+                            "buffer is too small for it at this ratio (raise --buffer): " + order_command + " tells which"));
     if (s.sort_violations > 0)
         warnings.note(std::string("the input is not sorted along ") + "xyz"[*options.sorted_axis] +
                      " as stated: " + std::to_string(s.sort_violations) +

@@ -290,7 +290,7 @@ void run_sort(const SortOptions& opt) {
     out.finish();
     progress.done();
     Warnings warnings;
-    note_unused_write_flags(opt.write, *out.format, warnings);
+    note_unused_write_flags(opt.write, *out.format, opt.output, warnings);
     filter.report(warnings);
     note_input_changes(header, input_name, warnings);
     warnings.print();

@@ -127,6 +127,31 @@ TEST(CliBadInput, DecimateReportWithAPipeIsRefusedBeforeAnyOutput) {
     CliRun w = run("decimate --report -r 0.5 --to stl " + dir / "in.stl" + " -");
     EXPECT_EQ(w.code, 2) << w.err;
     EXPECT_EQ(w.err.rfind("meshstream: error: <stdout>: --report", 0), 0u) << w.err;
+    // An output that replaces the input, by name or through a link: the comparison would read
+    // the output twice and report an error of 0.
+    const std::string before = slurp(dir / "in.stl");
+    fs::create_symlink(dir / "in.stl", dir / "link.stl");
+    for (const std::string out : {"in.stl", "link.stl"}) {
+        CliRun same = run("decimate --report -r 0.5 " + dir / "in.stl" + " " + dir / out);
+        EXPECT_EQ(same.code, 2) << same.err;
+        EXPECT_NE(same.err.find(": --report compares the output against the input, which this output replaces"),
+                  std::string::npos) << same.err;
+        EXPECT_EQ(slurp(dir / "in.stl"), before);
+    }
+}
+
+// Write options that do nothing for the output are named, not dropped in silence.
+TEST(CliBadInput, GzipLevelForAnOutputThatIsNotGzipIsNoted) {
+    TempDir dir;
+    write_file(dir / "in.stl", binary_stl(grid(4)));
+    CliRun r = run("convert --gzip-level 9 " + dir / "in.stl" + " " + dir / "out.stl");
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.err.find("warning: --gzip-level applies to outputs named *.gz: ignored for " + dir / "out.stl"),
+              std::string::npos) << r.err;
+    CliRun piped = run("convert --gzip-level 1 --to stl " + dir / "in.stl" + " - > " + dir / "piped.stl");
+    EXPECT_NE(piped.err.find("ignored for <stdout> (pipe it through gzip)"), std::string::npos) << piped.err;
+    CliRun gz = run("convert --gzip-level 9 " + dir / "in.stl" + " " + dir / "out.stl.gz");
+    EXPECT_EQ(gz.err.find("--gzip-level"), std::string::npos) << gz.err;
 }
 
 namespace {
@@ -229,7 +254,8 @@ TEST(CliBadInput, ForcedWritesEndWithAWarningThatAdvisesSort) {
                         "those positions are not joined to them (the output has cracks there)"),
               std::string::npos) << line;
     EXPECT_NE(line.find("either the input is not in streaming order (run `meshstream sort` on it first) or the buffer is "
-                        "too small for it at this ratio (raise --buffer): `meshstream info --order --ratio 0.1` tells which"),
+                        "too small for it at this ratio (raise --buffer): `meshstream info --order --ratio 0.1 --buffer 64` "
+                        "tells which"),
               std::string::npos) << line;
     EXPECT_NE(line.back(), ')') << line;  // no event count appended
 
@@ -239,7 +265,7 @@ TEST(CliBadInput, ForcedWritesEndWithAWarningThatAdvisesSort) {
     CliRun s = run("decimate --buffer 40 --sorted-axis y -r 0.1 " + dir / "rows.stl" + " " + dir / "out2.stl");
     EXPECT_EQ(s.code, 0) << s.err;
     EXPECT_NE(s.err.find("; the input is sorted, so the buffer is too small for it at this ratio: raise --buffer "
-                         "(`meshstream info --order --ratio 0.1` estimates the buffer it needs)"),
+                         "(`meshstream info --order --ratio 0.1 --buffer 40` estimates the buffer it needs)"),
               std::string::npos) << s.err;
     EXPECT_EQ(s.err.find("run `meshstream sort`"), std::string::npos) << s.err;
 }
