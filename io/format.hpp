@@ -37,6 +37,11 @@ struct MeshHeader {
 };
 // The note such a reader adds for `info`, saying the same in words.
 inline constexpr const char* kPrecisionNote = "coordinates";
+// The note a text reader adds when the file's last line has no line end, as when a download or
+// a pipe was cut inside the last number ("f 10 11 1" from "f 10 11 12"), which no count or
+// syntax can show. The commands repeat it as a warning.
+inline constexpr const char* kLastLineNote = "last line";
+inline constexpr const char* kLastLineText = "has no line end: the file may be cut short inside it";
 
 class Reader {
 public:

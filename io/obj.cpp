@@ -75,7 +75,13 @@ private:
         for (;;) {
             auto w = src_.window();
             if (w.empty()) {
-                if (!joined) return false;
+                if (!joined) {
+                    if (unterminated_ && !noted_unterminated_) {
+                        header_.notes.emplace_back(kLastLineNote, kLastLineText);
+                        noted_unterminated_ = true;
+                    }
+                    return false;
+                }
                 line_ = scratch_;
                 return true;
             }
@@ -100,6 +106,7 @@ private:
             src_.consume(nl ? len + 1 : len);
             ++physical_lines_;
             while (!view.empty() && is_space(view.back())) view.remove_suffix(1);
+            unterminated_ = !nl && !view.empty();
             // A CR inside a line: a file whose lines end in CR alone would otherwise read as one
             // line (its first statement only).
             if (std::memchr(view.data(), '\r', view.size())) fail(kCarriageReturnOnly);
@@ -216,6 +223,7 @@ private:
     std::string scratch_;
     std::string_view line_;
     uint64_t line_no_ = 0, physical_lines_ = 0, line_offset_ = 0;
+    bool unterminated_ = false, noted_unterminated_ = false;  // the last line read had no '\n'
     std::vector<uint64_t> polygon_;
     PolygonScratch polygon_scratch_;
     size_t polygon_next_ = 0;  // next triangle of polygon_ to emit

@@ -614,15 +614,24 @@ private:
 
     // When the faces are the last element, anything but blanks after them is data the header
     // does not count: its face count is short (issue 7; it used to be ignored silently).
+    // In ASCII, no line end after the last face is noted: a cut inside its last index ("3 9 10 1"
+    // of "3 9 10 11") is otherwise a valid file.
     void reject_trailing_data() {
-        if (face_ < 0 || static_cast<size_t>(face_) + 1 != elements_.size()) return;
+        if (face_ < 0 || static_cast<size_t>(face_) + 1 != elements_.size() || trailing_checked_) return;
+        trailing_checked_ = true;
+        bool line_end = false;
         for (;;) {
             auto w = src_.window();
-            if (w.empty()) return;
+            if (w.empty()) {
+                if (encoding_ == Encoding::kAscii && item_ > 0 && !line_end)
+                    header_.notes.emplace_back(kLastLineNote, kLastLineText);
+                return;
+            }
             const char* p = reinterpret_cast<const char*>(w.data());
             for (size_t i = 0; i < w.size(); ++i) {
                 if (p[i] == '\n') {
                     ++line_;
+                    line_end = true;
                 } else if (!is_blank(p[i])) {
                     src_.consume(i);
                     item_fail(src_.offset(), "data after the last of the " + std::to_string(item_) +
@@ -638,6 +647,7 @@ private:
     Encoding encoding_ = Encoding::kAscii;
     bool swap_ = false;
     uint64_t line_ = 0;  // lines consumed (header; ascii body)
+    bool trailing_checked_ = false;
     std::vector<Element> elements_;
     int vertex_ = -1, face_ = -1, index_prop_ = -1;
     int vertex_props_[6] = {-1, -1, -1, -1, -1, -1};  // x y z red green blue

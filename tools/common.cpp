@@ -49,6 +49,9 @@ CLI::Validator format_name(bool for_writing) {
 }  // namespace
 
 void note_input_changes(const io::MeshHeader& header, const std::string& input_name, Warnings& warnings) {
+    for (const auto& [key, text] : header.notes)
+        if (key == io::kLastLineNote)
+            warnings.note(input_name + ": the last line " + text + " (a truncated download or pipe?): check its last face");
     if (header.coordinate_rounding.value_or(0) <= 0) return;
     for (const auto& [key, text] : header.notes)
         if (key == io::kPrecisionNote)

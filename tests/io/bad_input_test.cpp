@@ -269,6 +269,39 @@ TEST(BadInput, TruncatedObjReadsFewerTrianglesOrThrows) {
     }
 }
 
+// A cut inside the last index of a text file ("f 10 11 1" of "f 10 11 12") is a valid file
+// with a wrong last triangle; only the missing line end shows it, so the reader notes that.
+TEST(BadInput, TextFileCutInsideItsLastIndexIsNoted) {
+    const std::string vertices = "0 0 0\n1 0 0\n0 1 0\n5 5 5\n6 5 5\n5 6 5\n5 5 6\n6 6 6\n7 7 7\n10 10 10\n11 10 10\n10 11 10\n";
+    std::string obj;
+    for (size_t at = 0; at < vertices.size();) {
+        const size_t end = vertices.find('\n', at);
+        obj += "v " + vertices.substr(at, end + 1 - at);
+        at = end + 1;
+    }
+    obj += "f 1 2 3\nf 10 11 12\n";
+    const std::string ply = "ply\nformat ascii 1.0\nelement vertex 12\nproperty float x\nproperty float y\n"
+                            "property float z\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n" +
+                            vertices + "3 0 1 2\n3 9 10 11\n";
+    auto last_line_note = [](const char* format, const std::string& bytes) {
+        io::ByteSource source(std::make_unique<MemoryInput>(bytes, true), "cut");
+        std::unique_ptr<io::Reader> reader = io::find_format(format)->open_reader(source, {});
+        io::TriangleChunk chunk(5, reader->header().channels);
+        uint64_t n = 0;
+        while (reader->next(chunk)) n += chunk.size();
+        EXPECT_EQ(n, 2u) << format;  // the cut file is valid: counting cannot tell
+        for (const auto& [key, text] : reader->header().notes)
+            if (key == io::kLastLineNote) return text;
+        return std::string();
+    };
+    for (const auto& [format, full] : {std::pair{"obj", obj}, std::pair{"ply-ascii", ply}}) {
+        EXPECT_EQ(last_line_note(format, full), "") << format;
+        EXPECT_EQ(last_line_note(format, full.substr(0, full.size() - 2)), io::kLastLineText) << format;
+        // A final line end is all it takes, with or without CR or blanks.
+        EXPECT_EQ(last_line_note(format, full.substr(0, full.size() - 1) + " \r\n"), "") << format;
+    }
+}
+
 // ---- header counts that lie, indices out of range ----
 
 TEST(BadInput, BinaryStlCountLyingEitherWayNamesByte84) {

@@ -140,6 +140,18 @@ TEST(CliBadInput, DecimateReportWithAPipeIsRefusedBeforeAnyOutput) {
     }
 }
 
+// A text file cut inside its last number reads as valid: the warning names the file.
+TEST(CliBadInput, TextInputWithoutAFinalLineEndIsWarnedAbout) {
+    TempDir dir;
+    write_file(dir / "cut.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4 3");
+    CliRun r = run("convert " + dir / "cut.obj" + " " + dir / "out.stl");
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.err.find("warning: " + dir / "cut.obj" +
+                         ": the last line has no line end: the file may be cut short inside it (a truncated download "
+                         "or pipe?): check its last face"),
+              std::string::npos) << r.err;
+}
+
 // Write options that do nothing for the output are named, not dropped in silence.
 TEST(CliBadInput, GzipLevelForAnOutputThatIsNotGzipIsNoted) {
     TempDir dir;
