@@ -89,14 +89,18 @@ void require_output_format(const std::string& output, const WriteFlags& flags) {
         throw UsageError(output + ": cannot tell the output format from the name (use --to, one of: " + format_names(true) + ")");
 }
 
+double physical_memory_bytes() {
+    const long pages = ::sysconf(_SC_PHYS_PAGES), page_bytes = ::sysconf(_SC_PAGESIZE);
+    return pages > 0 && page_bytes > 0 ? double(pages) * double(page_bytes) : 0;
+}
+
 io::ReadOptions ReadFlags::options() const {
     io::ReadOptions o;
     o.memory_budget_bytes = parse_bytes(memory);
     // Tables and sort runs reserve their share of the budget up front (untouched pages cost
     // nothing), so a budget past the machine's memory failed as a bare "out of memory" even on
     // a tiny input.
-    const long pages = ::sysconf(_SC_PHYS_PAGES), page_bytes = ::sysconf(_SC_PAGESIZE);
-    const double ram = pages > 0 && page_bytes > 0 ? double(pages) * double(page_bytes) : 0;
+    const double ram = physical_memory_bytes();
     if (ram > 0 && double(o.memory_budget_bytes) > ram)
         throw CLI::ValidationError("--memory", memory + " is more than this machine's memory (" + human_bytes(ram) +
                                                    "): give a smaller budget");

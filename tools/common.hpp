@@ -53,6 +53,8 @@ void add_write_flags(CLI::App* cmd, WriteFlags& flags);
 // Throws UsageError when no --to is given and `output` is stdout ("-") or a name whose
 // extension is no writable format.
 void require_output_format(const std::string& output, const WriteFlags& flags);
+// This machine's memory (0 when the system does not say).
+double physical_memory_bytes();
 class Warnings;
 // Notes Draco/glTF options given for an output of another format, and --gzip-level for an
 // output not named *.gz (they do nothing there).

@@ -10,6 +10,8 @@
 
 #include <cstdio>
 #include <memory>
+#include <optional>
+#include <string>
 
 namespace meshstream::tools {
 namespace {
@@ -38,13 +40,16 @@ nlohmann::ordered_json mesh_json(const MeshSummary& m) {
     return j;
 }
 
-nlohmann::ordered_json stats_json(const DistanceStats& s, double diagonal) {
-    auto pct = [&](double v) { return diagonal > 0 ? 100.0 * v / diagonal : 0.0; };
+// A direction without samples measured nothing: its figures are null, not 0; so are
+// percentages of a zero diagonal.
+nlohmann::ordered_json stats_json(const DistanceStats& s, double diagonal, bool measured) {
+    auto value = [&](double v) { return measured ? nlohmann::ordered_json(v) : nlohmann::ordered_json(); };
+    auto pct = [&](double v) { return diagonal > 0 ? value(100.0 * v / diagonal) : nlohmann::ordered_json(); };
     nlohmann::ordered_json j;
     j["samples"] = s.samples;
-    j["max"] = s.max;
-    j["mean"] = s.mean;
-    j["rms"] = s.rms;
+    j["max"] = value(s.max);
+    j["mean"] = value(s.mean);
+    j["rms"] = value(s.rms);
     j["max_pct"] = pct(s.max);
     j["mean_pct"] = pct(s.mean);
     j["rms_pct"] = pct(s.rms);
@@ -78,6 +83,13 @@ MeshSource source(const std::string& path, const ReadFlags& flags) {
 void run_compare(const CompareCliOptions& opt) {
     if (is_stream(opt.a) && is_stream(opt.b))
         throw UsageError("compare cannot read both A and B from stdin or pipes: one of them is read twice");
+    // The held mesh keeps every sample (about 50 bytes each): a count past memory would only
+    // fail after minutes of work, as a bare "out of memory".
+    const double sample_bytes = 50.0 * double(opt.samples.value_or(0)), ram = physical_memory_bytes();
+    if (ram > 0 && sample_bytes > ram)
+        throw UsageError("--samples " + std::to_string(*opt.samples) + ": the held mesh's samples alone take about " +
+                         human_bytes(sample_bytes) + " (50 bytes each), more than this machine's memory (" +
+                         human_bytes(ram) + ")");
     io::ReadOptions read = opt.read.options();
     CompareOptions co;
     co.samples = opt.samples;
@@ -97,19 +109,30 @@ void run_compare(const CompareCliOptions& opt) {
     progress.done();
 
     double diag = r.diagonal;
+    // A mesh of zero area (degenerate triangles only), or --samples too small for it, gets no
+    // samples: that direction is unmeasured, and the symmetric figures are the other one's.
+    Warnings warnings;
+    auto unsampled = [&](const MeshSummary& from, const char* direction) {
+        warnings.note(std::string("no samples on ") + from.name + " (" +
+                      (from.area > 0 ? "too few asked for: raise --samples" : "its triangles have no area") + "): " +
+                      direction + " is not measured, and the symmetric figures are the other direction's alone");
+    };
+    if (r.a_to_b.samples == 0) unsampled(r.a, "A -> B");
+    if (r.b_to_a.samples == 0) unsampled(r.b, "B -> A");
+    warnings.print();
     if (opt.json) {
         nlohmann::ordered_json j;
         j["a"] = mesh_json(r.a);
         j["b"] = mesh_json(r.b);
         j["seed"] = opt.seed;
-        j["a_to_b"] = stats_json(r.a_to_b, diag);
-        j["b_to_a"] = stats_json(r.b_to_a, diag);
+        j["a_to_b"] = stats_json(r.a_to_b, diag, r.a_to_b.samples > 0);
+        j["b_to_a"] = stats_json(r.b_to_a, diag, r.b_to_a.samples > 0);
         DistanceStats sym;
         sym.samples = r.a_to_b.samples + r.b_to_a.samples;
         sym.max = r.hausdorff();
         sym.mean = r.mean();
         sym.rms = r.rms();
-        nlohmann::ordered_json s = stats_json(sym, diag);
+        nlohmann::ordered_json s = stats_json(sym, diag, sym.samples > 0);
         s.erase("samples");
         j["symmetric"] = s;
         j["diagonal"] = diag;
@@ -128,16 +151,26 @@ void run_compare(const CompareCliOptions& opt) {
     mesh_line("A:", r.a);
     mesh_line("B:", r.b);
     std::printf("A bbox diagonal: %.9g (percentages below are of it)\n", diag);
-    auto pct = [&](double v) { return diag > 0 ? 100.0 * v / diag : 0.0; };
-    auto row = [&](const char* label, double max, double mean, double rms, uint64_t samples) {
-        std::printf("%-10s max %-12.6g (%8.5f%%)  mean %-12.6g (%8.5f%%)  rms %-12.6g (%8.5f%%)", label, max, pct(max), mean,
-                    pct(mean), rms, pct(rms));
-        if (samples) std::printf("  %llu samples", (unsigned long long)samples);
+    auto pct = [&](double v) {
+        char text[32];
+        if (diag > 0) std::snprintf(text, sizeof text, "%8.5f%%", 100.0 * v / diag);
+        else std::snprintf(text, sizeof text, "%9s", "n/a");  // a point: no size to relate to
+        return std::string(text);
+    };
+    auto row = [&](const char* label, double max, double mean, double rms, std::optional<uint64_t> samples) {
+        if (samples == 0u) {
+            std::printf("%-10s no samples: not measured\n", label);
+            return;
+        }
+        std::printf("%-10s max %-12.6g (%s)  mean %-12.6g (%s)  rms %-12.6g (%s)", label, max, pct(max).c_str(), mean,
+                    pct(mean).c_str(), rms, pct(rms).c_str());
+        if (samples) std::printf("  %llu samples", (unsigned long long)*samples);
         std::printf("\n");
     };
     row("A -> B", r.a_to_b.max, r.a_to_b.mean, r.a_to_b.rms, r.a_to_b.samples);
     row("B -> A", r.b_to_a.max, r.b_to_a.mean, r.b_to_a.rms, r.b_to_a.samples);
-    row("symmetric", r.hausdorff(), r.mean(), r.rms(), 0);
+    if (r.a_to_b.samples + r.b_to_a.samples == 0) row("symmetric", 0, 0, 0, 0);
+    else row("symmetric", r.hausdorff(), r.mean(), r.rms(), std::nullopt);
 }
 
 }  // namespace

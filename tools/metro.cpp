@@ -362,14 +362,16 @@ struct StatsAccumulator {
 };
 
 void grow_bounds(io::Bounds& b, const float* t, bool& first) {
+    if (first) {  // from the first corner only: each corner of the first triangle used to reset it
+        for (int a = 0; a < 3; ++a) b.min[a] = b.max[a] = t[a];
+        first = false;
+    }
     for (int v = 0; v < 3; ++v)
         for (int a = 0; a < 3; ++a) {
-            float x = t[3 * v + a];
-            if (first) b.min[a] = b.max[a] = x;
+            const float x = t[3 * v + a];
             b.min[a] = std::min(b.min[a], x);
             b.max[a] = std::max(b.max[a], x);
         }
-    first = false;
 }
 
 // Reads the whole of `source` through `fn(triangle_index, tri)` for finite triangles; fills

@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -15,6 +16,8 @@
 #include <sstream>
 #include <string>
 #include <vector>
+
+#include <unistd.h>
 
 namespace fs = std::filesystem;
 using namespace meshstream;
@@ -335,6 +338,15 @@ TEST(CompareCli, BadOptionExitsTwo) {
     EXPECT_EQ(r.exit_code, 2);
     r = run_cli(tmp.path, "compare a.stl");
     EXPECT_EQ(r.exit_code, 2);
+    // More samples than memory can hold: refused before any work (it used to fail after a
+    // minute and 12 GB as a bare "out of memory"). 2^32 samples take 215 GB.
+    if (double(::sysconf(_SC_PHYS_PAGES)) * double(::sysconf(_SC_PAGESIZE)) < 2e11) {
+        r = run_cli(tmp.path, "compare a.stl b.stl --samples 4294967296");
+        EXPECT_EQ(r.exit_code, 2);
+        EXPECT_NE(r.err.find("--samples 4294967296: the held mesh's samples alone take about 214.75 GB (50 bytes each), "
+                             "more than this machine's memory"),
+                  std::string::npos) << r.err;
+    }
 }
 
 TEST(CompareCli, JsonReportsBothDirectionsAndCounts) {
@@ -351,4 +363,39 @@ TEST(CompareCli, JsonReportsBothDirectionsAndCounts) {
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_NE(r.out.find("symmetric"), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("boundary edges 0"), std::string::npos) << r.out;
+}
+
+TEST(Metro, BoundsCountEveryCornerOfTheFirstTriangle) {
+    // A rhombus whose first triangle holds the extremes x = -1 and y = -1 in its first two
+    // corners: each corner of the first triangle used to restart the box, so only the third
+    // counted (box from x = 0, diagonal 2.236 instead of 2.828, every percentage 26 % high).
+    const std::vector<float> rhombus = {-1, 0, 0, 0, -1, 0, 0, 1, 0, 1, 0, 0, 0, 1, 0, 0, -1, 0};
+    std::vector<float> raised = rhombus;
+    for (size_t i = 2; i < raised.size(); i += 3) raised[i] = 0.1f;
+    CompareOptions options;
+    options.samples = 10'000;
+    const CompareResult r = compare_meshes(memory_source("a", rhombus), memory_source("b", raised), options);
+    EXPECT_EQ(r.a.bounds.min, (std::array<float, 3>{-1, -1, 0}));
+    EXPECT_EQ(r.a.bounds.max, (std::array<float, 3>{1, 1, 0}));
+    EXPECT_EQ(r.b.bounds.min, (std::array<float, 3>{-1, -1, 0.1f}));
+    EXPECT_NEAR(r.diagonal, 2 * std::sqrt(2.0), 1e-6);
+    EXPECT_NEAR(r.hausdorff(), 0.1, 1e-6);
+}
+
+TEST(CompareCli, ADirectionWithoutSamplesIsNotMeasuredNotZero) {
+    // A's triangles have no area, so nothing on A is sampled: A -> B used to print max 0, mean 0,
+    // though every point of A is 99 or more away from B.
+    TempDir tmp;
+    write_mesh(tmp.path / "sphere.stl", sphere(1));
+    write_mesh(tmp.path / "flat.stl", {100, 0, 0, 101, 0, 0, 102, 0, 0, 100, 1, 0, 100, 2, 0, 100, 3, 0});
+    const std::string args = (tmp.path / "flat.stl").string() + " " + (tmp.path / "sphere.stl").string();
+    RunResult r = run_cli(tmp.path, "compare " + args);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.out.find("A -> B     no samples: not measured"), std::string::npos) << r.out;
+    EXPECT_NE(r.err.find("warning: no samples on " + (tmp.path / "flat.stl").string() +
+                         " (its triangles have no area): A -> B is not measured"),
+              std::string::npos) << r.err;
+    r = run_cli(tmp.path, "compare --json " + args);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.out.find("\"samples\": 0,\n    \"max\": null"), std::string::npos) << r.out;
 }
