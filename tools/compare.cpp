@@ -1,6 +1,7 @@
 // `meshstream compare A B`: Metro-style surface error between two meshes (tools/metro.hpp),
 // as text or --json. Holds the smaller mesh in memory and streams the other one twice.
 #include "io/error.hpp"
+#include "tools/cli_checks.hpp"
 #include "tools/commands.hpp"
 #include "tools/common.hpp"
 #include "tools/input_filter.hpp"
@@ -191,7 +192,8 @@ void add_compare(CLI::App& app) {
     cmd->add_option("--samples", opt->samples,
                     "Samples per direction (default: 10 × triangles of the sampled mesh, clamped to 1e6..1e7)")
         ->check(CLI::Range(uint64_t{1}, uint64_t{1} << 32));
-    cmd->add_option("--seed", opt->seed, "Random seed of the sampling (same seed, same figures)")->capture_default_str();
+    cmd->add_option("--seed", opt->seed, "Random seed of the sampling (same seed, same figures)")
+        ->capture_default_str()->check(whole_number(0, "a whole number"));
     cmd->add_flag("--json", opt->json, "Print JSON instead of text");
     add_read_flags(cmd, opt->read);
     strict_reports_bad_triangles(cmd);

@@ -4,6 +4,7 @@
 #include "decimate/phase_timers.hpp"
 #include "decimate/stream_decimator.hpp"
 #include "io/error.hpp"
+#include "tools/cli_checks.hpp"
 #include "tools/commands.hpp"
 #include "tools/common.hpp"
 #include "tools/input_filter.hpp"
@@ -42,11 +43,16 @@ double weld_epsilon(const DecimateOptions& opt, const std::string& input_name) {
     if (text.empty()) return 0;
     const bool percent = text.back() == '%';
     double value = 0;
+    const std::string number = percent ? text.substr(0, text.size() - 1) : text;
+    size_t used = 0;
     try {
-        value = std::stod(percent ? text.substr(0, text.size() - 1) : text);
+        value = std::stod(number, &used);
     } catch (const std::exception&) {
-        throw CLI::ValidationError("--weld", "expected a number or a percentage, found '" + text + "'");
+        used = 0;
     }
+    // All of it: "1,5" used to weld on a grid of 1 (the whole bunny to one point), "1mm" of 1.
+    if (used == 0 || used != number.size())
+        throw CLI::ValidationError("--weld", "expected a number or a percentage, found '" + text + "'");
     if (!(value >= 0) || !std::isfinite(value))
         throw CLI::ValidationError("--weld", "must be a non-negative number, found '" + text + "'");
     if (!percent) return value;
@@ -257,34 +263,17 @@ void add_decimate(CLI::App& app) {
                     "triangle; a warning says so).");
     cmd->add_option("input", opt->input, "Input mesh ('-' = stdin)")->required();
     cmd->add_option("output", opt->output, "Output mesh ('-' = stdout, needs --to)")->required();
-    // CLI::Range would say "Value 0 not in range 0.000000 to 1.000000" for the open end.
-    const CLI::Validator open_unit(
-        [](const std::string& text) -> std::string {
-            double value = 0;
-            if (!CLI::detail::lexical_cast(text, value) || !(value > 0 && value <= 1))
-                return "must be a number in (0, 1], found '" + text + "'";
-            return {};
-        },
-        "in (0, 1]");
     auto* ratio = cmd->add_option("-r,--ratio", opt->ratio, "Fraction of input triangles to keep, in (0, 1] (default 0.1)")
-                      ->check(open_unit);
+                      ->check(open_unit_interval());
     cmd->add_option("--target", opt->target, "Exact output triangle count (needs a format that states the input count)")
         ->excludes(ratio)
-        ->check(CLI::Validator(
-            [](const std::string& text) -> std::string {
-                uint64_t value = 0;
-                // (strtoull, under lexical_cast, would take "-3" as 2^64 - 3)
-                if (text.find('-') != std::string::npos || !CLI::detail::lexical_cast(text, value) || value == 0)
-                    return "must be a whole number of triangles, at least 1, found '" + text + "'";
-                return {};
-            },
-            "N >= 1"));
+        ->check(whole_number(1, "a whole number of triangles"));
     cmd->add_option("--buffer", opt->buffer, "In-core buffer capacity in triangles (memory is fixed by it)")
         ->capture_default_str()->check(CLI::Range(size_t{16}, size_t{1} << 29));
     cmd->add_option("--candidates", opt->candidates, "Multiple-choice sample size for collapses and writes")
         ->capture_default_str()->check(CLI::Range(1, 64));
     cmd->add_option("--seed", opt->seed, "Random seed (same input, options and seed give identical output)")
-        ->capture_default_str();
+        ->capture_default_str()->check(whole_number(0, "a whole number"));
     cmd->add_option("--weld", opt->weld, "Weld vertices on a grid of this size (absolute, or N% of the bbox diagonal)");
     cmd->add_option("--sorted-axis", opt->sorted_axis,
                     "The input is sorted along this axis: x, y or z (or 0, 1, 2); read from the file when it says so")

@@ -1,6 +1,7 @@
 // `meshstream info FILE`: format, counts, bounding box, file size and degenerate triangles,
 // in one streaming pass (memory: one chunk), as plain text or --json.
 #include "io/error.hpp"
+#include "tools/cli_checks.hpp"
 #include "tools/commands.hpp"
 #include "tools/common.hpp"
 #include "tools/input_filter.hpp"
@@ -184,10 +185,12 @@ void add_info(CLI::App& app) {
     cmd->add_flag("--order", opt->order,
                   "Measure the stream's width: triangles held at once until all their vertices' uses were read "
                   "(exact within --memory, else sampled; see docs/cli.md)");
-    cmd->add_option("--buffer", opt->buffer, "With --order: decimation buffer (triangles) to judge (default 400000)");
+    // The same ranges as decimate's: settings it cannot run are not judged.
+    cmd->add_option("--buffer", opt->buffer, "With --order: decimation buffer (triangles) to judge (default 400000)")
+        ->check(CLI::Range(size_t{16}, size_t{1} << 29));
     cmd->add_option("--ratio", opt->ratio,
                     "With --order: the decimation ratio to judge it for (default 0.1; the buffer needed grows with it)")
-        ->check(CLI::Range(0.0, 1.0));
+        ->check(open_unit_interval());
     add_read_flags(cmd, opt->read);
     strict_reports_bad_triangles(cmd);
     cmd->callback([opt] { run_info(*opt); });

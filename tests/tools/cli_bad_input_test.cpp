@@ -195,8 +195,17 @@ TEST(CliBadInput, DecimateOptionValuesOutOfRangeAreRefusedClearly) {
                     {
                         {"--ratio 0", 2, "--ratio: must be a number in (0, 1], found '0'"},
                         {"--ratio 1.5", 2, "--ratio: must be a number in (0, 1], found '1.5'"},
-                        {"--target 0", 2, "--target: must be a whole number of triangles, at least 1, found '0'"},
-                        {"--target -3", 2, "--target: must be a whole number of triangles, at least 1, found '-3'"},
+                        {"--target 0", 2, "--target: must be a whole number of triangles from 1 to 18446744073709551615, found '0'"},
+                        {"--target -3", 2, "--target: must be a whole number of triangles from 1 to 18446744073709551615, found '-3'"},
+                        // used to be clamped to 2^64 - 1 and named as such
+                        {"--target 18446744073709551616", 2, "found '18446744073709551616'"},
+                        // used to wrap to 2^64 - 1, and larger ones were clamped to it
+                        {"--seed -1", 2, "--seed: must be a whole number from 0 to 18446744073709551615, found '-1'"},
+                        {"--seed 18446744073709551616", 2, "--seed: must be a whole number from 0 to 18446744073709551615"},
+                        // used to weld on a grid of 1 (a decimal comma) or of 1 (a unit)
+                        {"--weld 1,5", 2, "--weld: expected a number or a percentage, found '1,5'"},
+                        {"--weld 1mm", 2, "--weld: expected a number or a percentage, found '1mm'"},
+                        {"--weld 0.5.5%", 2, "--weld: expected a number or a percentage, found '0.5.5%'"},
                         {"--target 33", 2, "in.stl: --target 33 is more than the 32 triangles of the input"},
                         {"--sorted-axis w", 2, "--sorted-axis: must be x, y or z (or 0, 1, 2), found 'w'"},
                     });
@@ -205,6 +214,26 @@ TEST(CliBadInput, DecimateOptionValuesOutOfRangeAreRefusedClearly) {
         CliRun r = run("decimate " + dir / "in.stl" + " " + dir / "out.stl " + ok);
         EXPECT_EQ(r.code, 0) << ok << ": " << r.err;
     }
+}
+
+// info --order judges only what decimate can run; compare's and the generator's seeds are
+// whole numbers as decimate's.
+TEST(CliBadInput, InfoCompareAndGenOptionValuesOutOfRangeAreRefusedClearly) {
+    TempDir dir;
+    write_file(dir / "in.stl", binary_stl(grid(4)));
+    for (const auto& [args, message] : std::vector<std::pair<std::string, std::string>>{
+             // used to print "needs about 9223372036854775808", exit 0
+             {"info --order --ratio nan " + dir / "in.stl", "--ratio: must be a number in (0, 1], found 'nan'"},
+             {"info --order --ratio 0 " + dir / "in.stl", "--ratio: must be a number in (0, 1], found '0'"},
+             {"info --order --buffer 0 " + dir / "in.stl", "--buffer: Value 0 not in range 16 to"},
+             {"compare --seed -1 " + dir / "in.stl" + " " + dir / "in.stl", "--seed: must be a whole number from 0"}}) {
+        CliRun r = run(args);
+        EXPECT_EQ(r.code, 2) << args << ": " << r.err;
+        EXPECT_NE(r.err.find(message), std::string::npos) << args << ": " << r.err;
+    }
+    const int gen = std::system((std::string(MESHSTREAM_GEN_BINARY) + " --seed -1 " + dir / "g.stl" + " 2>/dev/null").c_str());
+    EXPECT_EQ(WEXITSTATUS(gen), 2);
+    EXPECT_EQ(listing(dir.path), std::vector<std::string>{"in.stl"});
 }
 
 TEST(CliBadInput, MemoryBudgetsThatAreNotSizesOrTooSmallAreRefusedClearly) {
