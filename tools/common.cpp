@@ -79,7 +79,8 @@ void note_unused_write_flags(const WriteFlags& flags, const io::Format& output, 
     add(flags.draco_qn != defaults.draco_qn, "--draco-qn");
     add(flags.draco_cl != defaults.draco_cl, "--draco-cl");
     if (!given.empty())
-        warnings.note(given + " apply to Draco and glTF outputs only: ignored for " + std::string(output.name));
+        warnings.note(given + (given.find(',') == std::string::npos ? " applies" : " apply") +
+                      " to Draco and glTF outputs only: ignored for " + std::string(output.name));
 }
 
 void require_output_format(const std::string& output, const WriteFlags& flags) {

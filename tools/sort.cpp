@@ -300,12 +300,16 @@ void run_sort(const SortOptions& opt) {
         const double seconds = seconds_since(t0);
         std::fprintf(stderr,
                      "sorted %llu triangles along %s in %.2f s (%s triangles/s; input and runs %.2f s, "
-                     "last run sort and merge passes %.2f s, final merge and output %.2f s): %llu runs of up to %llu, "
-                     "%d merge passes, %s temporary written, peak temporary disk %s, peak RSS %s\n",
-                     (unsigned long long)s.triangles, kAxisNames[axis], seconds, 
+                     "last run sort and merge passes %.2f s, final merge and output %.2f s): %s, "
+                     "%d merge pass%s, %s temporary written, peak temporary disk %s, peak RSS %s\n",
+                     (unsigned long long)s.triangles, kAxisNames[axis], seconds,
                      human_count(seconds > 0 ? double(s.triangles) / seconds : 0).c_str(), input_seconds, sort_seconds,
-                     seconds - input_seconds - sort_seconds, (unsigned long long)s.runs,
-                     (unsigned long long)s.run_capacity, s.merge_passes, human_bytes(double(s.temp_bytes_written)).c_str(),
+                     seconds - input_seconds - sort_seconds,
+                     (s.runs == 0 ? "in memory (room for " + std::to_string(s.run_capacity) + " triangles), no runs"
+                                  : std::to_string(s.runs) + (s.runs == 1 ? " run" : " runs") + " of up to " +
+                                        std::to_string(s.run_capacity))
+                         .c_str(),
+                     s.merge_passes, s.merge_passes == 1 ? "" : "es", human_bytes(double(s.temp_bytes_written)).c_str(),
                      human_bytes(double(s.peak_temp_bytes)).c_str(), human_bytes(double(peak_rss_bytes())).c_str());
     }
 }

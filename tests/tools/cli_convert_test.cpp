@@ -158,6 +158,9 @@ TEST(CliConvert, DracoOptionsForOtherOutputsAreSaidToDoNothing) {
     EXPECT_EQ(ply.code, 0) << ply.err;
     EXPECT_NE(ply.err.find("warning: --normals, --draco-qp apply to Draco and glTF outputs only: ignored for ply"),
               std::string::npos) << ply.err;
+    cli_test::CliRun one = run("convert --draco-qp 10 " + cube + " " + dir / "d.ply");
+    EXPECT_NE(one.err.find("warning: --draco-qp applies to Draco and glTF outputs only: ignored for ply"),
+              std::string::npos) << one.err;
     cli_test::CliRun glb = run("convert --normals --draco-qp 10 " + cube + " " + dir / "c.glb");
     EXPECT_EQ(glb.code, 0) << glb.err;
     EXPECT_EQ(glb.err.find("warning"), std::string::npos) << glb.err;

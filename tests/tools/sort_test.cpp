@@ -187,6 +187,11 @@ TEST(SortCommand, MultiPassMergeUnderOneMebibyte) {
     EXPECT_NE(r.err.find("2 merge passes"), std::string::npos) << r.err;
     expect_sorted_permutation(read_mesh(dir / "out.stl").tris, tris, 2);
     EXPECT_EQ(file_count(dir.path.string()), 2u);  // in.stl and out.stl only
+    // Within the budget nothing is written to disk: said so (it used to say "0 runs of up to N").
+    r = run("sort --stats --axis z " + dir / "in.stl" + " " + dir / "out.stl", dir);
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.err.find("): in memory (room for "), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(" triangles), no runs, 0 merge passes, 0 B temporary written"), std::string::npos) << r.err;
 }
 
 TEST(SortCommand, TruncatedInputLeavesNoOutputAndNoTemporaryFiles) {
