@@ -95,6 +95,16 @@ void StreamDecimator::read_triangle(const float tri[9], const size_t slots[3], c
     }();
     ++stats_.triangles_in;
     if (added.face == kNoIndex) {
+        // A triangle the weld grid collapsed is gone, as the weld asked (passed through it took
+        // output budget, and whole-mesh writers dropped it after the count was printed); one
+        // that came with repeated corners passes through as it came.
+        auto same = [&](int a, int b) {
+            return tri[3 * a] == tri[3 * b] && tri[3 * a + 1] == tri[3 * b + 1] && tri[3 * a + 2] == tri[3 * b + 2];
+        };
+        if (!same(0, 1) && !same(1, 2) && !same(2, 0)) {
+            ++stats_.weld_dropped;
+            return;
+        }
         pass_through(buffer_, added.vertex, next_id_, output_, out);
         ++stats_.degenerate_passed;
         return;

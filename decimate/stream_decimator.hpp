@@ -45,7 +45,8 @@ struct Stats {
     uint64_t collapses = 0;
     uint64_t forced_writes = 0;          // written while touching P_in (buffer stuck)
     uint64_t premature_writes = 0;       // written before R reached p (decimation stalled)
-    uint64_t degenerate_passed = 0;      // corners welded together: passed through
+    uint64_t degenerate_passed = 0;      // repeated corners in the input: passed through
+    uint64_t weld_dropped = 0;           // distinct corners that --weld merged: dropped
     uint64_t nonmanifold_edges = 0;      // half-edges frozen as non-manifold
     uint64_t boundary_edges = 0;         // edges without a partner: holes, borders, cracks
     uint64_t vertices_merged = 0;        // vertices that absorbed other positions (--weld)

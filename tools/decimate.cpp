@@ -207,12 +207,13 @@ void run_decimate(const DecimateOptions& opt) {
     if (s.nonmanifold_edges > 0)
         warnings.add("non-manifold, duplicate or mis-oriented edges frozen and passed through", s.nonmanifold_edges);
     if (s.degenerate_passed > 0)
-        warnings.add("degenerate triangles (welded corners) passed through", s.degenerate_passed);
-    // Welding that collapses many triangles is coarser than the mesh: they pass through
-    // undecimated, and the output misses its target.
-    if (options.weld_eps > 0 && s.degenerate_passed * 100 > s.triangles_in)
+        warnings.add("degenerate triangles (repeated corners) passed through", s.degenerate_passed);
+    if (s.weld_dropped > 0) warnings.add("triangles dropped because --weld merged their corners", s.weld_dropped);
+    // Welding that collapses many triangles is coarser than the mesh: it removes surface
+    // detail the decimation would have kept.
+    if (options.weld_eps > 0 && s.weld_dropped * 100 > s.triangles_in)
         warnings.note("--weld " + opt.weld + " welded the corners of " +
-                      std::to_string(s.degenerate_passed * 100 / s.triangles_in) +
+                      std::to_string(s.weld_dropped * 100 / s.triangles_in) +
                       " % of the triangles together: it is coarser than the mesh; weld on a smaller size");
     // Triangles that share no corners exactly (cracks from float round-off, a soup written
     // triangle by triangle) leave every edge open: decimation then eats the surface from every

@@ -357,6 +357,19 @@ TEST(CliBadInput, WeldPercentReadsTheBoxFirstOrRefusesAStream) {
     CliRun coarse = run("decimate -r 0.5 --weld 30% " + dir / "in.stl" + " " + dir / "coarse.stl");
     EXPECT_EQ(coarse.code, 0) << coarse.err;
     EXPECT_NE(coarse.err.find("warning: --weld 30% welded the corners of "), std::string::npos) << coarse.err;
+    // Those triangles are gone, counted, and not in the summary's count (they used to pass
+    // through: counted out, then dropped by Draco and glTF writers).
+    EXPECT_NE(coarse.err.find("warning: triangles dropped because --weld merged their corners ("), std::string::npos)
+        << coarse.err;
+    const uint64_t written = (fs::file_size(dir / "coarse.stl") - 84) / 50;  // binary STL
+    const size_t out_at = coarse.err.find(", out ");
+    ASSERT_NE(out_at, std::string::npos) << coarse.err;
+    EXPECT_EQ(std::stoull(coarse.err.substr(out_at + 6)), written) << coarse.err;
+    CliRun glb = run("decimate -r 0.5 --weld 30% " + dir / "in.stl" + " " + dir / "coarse.glb");
+    ASSERT_EQ(glb.code, 0) << glb.err;
+    CliRun info = run("info " + dir / "coarse.glb" + " > " + dir / "info.txt");
+    EXPECT_NE(slurp(dir / "info.txt").find("triangles:   " + std::to_string(written) + "\n"), std::string::npos)
+        << slurp(dir / "info.txt");
     EXPECT_NE(coarse.err.find("it is coarser than the mesh; weld on a smaller size\n"), std::string::npos) << coarse.err;
     CliRun p = run("decimate -r 0.5 --weld 0.5% - " + dir / "piped.stl" + " < " + dir / "in.stl");
     EXPECT_EQ(p.code, 2) << p.err;
