@@ -544,6 +544,30 @@ std::vector<std::string> required_extensions_in(const std::string& json) {
     return out;
 }
 
+// The JSON of a glTF document: the file itself, or a GLB's first chunk (empty when cut short).
+std::string json_text(const std::vector<unsigned char>& bytes, bool glb) {
+    if (!glb) return std::string(bytes.begin(), bytes.end());
+    if (bytes.size() < 20) return {};
+    const size_t len = std::min<size_t>(get_u32(&bytes[12]), bytes.size() - 20);
+    return std::string(reinterpret_cast<const char*>(&bytes[20]), len);
+}
+
+// The bytes the document's buffers in other files declare (byteLength of each buffer whose URI
+// is not a data: URI): tinygltf reads them whole, past the budget the document itself is held to.
+uint64_t external_buffer_bytes(const std::string& json) {
+    const auto doc = nlohmann::json::parse(json, nullptr, false);
+    uint64_t total = 0;
+    if (doc.is_discarded() || !doc.is_object() || !doc.contains("buffers") || !doc["buffers"].is_array()) return 0;
+    for (const auto& b : doc["buffers"]) {
+        if (!b.is_object() || !b.contains("uri") || !b["uri"].is_string() || !b.contains("byteLength") ||
+            !b["byteLength"].is_number_unsigned())
+            continue;
+        if (b["uri"].get<std::string>().rfind("data:", 0) == 0) continue;
+        total += b["byteLength"].get<uint64_t>();
+    }
+    return total;
+}
+
 class GltfReader final : public Reader {
 public:
     GltfReader(ByteSource& source, const ReadOptions& options) : name_(source.name()) {
@@ -574,6 +598,11 @@ public:
         header_.variant = glb ? "binary (GLB)" : "JSON";
 
         hide_draco_indices(bytes, glb);
+        if (const uint64_t external = external_buffer_bytes(json_text(bytes, glb));
+            bytes.size() + external > options.memory_budget_bytes)
+            throw Error(name_, "glTF documents are read whole into memory with their buffers: this one and its buffer "
+                               "files take " + binary_size(bytes.size() + external) + ", over the memory budget of " +
+                               binary_size(options.memory_budget_bytes) + "; raise --memory");
 
         tinygltf::TinyGLTF gltf;
         gltf.SetImageLoader(&skip_image, nullptr);
@@ -583,14 +612,7 @@ public:
                       : gltf.LoadASCIIFromString(&model_, &err, &warn, reinterpret_cast<const char*>(bytes.data()),
                                                  static_cast<unsigned>(bytes.size()), base_dir);
         if (!ok) {
-            std::string json;
-            if (glb && bytes.size() >= 20) {
-                size_t len = std::min<size_t>(get_u32(&bytes[12]), bytes.size() - 20);
-                json.assign(reinterpret_cast<const char*>(&bytes[20]), len);
-            } else if (!glb) {
-                json.assign(bytes.begin(), bytes.end());
-            }
-            for (const std::string& ext : required_extensions_in(json))
+            for (const std::string& ext : required_extensions_in(json_text(bytes, glb)))
                 if (!extension_supported(ext)) throw_unsupported_extension(ext);
             while (!err.empty() && (err.back() == '\n' || err.back() == ' ')) err.pop_back();
             throw Error(name_, "invalid glTF: " + (err.empty() ? std::string("tinygltf failed to parse it") : err));

@@ -253,6 +253,25 @@ TEST(GltfReader, AppliesMorphTargetsAtTheirDefaultWeights) {
         << what;
 }
 
+TEST(GltfReader, BufferFilesCountAgainstTheMemoryBudget) {
+    // The document (3 695 bytes) was held to --memory, its buffer files (840 bytes here, 18 MB
+    // for a 1 M mesh) were not.
+    const std::string path = fixture("gltf/BoxTextured_external/BoxTextured.gltf");
+    io::ReadOptions options;
+    options.memory_budget_bytes = 4000;
+    std::string what;
+    try {
+        io::open_input(path, {}, options);
+    } catch (const io::Error& e) {
+        what = e.what();
+    }
+    EXPECT_NE(what.find("glTF documents are read whole into memory with their buffers: this one and its buffer files "
+                        "take 4.4 KiB, over the memory budget of 3.9 KiB; raise --memory"),
+              std::string::npos) << what;
+    options.memory_budget_bytes = 3695 + 840;
+    EXPECT_EQ(io::open_input(path, {}, options).reader->triangle_count(), 12u);
+}
+
 TEST(GltfReader, NamesABufferViewPastTheEndOfItsBuffer) {
     // The message used to clamp the view's end to the buffer: "reaches byte 36 of a buffer view
     // ending at 36".
