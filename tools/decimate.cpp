@@ -81,8 +81,12 @@ void run_decimate(const DecimateOptions& opt) {
         }
         // Replaced in place, the input is gone when the comparison reads it: the output would be
         // compared with itself (an error of 0).
-        std::error_code ec;
-        if (std::filesystem::equivalent(opt.input, opt.output, ec))
+        // (By resolved name, not by file: a hard link to the input keeps the old file when the
+        // output replaces its name.)
+        std::error_code ec_in, ec_out;
+        const auto input = std::filesystem::weakly_canonical(opt.input, ec_in);
+        const auto output = std::filesystem::weakly_canonical(opt.output, ec_out);
+        if (!ec_in && !ec_out && input == output)
             throw UsageError(opt.output + ": --report compares the output against the input, which this output "
                              "replaces: write the output to another file");
     }

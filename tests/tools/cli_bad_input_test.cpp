@@ -138,6 +138,12 @@ TEST(CliBadInput, DecimateReportWithAPipeIsRefusedBeforeAnyOutput) {
                   std::string::npos) << same.err;
         EXPECT_EQ(slurp(dir / "in.stl"), before);
     }
+    // A hard link is another name: the output replaces that name, the input keeps its file.
+    fs::create_hard_link(dir / "in.stl", dir / "hard.stl");
+    CliRun hard = run("decimate --report -r 0.5 " + dir / "in.stl" + " " + dir / "hard.stl");
+    EXPECT_EQ(hard.code, 0) << hard.err;
+    EXPECT_EQ(slurp(dir / "in.stl"), before);
+    EXPECT_NE(hard.err.find("error vs input"), std::string::npos) << hard.err;
 }
 
 // A text file cut inside its last number reads as valid: the warning names the file.
