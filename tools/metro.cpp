@@ -301,11 +301,9 @@ struct SampleIndex {
         for (size_t i = 0; i < order.size(); ++i) best2[i] = bound2[order[i]];
     }
 
-    // Lowers best2 of every sample that a triangle of `chunk` (absolute bounding box
-    // abs_lo..abs_hi around all of them) is closer to. A chunk of triangles at a time, through
-    // their own BVH: one triangle at a time, every sample within reach was visited once per
-    // triangle, which made surfaces far apart (a plane 0.25 above a fine grid) take minutes.
-    void update(const TriangleIndex& chunk, const float abs_lo[3], const float abs_hi[3]) {
+    // Lowers best2 of every sample that triangle t (absolute bounding box abs_lo..abs_hi) is
+    // closer to.
+    void update(const float* t, const float abs_lo[3], const float abs_hi[3]) {
         if (nodes.empty()) return;
         float lo[3], hi[3];  // the box relative to origin, rounded outwards
         for (int a = 0; a < 3; ++a) {
@@ -337,8 +335,7 @@ struct SampleIndex {
                     box2 += d * d;
                 }
                 if (box2 >= best2[i]) continue;
-                best2[i] = bvh_nearest(chunk.nodes, p, best2[i],
-                                       [&](uint32_t k) { return point_triangle_dist2(p, &chunk.xyz[9 * size_t{k}]); });
+                best2[i] = std::min(best2[i], point_triangle_dist2(p, t));
             }
         }
     }
@@ -695,17 +692,6 @@ CompareResult compare_meshes(const MeshSource& a, const MeshSource& b, const Com
     {
         double density = streamed_summary.area > 0 ? double(streamed_samples) / streamed_summary.area : 0;
         MeshSummary check;
-        // The held samples meet the streamed triangles a chunk at a time (consecutive triangles
-        // of a mesh file are mostly near each other, so a chunk's box stays small).
-        constexpr size_t kChunkTriangles = 64;
-        TriangleIndex chunk;
-        float chunk_lo[3], chunk_hi[3];
-        auto flush = [&] {
-            if (chunk.xyz.empty()) return;
-            chunk.build();
-            samples.update(chunk, chunk_lo, chunk_hi);
-            chunk.xyz.clear();
-        };
         stream_mesh(streamed, check, nullptr, options, "pass 2: " + streamed.name, [&](uint64_t index, const float* t) {
             Rng rng = triangle_rng(options.seed, kSaltStreamSamples, index);
             uint64_t k = density > 0 ? samples_for(triangle_area(t), density, rng) : 0;
@@ -714,16 +700,13 @@ CompareResult compare_meshes(const MeshSource& a, const MeshSource& b, const Com
                 point_in_triangle(t, rng, p);
                 streamed_stats.add(triangles.nearest_dist2(p));
             }
-            const bool first = chunk.xyz.empty();
+            float lo[3], hi[3];
             for (int x = 0; x < 3; ++x) {
-                const float lo = std::min({t[x], t[3 + x], t[6 + x]}), hi = std::max({t[x], t[3 + x], t[6 + x]});
-                chunk_lo[x] = first ? lo : std::min(chunk_lo[x], lo);
-                chunk_hi[x] = first ? hi : std::max(chunk_hi[x], hi);
+                lo[x] = std::min({t[x], t[3 + x], t[6 + x]});
+                hi[x] = std::max({t[x], t[3 + x], t[6 + x]});
             }
-            chunk.xyz.insert(chunk.xyz.end(), t, t + 9);
-            if (chunk.xyz.size() == 9 * kChunkTriangles) flush();
+            samples.update(t, lo, hi);
         });
-        flush();
         if (check.triangles != streamed_summary.triangles || check.area != streamed_summary.area)
             throw io::Error(streamed.name, "changed between the two passes (" + std::to_string(streamed_summary.triangles) +
                                                " triangles, then " + std::to_string(check.triangles) + ")");
