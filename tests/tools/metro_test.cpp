@@ -399,3 +399,33 @@ TEST(CompareCli, ADirectionWithoutSamplesIsNotMeasuredNotZero) {
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_NE(r.out.find("\"samples\": 0,\n    \"max\": null"), std::string::npos) << r.out;
 }
+
+TEST(Metro, HeldSamplesFarFromTheStreamedSurfaceAreExactToo) {
+    // A fine grid on z = 0 (streamed: the larger) and a square tilted from z = 0 to z = 1 above it
+    // (held): each held sample's distance is its height, so near samples (met a streamed
+    // triangle at a time) and far ones (met a chunk at a time) mix. Mean 1/2, RMS sqrt(1/3).
+    std::vector<float> grid;
+    const int n = 60;
+    for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j) {
+            const float x0 = float(i) / n, x1 = float(i + 1) / n, y0 = float(j) / n, y1 = float(j + 1) / n;
+            const float a[3] = {x0, y0, 0}, b[3] = {x1, y0, 0}, c[3] = {x1, y1, 0}, d[3] = {x0, y1, 0};
+            push_tri(grid, a, b, c);
+            push_tri(grid, a, c, d);
+        }
+    const std::vector<float> tilted = {0, 0, 0, 1, 0, 1, 1, 1, 1, 0, 0, 0, 1, 1, 1, 0, 1, 0};
+    CompareOptions options;
+    options.samples = 40'000;
+    const CompareResult r = compare_meshes(memory_source("tilted", tilted), memory_source("grid", grid), options);
+    ASSERT_TRUE(r.a.in_memory);
+    EXPECT_NEAR(r.a_to_b.mean, 0.5, 0.01);
+    EXPECT_NEAR(r.a_to_b.rms, std::sqrt(1.0 / 3), 0.01);
+    EXPECT_GT(r.a_to_b.max, 0.99);
+    EXPECT_LE(r.a_to_b.max, 1.0 + 1e-6);
+    // And every held sample's distance is exactly its height (to float storage).
+    const CompareResult flat = compare_meshes(memory_source("high", {0, 0, 0.5f, 1, 0, 0.5f, 1, 1, 0.5f, 0, 0, 0.5f, 1, 1, 0.5f, 0, 1, 0.5f}),
+                                              memory_source("grid", grid), options);
+    EXPECT_NEAR(flat.a_to_b.max, 0.5, 1e-7);
+    EXPECT_NEAR(flat.a_to_b.mean, 0.5, 1e-7);
+    EXPECT_NEAR(flat.b_to_a.max, 0.5, 1e-7);
+}
