@@ -249,6 +249,9 @@ void run_sort(const SortOptions& opt) {
             progress.update(read.load(std::memory_order_relaxed));
         }
     }
+    // What the reader noted by the end of the input (a last line without a line end), before
+    // it goes.
+    const io::MeshHeader end_header = in.reader->header();
     in = {};  // the reader's buffers and tables are not needed while merging
     const double input_seconds = seconds_since(t0);
     sorter.finish_input();
@@ -292,7 +295,7 @@ void run_sort(const SortOptions& opt) {
     Warnings warnings;
     note_unused_write_flags(opt.write, *out.format, opt.output, warnings);
     filter.report(warnings);
-    note_input_changes(header, input_name, warnings);
+    note_input_changes(end_header, input_name, warnings);
     warnings.print();
 
     if (opt.stats) {
