@@ -113,10 +113,12 @@ void run_compare(const CompareCliOptions& opt) {
     // A mesh of zero area (degenerate triangles only), or --samples too small for it, gets no
     // samples: that direction is unmeasured, and the symmetric figures are the other one's.
     Warnings warnings;
+    const bool none = r.a_to_b.samples == 0 && r.b_to_a.samples == 0;
     auto unsampled = [&](const MeshSummary& from, const char* direction) {
         warnings.note(std::string("no samples on ") + from.name + " (" +
                       (from.area > 0 ? "too few asked for: raise --samples" : "its triangles have no area") + "): " +
-                      direction + " is not measured, and the symmetric figures are the other direction's alone");
+                      direction + " is not measured" +
+                      (none ? std::string() : ", and the symmetric figures are the other direction's alone"));
     };
     if (r.a_to_b.samples == 0) unsampled(r.a, "A -> B");
     if (r.b_to_a.samples == 0) unsampled(r.b, "B -> A");

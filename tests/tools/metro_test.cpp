@@ -395,9 +395,17 @@ TEST(CompareCli, ADirectionWithoutSamplesIsNotMeasuredNotZero) {
     EXPECT_NE(r.err.find("warning: no samples on " + (tmp.path / "flat.stl").string() +
                          " (its triangles have no area): A -> B is not measured"),
               std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("A -> B is not measured, and the symmetric figures are the other direction's alone"),
+              std::string::npos) << r.err;
     r = run_cli(tmp.path, "compare --json " + args);
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_NE(r.out.find("\"samples\": 0,\n    \"max\": null"), std::string::npos) << r.out;
+    // Neither measured: no "other direction" to speak of.
+    r = run_cli(tmp.path, "compare " + (tmp.path / "flat.stl").string() + " " + (tmp.path / "flat.stl").string());
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.out.find("symmetric  no samples: not measured"), std::string::npos) << r.out;
+    EXPECT_NE(r.err.find("B -> A is not measured\n"), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("other direction"), std::string::npos) << r.err;
 }
 
 TEST(Metro, HeldSamplesFarFromTheStreamedSurfaceAreExactToo) {
