@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <optional>
+#include <vector>
 
 namespace meshstream::decimate {
 namespace {
@@ -489,6 +490,29 @@ bool decimate_once(HalfEdgeBuffer& buffer, Rng& rng, int candidates, CandidateMe
             return true;
         }
     }
+    return false;
+}
+
+bool collapse_best_of_all(HalfEdgeBuffer& buffer) {
+    struct Candidate {
+        uint32_t h;
+        CollapsePlacement placement;
+    };
+    std::vector<Candidate> all;
+    const FaceSet& live = buffer.live_faces();
+    for (size_t i = 0; i < live.size(); ++i)
+        for (uint32_t k = 0; k < 3; ++k) {
+            const uint32_t h = half_edge(live.at(i), k);
+            if (collapse_eligible(buffer, h)) all.push_back({h, collapse_placement(buffer, h)});
+        }
+    // Stable: ties keep buffer order, so the result is deterministic.
+    std::stable_sort(all.begin(), all.end(),
+                     [](const Candidate& a, const Candidate& b) { return a.placement.error < b.placement.error; });
+    for (const Candidate& c : all)
+        if (collapse_valid(buffer, c.h, c.placement.target)) {
+            apply_collapse(buffer, c.h, c.placement.target);
+            return true;
+        }
     return false;
 }
 

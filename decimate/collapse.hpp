@@ -120,4 +120,9 @@ bool decimate_once(HalfEdgeBuffer& buffer, Rng& rng, int candidates, CandidateMe
 // there is none (closed meshes have an even face count).
 bool collapse_one_boundary_edge(HalfEdgeBuffer& buffer);
 
+// The valid collapse with the smallest error among every eligible half-edge of the buffer,
+// rated and placed by collapse_placement(), found by a scan; false when none is valid. For the
+// end of input, when random draws stop finding the few valid collapses left in a small buffer.
+bool collapse_best_of_all(HalfEdgeBuffer& buffer);
+
 }  // namespace meshstream::decimate

@@ -55,6 +55,7 @@ struct Stats {
     uint64_t sort_violations = 0;        // triangles reaching behind the sweep (sweep then stops)
     uint64_t orphans_evicted = 0;
     uint64_t vertices_moved = 0;         // moved to their quadric optimum when written
+    bool no_valid_collapse_left = false;  // the end's scan of every half-edge found none valid
 };
 
 class StreamDecimator {

@@ -237,6 +237,9 @@ void run_decimate(const DecimateOptions& opt) {
                       std::to_string(s.triangles_in) + " usable input triangles: nothing was decimated");
     else if (s.triangles_in > 0 && s.triangles_out == s.target_triangles + 1)
         warnings.note(missed + " (a collapse removes two triangles, and no boundary edge could be collapsed to remove the odd one)");
+    else if (s.triangles_in > 0 && s.triangles_out != s.target_triangles && s.no_valid_collapse_left)
+        warnings.note(missed + " (no allowed collapse is left: each would fold a face over or change the topology, "
+                               "or move a vertex that must stay, as on a non-manifold edge)");
     else if (s.triangles_in > 0 && s.triangles_out != s.target_triangles)
         warnings.note(missed + " (too little left that could be decimated)");
     else if (s.triangles_in > 0 && s.target_triangles == 0)

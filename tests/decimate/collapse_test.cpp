@@ -368,3 +368,54 @@ TEST(Collapse, HoleBoundaryCollapsesAlongItsEdgeAndBoundaryPlanesPriceCorners) {
     EXPECT_EQ(buffer.face_count(), 31u);
     EXPECT_EQ(buffer.vertex(right).open_edges, 2u);
 }
+
+TEST(Collapse, BestOfAllScansUntilNoCollapseIsValid) {
+    // An octahedron comes down two faces a scan to the tetrahedron, which no collapse may
+    // reduce: then the scan says so.
+    HalfEdgeBuffer buffer(64, 0);
+    add_indexed(buffer, octahedron_points(), octahedron_faces());
+    EXPECT_TRUE(collapse_best_of_all(buffer));
+    EXPECT_EQ(buffer.face_count(), 6u);
+    EXPECT_TRUE(buffer_consistent(buffer));
+    EXPECT_TRUE(collapse_best_of_all(buffer));
+    EXPECT_EQ(buffer.face_count(), 4u);
+    EXPECT_TRUE(buffer_consistent(buffer));
+    EXPECT_FALSE(collapse_best_of_all(buffer));
+    EXPECT_EQ(buffer.face_count(), 4u);
+}
+
+TEST(Collapse, BestOfAllTakesTheCheapestValidCollapse) {
+    // On the bowl, the scan does what taking the cheapest valid candidate by hand does (the
+    // first of equals in buffer order).
+    HalfEdgeBuffer scanned(256, 0), brute(256, 0);
+    add_grid(scanned);
+    add_grid(brute);
+    double cheapest = INFINITY;
+    uint32_t best = kNoIndex;
+    CollapsePlacement best_placement{};
+    const FaceSet& live = brute.live_faces();
+    for (size_t i = 0; i < live.size(); ++i)
+        for (uint32_t k = 0; k < 3; ++k) {
+            const uint32_t h = half_edge(live.at(i), k);
+            if (!collapse_eligible(brute, h)) continue;
+            const CollapsePlacement c = collapse_placement(brute, h);
+            if (c.error < cheapest && collapse_valid(brute, h, c.target)) {
+                cheapest = c.error;
+                best = h;
+                best_placement = c;
+            }
+        }
+    ASSERT_NE(best, kNoIndex);
+    apply_collapse(brute, best, best_placement.target);
+    ASSERT_TRUE(collapse_best_of_all(scanned));
+    EXPECT_EQ(scanned.face_count(), 30u);
+    EXPECT_TRUE(buffer_consistent(scanned));
+    for (uint32_t v = 0; v < 25; ++v) {
+        EXPECT_EQ(scanned.vertex(v).flags & kAlive, brute.vertex(v).flags & kAlive) << v;
+        EXPECT_EQ(scanned.vertex(v).face_count, brute.vertex(v).face_count) << v;
+        double a[3], b[3];
+        scanned.position(v, a);
+        brute.position(v, b);
+        EXPECT_EQ(std::vector<double>(a, a + 3), std::vector<double>(b, b + 3)) << v;
+    }
+}
