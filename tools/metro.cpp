@@ -310,14 +310,14 @@ struct SampleIndex {
     // Lowers best2 of every sample that triangle t (absolute bounding box abs_lo..abs_hi) is
     // closer to.
     void update(const float* t, const float abs_lo[3], const float abs_hi[3]) {
-        lower_within(abs_lo, abs_hi, [&](const double p[3], double best2) { return std::min(best2, point_triangle_dist2(p, t)); });
+        lower_within(abs_lo, abs_hi, [&](const double p[3], double so_far) { return std::min(so_far, point_triangle_dist2(p, t)); });
     }
     // The same for every triangle of `chunk` (abs_lo..abs_hi bounds them all), through its BVH:
     // for samples far from the streamed surface, which a triangle at a time would meet once for
     // every triangle within reach.
     void update(const TriangleIndex& chunk, const float abs_lo[3], const float abs_hi[3]) {
-        lower_within(abs_lo, abs_hi, [&](const double p[3], double best2) {
-            return bvh_nearest(chunk.nodes, p, best2, [&](uint32_t k) { return point_triangle_dist2(p, &chunk.xyz[9 * size_t{k}]); });
+        lower_within(abs_lo, abs_hi, [&](const double p[3], double so_far) {
+            return bvh_nearest(chunk.nodes, p, so_far, [&](uint32_t k) { return point_triangle_dist2(p, &chunk.xyz[9 * size_t{k}]); });
         });
     }
 
@@ -711,7 +711,7 @@ CompareResult compare_meshes(const MeshSource& a, const MeshSource& b, const Com
                                    ? std::sqrt(2 * streamed_summary.area / double(streamed_summary.triangles))
                                    : 0;
         const double far2 = (kFarFactor * typical) * (kFarFactor * typical);
-        if (std::any_of(bound2.begin(), bound2.end(), [&](double b) { return b > far2; })) {
+        if (std::any_of(bound2.begin(), bound2.end(), [&](double bound) { return bound > far2; })) {
             SampleIndex near;
             std::copy(samples.origin, samples.origin + 3, near.origin);
             std::copy(samples.origin, samples.origin + 3, far_samples.origin);
