@@ -24,6 +24,7 @@
 #include <map>
 #include <memory>
 #include <sstream>
+#include <string_view>
 #include <sys/stat.h>
 
 #ifndef MESHSTREAM_VERSION
@@ -535,7 +536,7 @@ double det3(const double* m) {
 
 // Required extensions listed in the raw JSON, for a clear refusal when tinygltf itself fails
 // on data only the extension explains (EXT_meshopt_compression's fallback buffers).
-std::vector<std::string> required_extensions_in(const std::string& json) {
+std::vector<std::string> required_extensions_in(std::string_view json) {
     std::vector<std::string> out;
     auto doc = nlohmann::json::parse(json, nullptr, false);
     if (doc.is_discarded() || !doc.is_object() || !doc.contains("extensionsRequired")) return out;
@@ -545,16 +546,30 @@ std::vector<std::string> required_extensions_in(const std::string& json) {
 }
 
 // The JSON of a glTF document: the file itself, or a GLB's first chunk (empty when cut short).
-std::string json_text(const std::vector<unsigned char>& bytes, bool glb) {
-    if (!glb) return std::string(bytes.begin(), bytes.end());
+std::string_view json_text(const std::vector<unsigned char>& bytes, bool glb) {
+    const char* text = reinterpret_cast<const char*>(bytes.data());
+    if (!glb) return {text, bytes.size()};
     if (bytes.size() < 20) return {};
-    const size_t len = std::min<size_t>(get_u32(&bytes[12]), bytes.size() - 20);
-    return std::string(reinterpret_cast<const char*>(&bytes[20]), len);
+    return {text + 20, std::min<size_t>(get_u32(&bytes[12]), bytes.size() - 20)};
+}
+
+// Whether some "uri" of the document names something other than a data: URI (a file).
+bool names_files(std::string_view json) {
+    for (size_t at = json.find("\"uri\""); at != std::string_view::npos; at = json.find("\"uri\"", at + 5)) {
+        size_t v = at + 5;
+        while (v < json.size() && (json[v] == ' ' || json[v] == '\t' || json[v] == '\r' || json[v] == '\n' || json[v] == ':'))
+            ++v;
+        if (json.substr(v, 6) != "\"data:") return true;
+    }
+    return false;
 }
 
 // The bytes the document's buffers in other files declare (byteLength of each buffer whose URI
 // is not a data: URI): tinygltf reads them whole, past the budget the document itself is held to.
-uint64_t external_buffer_bytes(const std::string& json) {
+// (Parsed only when some URI names a file: a document with embedded buffers, hundreds of MB of
+// base64, is not parsed an extra time.)
+uint64_t external_buffer_bytes(std::string_view json) {
+    if (!names_files(json)) return 0;
     const auto doc = nlohmann::json::parse(json, nullptr, false);
     uint64_t total = 0;
     if (doc.is_discarded() || !doc.is_object() || !doc.contains("buffers") || !doc["buffers"].is_array()) return 0;
