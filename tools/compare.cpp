@@ -43,8 +43,8 @@ nlohmann::ordered_json mesh_json(const MeshSummary& m) {
 
 // A direction without samples measured nothing: its figures are null, not 0; so are
 // percentages of a zero diagonal.
-nlohmann::ordered_json stats_json(const DistanceStats& s, double diagonal, bool measured) {
-    auto value = [&](double v) { return measured ? nlohmann::ordered_json(v) : nlohmann::ordered_json(); };
+nlohmann::ordered_json stats_json(const DistanceStats& s, double diagonal) {
+    auto value = [&](double v) { return s.samples > 0 ? nlohmann::ordered_json(v) : nlohmann::ordered_json(); };
     auto pct = [&](double v) { return diagonal > 0 ? value(100.0 * v / diagonal) : nlohmann::ordered_json(); };
     nlohmann::ordered_json j;
     j["samples"] = s.samples;
@@ -128,14 +128,14 @@ void run_compare(const CompareCliOptions& opt) {
         j["a"] = mesh_json(r.a);
         j["b"] = mesh_json(r.b);
         j["seed"] = opt.seed;
-        j["a_to_b"] = stats_json(r.a_to_b, diag, r.a_to_b.samples > 0);
-        j["b_to_a"] = stats_json(r.b_to_a, diag, r.b_to_a.samples > 0);
+        j["a_to_b"] = stats_json(r.a_to_b, diag);
+        j["b_to_a"] = stats_json(r.b_to_a, diag);
         DistanceStats sym;
         sym.samples = r.a_to_b.samples + r.b_to_a.samples;
         sym.max = r.hausdorff();
         sym.mean = r.mean();
         sym.rms = r.rms();
-        nlohmann::ordered_json s = stats_json(sym, diag, sym.samples > 0);
+        nlohmann::ordered_json s = stats_json(sym, diag);
         s.erase("samples");
         j["symmetric"] = s;
         j["diagonal"] = diag;
@@ -172,7 +172,7 @@ void run_compare(const CompareCliOptions& opt) {
     };
     row("A -> B", r.a_to_b.max, r.a_to_b.mean, r.a_to_b.rms, r.a_to_b.samples);
     row("B -> A", r.b_to_a.max, r.b_to_a.mean, r.b_to_a.rms, r.b_to_a.samples);
-    if (r.a_to_b.samples + r.b_to_a.samples == 0) row("symmetric", 0, 0, 0, 0);
+    if (none) row("symmetric", 0, 0, 0, 0);
     else row("symmetric", r.hausdorff(), r.mean(), r.rms(), std::nullopt);
 }
 
