@@ -52,9 +52,7 @@ void note_input_changes(const io::MeshHeader& header, const std::string& input_n
     for (const auto& [key, text] : header.notes)
         if (key == io::kLastLineNote)
             warnings.note(input_name + ": the last line " + text + " (a truncated download or pipe?): check its last face");
-    if (header.coordinate_rounding.value_or(0) <= 0) return;
-    for (const auto& [key, text] : header.notes)
-        if (key == io::kPrecisionNote)
+        else if (key == io::kPrecisionNote && header.coordinate_rounding.value_or(0) > 0)
             warnings.note(input_name + ": coordinates are " + text + "; meshstream works in float (32-bit)");
 }
 
