@@ -24,6 +24,11 @@ constexpr double kMinNormalCos = 0.1;
 constexpr double kMinFanCos = -0.6;
 // |n|² / (Σ edge²)² below this is a needle or cap (0.083 for an equilateral triangle).
 constexpr double kMinShapeQuality = 1e-8;
+// The two faces beside a removed face become neighbours; their normals may be at most ~154°
+// apart (cos > −0.9). Further is a knife edge or a fold: a gear's thin tooth whose narrow top
+// strip collapses leaves its two walls back to back. Neither wall need turn much (they were
+// nearly opposite across the strip already), so the per-face limits above do not see it.
+constexpr double kMinWingCos = -0.9;
 
 void sub(const double a[3], const double b[3], double out[3]) {
     out[0] = a[0] - b[0]; out[1] = a[1] - b[1]; out[2] = a[2] - b[2];
@@ -162,7 +167,7 @@ bool collapse_valid(HalfEdgeBuffer& buffer, uint32_t h) {
     return collapse_valid(buffer, h, to);
 }
 
-bool collapse_valid(HalfEdgeBuffer& buffer, uint32_t h, const double target[3]) {
+bool collapse_valid(HalfEdgeBuffer& buffer, uint32_t h, const double target[3], KnifeEdges knife_edges) {
     const PhaseTimer timer(Phase::kValidate);
     const uint32_t p = buffer.corner_vertex(h), q = buffer.corner_vertex(next_in_face(h));
     const uint32_t t = buffer.twin(h);
@@ -311,6 +316,22 @@ bool collapse_valid(HalfEdgeBuffer& buffer, uint32_t h, const double target[3]) 
                 written_other(buffer.corner_vertex(prev_in_face(cp))))
                 return false;
     }
+
+    // The faces beside removed face (u, v, w), where e = u→v is h or its twin, meet across w–v
+    // once u and v are at the target: (w, v, x) through twin(v→w), (u, w, y) through twin(w→u).
+    auto back_to_back = [&](uint32_t e) {
+        const uint32_t a = buffer.twin(next_in_face(e)), b = buffer.twin(prev_in_face(e));
+        if (!is_half_edge(a) || !is_half_edge(b)) return false;
+        double w[3], x[3], y[3], e1[3], e2[3], na[3], nb[3];
+        buffer.position(buffer.corner_vertex(a), w);
+        buffer.position(buffer.corner_vertex(prev_in_face(a)), x);
+        buffer.position(buffer.corner_vertex(prev_in_face(b)), y);
+        sub(target, w, e1); sub(x, w, e2); cross(e1, e2, na);
+        sub(w, target, e1); sub(y, target, e2); cross(e1, e2, nb);
+        const double d = dot(na, nb);
+        return d < 0 && d * d > kMinWingCos * kMinWingCos * dot(na, na) * dot(nb, nb);
+    };
+    if (knife_edges == KnifeEdges::kRefuse && (back_to_back(h) || (!boundary && back_to_back(t)))) return false;
 
     double from_p[3];
     buffer.position(p, from_p);
@@ -508,11 +529,12 @@ bool collapse_best_of_all(HalfEdgeBuffer& buffer) {
     // Stable: ties keep buffer order, so the result is deterministic.
     std::stable_sort(all.begin(), all.end(),
                      [](const Candidate& a, const Candidate& b) { return a.placement.error < b.placement.error; });
-    for (const Candidate& c : all)
-        if (collapse_valid(buffer, c.h, c.placement.target)) {
-            apply_collapse(buffer, c.h, c.placement.target);
-            return true;
-        }
+    for (const KnifeEdges knife_edges : {KnifeEdges::kRefuse, KnifeEdges::kAllow})
+        for (const Candidate& c : all)
+            if (collapse_valid(buffer, c.h, c.placement.target, knife_edges)) {
+                apply_collapse(buffer, c.h, c.placement.target);
+                return true;
+            }
     return false;
 }
 

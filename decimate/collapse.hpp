@@ -64,11 +64,16 @@ CollapsePlacement collapse_placement(const HalfEdgeBuffer& buffer, uint32_t h);
 // Full validity of an eligible collapse p→q: p's fan is a single closed (or, for a boundary
 // half-edge, a single open) fan; the link condition holds (the common neighbours of p and q
 // are exactly the vertices opposite the edge), no tetrahedron collapses; no remaining face
-// around p flips or folds (normal turns by more than ~84°) or becomes degenerate.
+// around p flips or folds (normal turns by more than ~84°) or becomes degenerate; the two
+// faces beside each removed face, which become neighbours, do not end up back to back (a
+// knife edge: normals more than ~154° apart).
 bool collapse_valid(HalfEdgeBuffer& buffer, uint32_t h);
 // The same for merging p and q at `target` (relative coordinates): the remaining faces of
-// both p and q are checked against the new position.
-bool collapse_valid(HalfEdgeBuffer& buffer, uint32_t h, const double target[3]);
+// both p and q are checked against the new position. kAllow lets knife edges through (every
+// other check still holds): for the end of input, when nothing else is left.
+enum class KnifeEdges { kRefuse, kAllow };
+bool collapse_valid(HalfEdgeBuffer& buffer, uint32_t h, const double target[3],
+                    KnifeEdges knife_edges = KnifeEdges::kRefuse);
 
 // Performs the half-edge collapse p→q: removes the one or two faces on the edge, re-links
 // their outer neighbours, moves p's corners to q and adds Q_p to Q_q, frees p.
@@ -123,6 +128,9 @@ bool collapse_one_boundary_edge(HalfEdgeBuffer& buffer);
 // The valid collapse with the smallest error among every eligible half-edge of the buffer,
 // rated and placed by collapse_placement(), found by a scan; false when none is valid. For the
 // end of input, when random draws stop finding the few valid collapses left in a small buffer.
+// Only when no collapse is valid does it take the cheapest one that leaves a knife edge
+// (KnifeEdges::kAllow): reaching the count asked for comes first (thin tubes, such as a
+// spider's legs, cannot come down otherwise).
 bool collapse_best_of_all(HalfEdgeBuffer& buffer);
 
 }  // namespace meshstream::decimate

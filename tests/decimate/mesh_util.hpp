@@ -121,6 +121,28 @@ inline void triangle_normal(const float* t, double n[3]) {
     n[2] = e1[0] * e2[1] - e1[1] * e2[0];
 }
 
+// Edges between two faces whose normals are more than ~154° apart (cos < −0.9): knife edges
+// and folds. `ids` index the corners of `xyz` (9 floats a triangle).
+inline size_t back_to_back_edges(const std::vector<float>& xyz, const std::vector<uint64_t>& ids) {
+    std::map<std::pair<uint64_t, uint64_t>, std::vector<size_t>> faces_of_edge;
+    for (size_t f = 0; f < ids.size() / 3; ++f)
+        for (int k = 0; k < 3; ++k) {
+            const uint64_t a = ids[3 * f + k], b = ids[3 * f + (k + 1) % 3];
+            faces_of_edge[{std::min(a, b), std::max(a, b)}].push_back(f);
+        }
+    size_t count = 0;
+    for (const auto& [edge, faces] : faces_of_edge) {
+        if (faces.size() != 2) continue;
+        double m[3], n[3];
+        triangle_normal(&xyz[9 * faces[0]], m);
+        triangle_normal(&xyz[9 * faces[1]], n);
+        const double d = m[0] * n[0] + m[1] * n[1] + m[2] * n[2];
+        if (d < 0 && d * d > 0.81 * (m[0] * m[0] + m[1] * m[1] + m[2] * m[2]) * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]))
+            ++count;
+    }
+    return count;
+}
+
 // Fraction of output area whose normal points against the normal of the nearest input
 // triangle (nearest by centroid, through a uniform grid).
 inline double flipped_area_fraction(const std::vector<float>& input, const std::vector<float>& output) {
