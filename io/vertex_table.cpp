@@ -15,10 +15,14 @@ namespace meshstream::io {
 namespace {
 
 constexpr size_t kPageBytes = 4096;
-// Residency is accounted in blocks of this size, not pages: on a read fault in a shared file
-// mapping, Linux also maps the neighbouring pages already in the page cache ("fault-around",
-// 64 KiB by default), so one touched page can make sixteen resident.
-constexpr size_t kResidencyBlockBytes = size_t{64} << 10;
+// Residency is accounted in blocks of this size, aligned in the file, not in pages: on a read
+// fault in a shared file mapping, Linux maps the page's whole page-cache folio, which can be
+// as large as the PMD size (2 MiB on x86-64), and the cached pages within 64 KiB around it
+// ("fault-around"), with their folios. Measured on the 6.18 kernel this was written on: one
+// byte read from a file the page cache had read ahead made 2 MiB resident, from a file just
+// written about 350 KiB.
+constexpr uint64_t kResidencyBlockBytes = uint64_t{2} << 20;
+constexpr uint64_t kFaultAroundBytes = uint64_t{64} << 10;
 constexpr size_t kTailBytes = size_t{1} << 20;
 
 }  // namespace
@@ -53,6 +57,7 @@ std::unique_ptr<VertexTable> VertexTable::map_input_file(const std::string& path
         throw Error(path, offset, 0, "cannot map the vertex block: " + std::string(std::strerror(errno)));
     }
     t->base_ = static_cast<const std::byte*>(t->map_) + (offset - aligned);
+    t->base_file_offset_ = offset;
     if (t->map_bytes_ > budget_bytes) t->start_accounting();
     return t;
 }
@@ -108,7 +113,6 @@ void VertexTable::flush_tail() {
     uint64_t bytes = (mapped_records_ + records) * stride_;
     if (bytes > map_bytes_) map_temp(bytes);
     mapped_records_ += records;
-    touched_bits_.resize(block_count() / 64 + 2, 0);
 }
 
 // Maps the temp file with room to grow: a shared mapping longer than the file is valid, and
@@ -128,35 +132,44 @@ void VertexTable::map_temp(uint64_t min_bytes) {
 }
 
 size_t VertexTable::block_count() const {
-    const uintptr_t start = reinterpret_cast<uintptr_t>(map_) / kResidencyBlockBytes * kResidencyBlockBytes;
-    return (reinterpret_cast<uintptr_t>(map_) + map_bytes_ - start) / kResidencyBlockBytes + 1;
+    const uint64_t map_file_offset = base_file_offset_ - static_cast<uint64_t>(base_ - static_cast<const std::byte*>(map_));
+    return static_cast<size_t>((map_file_offset + map_bytes_ + kFaultAroundBytes) / kResidencyBlockBytes + 1);
 }
 
 void VertexTable::start_accounting() {
-    block_limit_ = std::max<uint64_t>(budget_bytes_ / kResidencyBlockBytes, 16);
-    touched_bits_.assign(block_count() / 64 + 2, 0);
-    touched_blocks_ = 0;
+    // At least the three blocks one read can make resident (its own and a neighbour each side).
+    block_limit_ = std::max<uint64_t>(budget_bytes_ / kResidencyBlockBytes, 3);
+    touched_bits_.assign(block_count() / 64 + 1, 0);
+    touched_order_.clear();
 }
 
 const std::byte* VertexTable::record_in_map(uint64_t byte_offset) {
     const std::byte* record = base_ + byte_offset;
-    if (!touched_bits_.empty()) {
-        // Fault-around windows are aligned in the address space, so blocks are counted there.
-        const uintptr_t start = reinterpret_cast<uintptr_t>(map_) / kResidencyBlockBytes * kResidencyBlockBytes;
-        const uint64_t block = (reinterpret_cast<uintptr_t>(record) - start) / kResidencyBlockBytes;
+    if (touched_bits_.empty()) return record;
+    // The blocks this read can make resident: the record's (a record of at most 16 bytes may
+    // straddle into the next, within the fault-around reach) and those within 64 KiB of it.
+    const uint64_t at = base_file_offset_ + byte_offset;
+    const uint64_t blocks[3] = {(at > kFaultAroundBytes ? at - kFaultAroundBytes : 0) / kResidencyBlockBytes,
+                                at / kResidencyBlockBytes, (at + kFaultAroundBytes) / kResidencyBlockBytes};
+    for (const uint64_t block : blocks) {
         uint64_t& word = touched_bits_[block >> 6];
         const uint64_t bit = uint64_t{1} << (block & 63);
         if (!(word & bit)) {
-            // A record can straddle two blocks; count the first, the second is at most one more.
             word |= bit;
-            if (++touched_blocks_ > block_limit_) {
-                uint64_t used = mapped_records_ * stride_ + static_cast<uint64_t>(base_ - static_cast<const std::byte*>(map_));
-                ::madvise(map_, static_cast<size_t>(std::min<uint64_t>(used + kPageBytes, map_bytes_)) / kPageBytes * kPageBytes,
-                          MADV_DONTNEED);
-                std::fill(touched_bits_.begin(), touched_bits_.end(), 0);
-                touched_blocks_ = 0;
-            }
+            touched_order_.push_back(block);
         }
+    }
+    // Past the budget, the block touched first goes (first in, first out: faces use vertices
+    // near each other, so a sliding window of blocks stays resident). This read's own blocks
+    // are the last ones in, and the limit is at least three, so they stay.
+    const uint64_t map_file_offset = base_file_offset_ - static_cast<uint64_t>(base_ - static_cast<const std::byte*>(map_));
+    while (touched_order_.size() > block_limit_) {
+        const uint64_t block = touched_order_.front();
+        touched_order_.pop_front();
+        touched_bits_[block >> 6] &= ~(uint64_t{1} << (block & 63));
+        const uint64_t begin = std::max(block * kResidencyBlockBytes, map_file_offset) - map_file_offset;
+        const uint64_t end = std::min((block + 1) * kResidencyBlockBytes - map_file_offset, uint64_t{map_bytes_});
+        if (begin < end) ::madvise(static_cast<std::byte*>(map_) + begin, static_cast<size_t>(end - begin), MADV_DONTNEED);
     }
     return record;
 }

@@ -6,12 +6,12 @@
 // block is mapped (map_input_file). emit_polygon, at the end, turns a face into triangles for
 // both readers.
 //
-// Memory: mapped pages count towards RSS once touched, and Linux maps up to 64 KiB of cached
-// neighbours with each faulted page (fault-around). So reads through a mapping larger than the
-// budget mark the 64 KiB blocks they touch in a bitmap and drop them all with
-// madvise(MADV_DONTNEED) when the marked blocks pass the budget. Resident memory is therefore
-// at most budget + 64 KiB + bitmap (1/2^22 of the table) + one 1 MiB append buffer, whatever
-// the input size.
+// Memory: mapped pages count towards RSS once touched, and Linux maps the faulted page's whole
+// page-cache folio (up to 2 MiB) and its cached neighbours within 64 KiB (fault-around). So
+// reads through a mapping larger than the budget note the 2 MiB blocks of the file they can
+// have made resident, and past the budget drop the block noted first with
+// madvise(MADV_DONTNEED). Resident memory is therefore at most max(budget, 6 MiB) + bitmap
+// (1/2^24 of the table) + one 1 MiB append buffer, whatever the input size.
 #pragma once
 
 #include "io/byte_stream.hpp"
@@ -20,6 +20,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <deque>
 #include <memory>
 #include <string>
 #include <vector>
@@ -80,13 +81,14 @@ private:
     void* map_ = nullptr;
     size_t map_bytes_ = 0;
     const std::byte* base_ = nullptr;  // first record (map_ plus the page-alignment delta)
+    uint64_t base_file_offset_ = 0;    // where the first record is in the mapped file
     uint64_t mapped_records_ = 0;
     std::vector<std::byte> tail_;
-    // Residency accounting for mappings larger than the budget, in 64 KiB blocks.
+    // Residency accounting for mappings larger than the budget, in 2 MiB blocks of the file.
     void start_accounting();
     size_t block_count() const;
-    std::vector<uint64_t> touched_bits_;
-    uint64_t touched_blocks_ = 0;
+    std::vector<uint64_t> touched_bits_;  // blocks that may be resident
+    std::deque<uint64_t> touched_order_;  // the same, in the order they were first touched
     uint64_t block_limit_ = 0;
 };
 
