@@ -13,8 +13,11 @@
 // positions and exact welding recovers a closed manifold (before --holes), except where float
 // rounding lands two edge vertices on one position (a few edges at some sizes: 4 at 100 k).
 //
-// Memory: two planes of grid values ((n+1)² floats each, n ≈ 1200 for 50 M triangles: 12 MB)
-// and one output chunk; with --shuffle, bucket buffers of at most 128 MiB each.
+// Memory: the triangles of the bands of 4 slabs in flight (2 per worker thread waiting, one per
+// worker being marched, one being written), which grow with the triangles per slab: measured
+// 43 MB for 10 M and 150 MB for 50 M triangles with two threads (28 and 94 MB with one); the
+// grid planes are small beside them (n ≈ 1200 for 50 M triangles: 12 MB). --shuffle adds one
+// bucket of at most 128 MiB, shuffled in memory.
 #include "io/byte_stream.hpp"
 #include "io/error.hpp"
 #include "io/format.hpp"
@@ -423,11 +426,14 @@ int run(const GenOptions& opt) {
         Rng rng{opt.seed ^ 0x53485546ull};
         count = march_parallel(table, shape, n, holes, threads,
                       [&](const float* tri) { files[rng.next() % buckets]->write(tri, 9 * sizeof(float)); });
-        std::vector<float> data;
+        // One allocation for the largest bucket: growing the vector from bucket to bucket held
+        // two buckets at once while it copied (250 MB for 10 M triangles instead of 170).
+        uint64_t largest = 0;
+        for (const auto& file : files) largest = std::max(largest, file->size());
+        std::vector<float> data(largest / sizeof(float));
         for (auto& file : files) {
-            data.resize(file->size() / sizeof(float));
-            if (!data.empty()) file->read_at(0, data.data(), data.size() * sizeof(float));
-            size_t m = data.size() / 9;
+            const size_t m = file->size() / (9 * sizeof(float));
+            if (m > 0) file->read_at(0, data.data(), m * 9 * sizeof(float));
             for (size_t i = m; i > 1; --i) {
                 size_t r = rng.next() % i;
                 if (r != i - 1) std::swap_ranges(&data[9 * r], &data[9 * r + 9], &data[9 * (i - 1)]);
@@ -457,8 +463,9 @@ int main(int argc, char** argv) {
     tools::GenOptions opt;
     CLI::App app{
         "meshstream-gen: write a synthetic marching-cubes mesh (gyroid network with bumps, clipped to a ball) as a\n"
-        "triangle soup approximately sorted along z, like a scanner pipeline. Memory: two grid planes (about 12 MB\n"
-        "for 50 M triangles) plus one chunk; --shuffle adds bucket files in --tmpdir and at most 128 MiB of memory."};
+        "triangle soup approximately sorted along z, like a scanner pipeline. Memory: the bands of triangles in\n"
+        "flight, about 45 MB for 10 M and 150 MB for 50 M triangles with two threads (less with --threads 1);\n"
+        "--shuffle adds bucket files in --tmpdir and one bucket of at most 128 MiB in memory."};
     app.add_option("output", opt.output, "Output mesh (format from the extension, or --to)")->required();
     app.add_option("-n,--triangles", opt.triangles, "Target triangle count (met within 1 % from about 10000 up; small ones overshoot: 100 gives 160)")
         ->capture_default_str()
