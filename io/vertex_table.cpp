@@ -57,7 +57,7 @@ std::unique_ptr<VertexTable> VertexTable::map_input_file(const std::string& path
         throw Error(path, offset, 0, "cannot map the vertex block: " + std::string(std::strerror(errno)));
     }
     t->base_ = static_cast<const std::byte*>(t->map_) + (offset - aligned);
-    t->base_file_offset_ = offset;
+    t->map_file_offset_ = aligned;
     if (t->map_bytes_ > budget_bytes) t->start_accounting();
     return t;
 }
@@ -132,8 +132,7 @@ void VertexTable::map_temp(uint64_t min_bytes) {
 }
 
 size_t VertexTable::block_count() const {
-    const uint64_t map_file_offset = base_file_offset_ - static_cast<uint64_t>(base_ - static_cast<const std::byte*>(map_));
-    return static_cast<size_t>((map_file_offset + map_bytes_ + kFaultAroundBytes) / kResidencyBlockBytes + 1);
+    return static_cast<size_t>((map_file_offset_ + map_bytes_ + kFaultAroundBytes) / kResidencyBlockBytes + 1);
 }
 
 void VertexTable::start_accounting() {
@@ -148,7 +147,8 @@ const std::byte* VertexTable::record_in_map(uint64_t byte_offset) {
     if (touched_bits_.empty()) return record;
     // The blocks this read can make resident: the record's (a record of at most 16 bytes may
     // straddle into the next, within the fault-around reach) and those within 64 KiB of it.
-    const uint64_t at = base_file_offset_ + byte_offset;
+    const std::byte* map = static_cast<const std::byte*>(map_);
+    const uint64_t at = map_file_offset_ + static_cast<uint64_t>(record - map);
     const uint64_t blocks[3] = {(at > kFaultAroundBytes ? at - kFaultAroundBytes : 0) / kResidencyBlockBytes,
                                 at / kResidencyBlockBytes, (at + kFaultAroundBytes) / kResidencyBlockBytes};
     for (const uint64_t block : blocks) {
@@ -162,14 +162,16 @@ const std::byte* VertexTable::record_in_map(uint64_t byte_offset) {
     // Past the budget, the block touched first goes (first in, first out: faces use vertices
     // near each other, so a sliding window of blocks stays resident). This read's own blocks
     // are the last ones in, and the limit is at least three, so they stay.
-    const uint64_t map_file_offset = base_file_offset_ - static_cast<uint64_t>(base_ - static_cast<const std::byte*>(map_));
     while (touched_order_.size() > block_limit_) {
         const uint64_t block = touched_order_.front();
         touched_order_.pop_front();
         touched_bits_[block >> 6] &= ~(uint64_t{1} << (block & 63));
-        const uint64_t begin = std::max(block * kResidencyBlockBytes, map_file_offset) - map_file_offset;
-        const uint64_t end = std::min((block + 1) * kResidencyBlockBytes - map_file_offset, uint64_t{map_bytes_});
-        if (begin < end) ::madvise(static_cast<std::byte*>(map_) + begin, static_cast<size_t>(end - begin), MADV_DONTNEED);
+        // The block's part of the mapping, in file offsets (a block may lie partly or wholly
+        // outside it).
+        const uint64_t begin = std::max(block * kResidencyBlockBytes, map_file_offset_);
+        const uint64_t end = std::min((block + 1) * kResidencyBlockBytes, map_file_offset_ + map_bytes_);
+        if (begin < end)
+            ::madvise(const_cast<std::byte*>(map + (begin - map_file_offset_)), static_cast<size_t>(end - begin), MADV_DONTNEED);
     }
     return record;
 }

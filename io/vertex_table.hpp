@@ -81,7 +81,7 @@ private:
     void* map_ = nullptr;
     size_t map_bytes_ = 0;
     const std::byte* base_ = nullptr;  // first record (map_ plus the page-alignment delta)
-    uint64_t base_file_offset_ = 0;    // where the first record is in the mapped file
+    uint64_t map_file_offset_ = 0;     // where map_ starts in the mapped file
     uint64_t mapped_records_ = 0;
     std::vector<std::byte> tail_;
     // Residency accounting for mappings larger than the budget, in 2 MiB blocks of the file.
