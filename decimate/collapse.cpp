@@ -411,7 +411,7 @@ void apply_collapse(HalfEdgeBuffer& buffer, uint32_t h, const double target[3]) 
     if (at[0] != target[0] || at[1] != target[1] || at[2] != target[2]) buffer.set_position(q, target);
 }
 
-bool decimate_once(HalfEdgeBuffer& buffer, Rng& rng, int candidates, CandidateMemory* memory) {
+bool decimate_once(HalfEdgeBuffer& buffer, Rng& rng, int candidates, CandidateMemory* memory, KnifeEdges knife_edges) {
     using Candidate = CandidateMemory::Entry;
     constexpr int kMaxCandidates = CandidateMemory::kCapacity;
     const int wanted = std::clamp(candidates, 1, kMaxCandidates);
@@ -494,7 +494,7 @@ bool decimate_once(HalfEdgeBuffer& buffer, Rng& rng, int candidates, CandidateMe
     for (int i = 0; i < found; ++i) {
         const Candidate& c = rated[order[i]];
         if (i > 0 && c.h == rated[order[i - 1]].h) continue;
-        if (collapse_valid(buffer, c.h, c.target)) {
+        if (collapse_valid(buffer, c.h, c.target, knife_edges)) {
             const uint32_t t = buffer.twin(c.h);
             const uint32_t r = buffer.corner_vertex(prev_in_face(c.h));
             const uint32_t s = is_half_edge(t) ? buffer.corner_vertex(prev_in_face(t)) : kNoIndex;

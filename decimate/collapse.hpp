@@ -90,8 +90,8 @@ bool moves_keep_faces_valid(const HalfEdgeBuffer& buffer, uint32_t v, const doub
                             const double to[3], uint32_t skip0, uint32_t skip1);
 
 // DECIMATE(1) of §4.3: draws up to `candidates` eligible half-edges (at most 8·candidates
-// random draws), collapses the valid one with the smallest error, each rated and placed by
-// collapse_placement(). Returns false when no
+// random draws), collapses the valid one with the smallest error (validity as collapse_valid's
+// with `knife_edges`), each rated and placed by collapse_placement(). Returns false when no
 // candidate was found or none was valid (the caller decides whether that means "stalled").
 //
 // Beyond the paper: with `memory`, the runners-up of one call (the valid-looking candidates
@@ -117,7 +117,8 @@ struct CandidateMemory {
     uint64_t edits = 0;        // buffer.edits() right after the last collapse
     uint32_t touched[4] = {};  // the vertices that collapse changed
 };
-bool decimate_once(HalfEdgeBuffer& buffer, Rng& rng, int candidates, CandidateMemory* memory = nullptr);
+bool decimate_once(HalfEdgeBuffer& buffer, Rng& rng, int candidates, CandidateMemory* memory = nullptr,
+                   KnifeEdges knife_edges = KnifeEdges::kRefuse);
 
 // A boundary collapse removing exactly one face, used once at the end of input to land on an
 // odd target count: the valid collapse p→q along a true-boundary half-edge (no partner, p not

@@ -243,20 +243,29 @@ void StreamDecimator::finish(const Emit& out) {
     stats_.target_triangles = target;
     const size_t budget = final_budget(target, output_.triangle_count());
     int failures = 0;
+    KnifeEdges knife_edges = KnifeEdges::kRefuse;
     while (buffer_.face_count() >= budget + 2) {
-        if (decimate_once(buffer_, rng_, options_.candidates, &candidate_memory_)) {
+        if (decimate_once(buffer_, rng_, options_.candidates, &candidate_memory_, knife_edges)) {
             ++stats_.collapses;
             failures = 0;
         } else if (++failures >= stall_attempts(options_.candidates)) {
-            // Random draws miss the few valid collapses left in a small buffer (a closed 5 558
-            // triangle elephant stopped at 62 of 56): a scan finds them, or shows there are none.
-            if (buffer_.face_count() > kScanLimit) break;
-            if (!collapse_best_of_all(buffer_)) {
-                stats_.no_valid_collapse_left = true;
+            failures = 0;
+            if (buffer_.face_count() <= kScanLimit) {
+                // Random draws miss the few valid collapses left in a small buffer (a closed
+                // 5 558 triangle elephant stopped at 62 of 56): a scan finds them (allowing a
+                // knife edge only when nothing else is left), or shows there are none.
+                if (!collapse_best_of_all(buffer_)) {
+                    stats_.no_valid_collapse_left = true;
+                    break;
+                }
+                ++stats_.collapses;
+            } else if (knife_edges == KnifeEdges::kRefuse) {
+                // Too large to scan: the count comes first, so draws may now leave knife edges
+                // (the strips between a CAD part's many small faces cannot come down otherwise).
+                knife_edges = KnifeEdges::kAllow;
+            } else {
                 break;
             }
-            ++stats_.collapses;
-            failures = 0;
         }
     }
     // Collapses remove two faces; an odd remainder needs one boundary collapse.
