@@ -59,7 +59,7 @@ public:
     const std::string& name() const { return name_; }
     bool gzip() const { return gzip_; }
     // The filesystem path when the source is a plain (not gzip) regular file, for readers that
-    // can mmap parts of it; empty otherwise.
+    // read parts of it in place; empty otherwise.
     const std::string& regular_file_path() const { return regular_path_; }
 
     // Throws io::Error at the current offset (helper for readers).

@@ -483,7 +483,7 @@ private:
         const Element& e = elements_[index];
         size_t fixed = e.fixed_bytes();
         const uint64_t budget = options_.memory_budget_bytes;
-        // A plain file in host byte order with float x, y, z (and uchar colour) is mapped as is.
+        // A plain file in host byte order with float x, y, z (and uchar colour) is read in place.
         bool direct = encoding_ != Encoding::kAscii && !swap_ && fixed > 0 && !src_.regular_file_path().empty();
         size_t offsets[6] = {};
         for (int s = 0; s < 6; ++s) {
@@ -505,7 +505,7 @@ private:
             const size_t xyz[3] = {offsets[0], offsets[1], offsets[2]};
             table_ = VertexTable::map_input_file(src_.regular_file_path(), start, e.count, fixed, xyz,
                                                  has_color_ ? offsets + 3 : nullptr, budget);
-            header_.notes.emplace_back("vertex table", "input file, mapped");
+            header_.notes.emplace_back("vertex table", "input file, read in place");
             return;
         }
         table_ = std::make_unique<VertexTable>(budget, options_.tmpdir, has_color_);
@@ -552,7 +552,7 @@ private:
         }
         header_.notes.emplace_back("vertex table", table_->storage() == VertexTable::Storage::kMemory
                                                        ? "in memory"
-                                                       : "temporary file, mapped");
+                                                       : "temporary file");
         if (doubles) {
             std::string text = "double, rounded to float: moved by up to ";
             append_number(text, static_cast<float>(worst_rounding));

@@ -1,7 +1,7 @@
 // PLY (Stanford polygon file format), ascii, binary_little_endian and binary_big_endian.
 // Memory class: O(vertices), spilled past --memory. The reader keeps the vertex table
 // (io/vertex_table.hpp: in memory within the budget, else a temp file or the input's own
-// vertex block read through mmap) and streams the faces, triangulating polygons
+// vertex block read in place) and streams the faces, triangulating polygons
 // (io/triangulate.hpp: the fan from the first corner when convex, else ear clipping). The
 // writer welds (io/weld.hpp) and assembles header, vertices and faces at finish(), so the
 // output is valid even on stdout.

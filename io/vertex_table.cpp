@@ -1,5 +1,5 @@
-// The spillable vertex table: memory blocks, then a temp file or the input read through mmap
-// with resident-page accounting (see vertex_table.hpp).
+// The spillable vertex table: memory blocks, then a temp file or the input file read through
+// a page cache of its own (see vertex_table.hpp).
 #include "io/vertex_table.hpp"
 
 #include "io/error.hpp"
@@ -8,6 +8,7 @@
 #include <cerrno>
 #include <cstring>
 #include <fcntl.h>
+#include <new>
 #include <sys/mman.h>
 #include <unistd.h>
 
@@ -15,14 +16,7 @@ namespace meshstream::io {
 namespace {
 
 constexpr size_t kPageBytes = 4096;
-// Residency is accounted in blocks of this size, aligned in the file, not in pages: on a read
-// fault in a shared file mapping, Linux maps the page's whole page-cache folio, which can be
-// as large as the PMD size (2 MiB on x86-64), and the cached pages within 64 KiB around it
-// ("fault-around"), with their folios. Measured on the 6.18 kernel this was written on: one
-// byte read from a file the page cache had read ahead made 2 MiB resident, from a file just
-// written about 350 KiB.
-constexpr uint64_t kResidencyBlockBytes = uint64_t{2} << 20;
-constexpr uint64_t kFaultAroundBytes = uint64_t{64} << 10;
+constexpr uint64_t kNoPage = ~uint64_t{0};
 constexpr size_t kTailBytes = size_t{1} << 20;
 
 }  // namespace
@@ -40,7 +34,9 @@ std::unique_ptr<VertexTable> VertexTable::map_input_file(const std::string& path
     t->budget_bytes_ = budget_bytes;
     t->stride_ = stride;
     t->size_ = count;
-    t->mapped_records_ = count;
+    t->file_records_ = count;
+    t->file_offset_ = offset;
+    t->input_path_ = path;
     std::copy(std::begin(xyz_offsets), std::end(xyz_offsets), t->xyz_offsets_);
     if (rgb_offsets) {
         t->color_ = true;
@@ -48,22 +44,12 @@ std::unique_ptr<VertexTable> VertexTable::map_input_file(const std::string& path
     }
     if (count == 0) return t;
     t->input_fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-    if (t->input_fd_ < 0) throw Error(path, "cannot open for mapping: " + std::string(std::strerror(errno)));
-    uint64_t aligned = offset / kPageBytes * kPageBytes;
-    t->map_bytes_ = static_cast<size_t>(offset - aligned + count * stride);
-    t->map_ = ::mmap(nullptr, t->map_bytes_, PROT_READ, MAP_SHARED, t->input_fd_, static_cast<off_t>(aligned));
-    if (t->map_ == MAP_FAILED) {
-        t->map_ = nullptr;
-        throw Error(path, offset, 0, "cannot map the vertex block: " + std::string(std::strerror(errno)));
-    }
-    t->base_ = static_cast<const std::byte*>(t->map_) + (offset - aligned);
-    t->map_file_offset_ = aligned;
-    if (t->map_bytes_ > budget_bytes) t->start_accounting();
+    if (t->input_fd_ < 0) throw Error(path, "cannot open to read the vertex block: " + std::string(std::strerror(errno)));
+    t->start_cache(count * stride);
     return t;
 }
 
 VertexTable::~VertexTable() {
-    if (map_) ::munmap(map_, map_bytes_);
     if (input_fd_ >= 0) ::close(input_fd_);
 }
 
@@ -83,7 +69,7 @@ void VertexTable::append(const float* xyz, const uint8_t* rgb) {
             return;
         }
     }
-    // kTempFile: append to the tail, flushing it (and extending the mapping) when full.
+    // kTempFile: append to the tail, flushing it to the file when full.
     if (tail_.size() + stride_ > kTailBytes) flush_tail();
     tail_.insert(tail_.end(), rec, rec + stride_);
     ++size_;
@@ -100,95 +86,96 @@ void VertexTable::spill() {
     std::vector<std::unique_ptr<std::byte[]>>().swap(blocks_);
     storage_ = Storage::kTempFile;
     tail_.reserve(kTailBytes);
-    map_temp(size_ * stride_);
-    mapped_records_ = size_;
+    file_records_ = size_;
+    start_cache(~uint64_t{0});  // the table grows: a cache as large as the budget
 }
 
 void VertexTable::flush_tail() {
     if (tail_.empty()) return;
+    // The page holding the file's current end may be cached short: it is about to grow.
+    const uint64_t end = file_offset_ + file_records_ * stride_;
+    if (end % kPageBytes != 0) {
+        const uint64_t page = end / kPageBytes - file_offset_ / kPageBytes;
+        uint64_t& tag = page_tags_[static_cast<size_t>(page % page_tags_.size())];
+        if (tag == page) tag = kNoPage;
+    }
     temp_->write(tail_.data(), tail_.size());
     temp_->flush();
-    uint64_t records = tail_.size() / stride_;
+    file_records_ += tail_.size() / stride_;
     tail_.clear();
-    uint64_t bytes = (mapped_records_ + records) * stride_;
-    if (bytes > map_bytes_) map_temp(bytes);
-    mapped_records_ += records;
 }
 
-// Maps the temp file with room to grow: a shared mapping longer than the file is valid, and
-// the pages become readable as write() extends the file (one page cache).
-void VertexTable::map_temp(uint64_t min_bytes) {
-    if (map_) ::munmap(map_, map_bytes_);
-    map_ = nullptr;
-    uint64_t want = std::max<uint64_t>({min_bytes * 2, uint64_t{1} << 30});
-    map_bytes_ = static_cast<size_t>(want);
-    map_ = ::mmap(nullptr, map_bytes_, PROT_READ, MAP_SHARED, temp_->fd(), 0);
-    if (map_ == MAP_FAILED) {
-        map_ = nullptr;
-        throw Error(temp_->path(), "cannot map the vertex table: " + std::string(std::strerror(errno)));
+void VertexTable::start_cache(uint64_t table_bytes) {
+    // Slots for the whole table when it fits the budget (no two pages then share a slot),
+    // else for the budget; at least 16.
+    const uint64_t pages = std::min(table_bytes / kPageBytes + 2, std::max<uint64_t>(budget_bytes_ / kPageBytes, 16));
+    const size_t bytes = static_cast<size_t>(pages * kPageBytes);
+    void* p = ::mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);  // resident when used
+    if (p == MAP_FAILED) throw std::bad_alloc();
+    pages_ = std::unique_ptr<std::byte, Unmap>(static_cast<std::byte*>(p), Unmap{bytes});
+    page_tags_.assign(static_cast<size_t>(pages), kNoPage);
+}
+
+void VertexTable::Unmap::operator()(std::byte* p) const { ::munmap(p, bytes); }
+
+void VertexTable::read_file(uint64_t offset, void* dst, size_t n) {
+    const int fd = storage_ == Storage::kInputFile ? input_fd_ : temp_->fd();
+    auto* p = static_cast<char*>(dst);
+    while (n > 0) {
+        const ssize_t got = ::pread(fd, p, n, static_cast<off_t>(offset));
+        if (got < 0 && errno == EINTR) continue;
+        const std::string& path = storage_ == Storage::kInputFile ? input_path_ : temp_->path();
+        if (got < 0) throw Error(path, offset, 0, "cannot read the vertex table: " + std::string(std::strerror(errno)));
+        if (got == 0) throw Error(path, offset, 0, "the vertex table ends early (was the file changed while read?)");
+        p += got;
+        n -= static_cast<size_t>(got);
+        offset += static_cast<uint64_t>(got);
     }
-    base_ = static_cast<const std::byte*>(map_);
-    start_accounting();
 }
 
-size_t VertexTable::block_count() const {
-    return static_cast<size_t>((map_file_offset_ + map_bytes_ + kFaultAroundBytes) / kResidencyBlockBytes + 1);
-}
-
-void VertexTable::start_accounting() {
-    // At least the three blocks one read can make resident (its own and a neighbour each side).
-    block_limit_ = std::max<uint64_t>(budget_bytes_ / kResidencyBlockBytes, 3);
-    touched_bits_.assign(block_count() / 64 + 1, 0);
-    touched_order_.clear();
-}
-
-const std::byte* VertexTable::record_in_map(uint64_t byte_offset) {
-    const std::byte* record = base_ + byte_offset;
-    if (touched_bits_.empty()) return record;
-    // The blocks this read can make resident: the record's (a record of at most 16 bytes may
-    // straddle into the next, within the fault-around reach) and those within 64 KiB of it.
-    const std::byte* map = static_cast<const std::byte*>(map_);
-    const uint64_t at = map_file_offset_ + static_cast<uint64_t>(record - map);
-    const uint64_t blocks[3] = {(at > kFaultAroundBytes ? at - kFaultAroundBytes : 0) / kResidencyBlockBytes,
-                                at / kResidencyBlockBytes, (at + kFaultAroundBytes) / kResidencyBlockBytes};
-    for (const uint64_t block : blocks) {
-        uint64_t& word = touched_bits_[block >> 6];
-        const uint64_t bit = uint64_t{1} << (block & 63);
-        if (!(word & bit)) {
-            word |= bit;
-            touched_order_.push_back(block);
-        }
+const std::byte* VertexTable::cached_page(uint64_t page) {
+    const size_t slot = static_cast<size_t>(page % page_tags_.size());
+    std::byte* data = pages_.get() + slot * kPageBytes;
+    if (page_tags_[slot] != page) {
+        // Only the part holding records: the file may end, or go on with faces, within it.
+        const uint64_t first = file_offset_ / kPageBytes * kPageBytes;
+        const uint64_t begin = std::max(first + page * kPageBytes, file_offset_);
+        const uint64_t end = std::min(first + (page + 1) * kPageBytes, file_offset_ + file_records_ * stride_);
+        read_file(begin, data + (begin - first - page * kPageBytes), static_cast<size_t>(end - begin));
+        page_tags_[slot] = page;
     }
-    // Past the budget, the block touched first goes (first in, first out: faces use vertices
-    // near each other, so a sliding window of blocks stays resident). This read's own blocks
-    // are the last ones in, and the limit is at least three, so they stay.
-    while (touched_order_.size() > block_limit_) {
-        const uint64_t block = touched_order_.front();
-        touched_order_.pop_front();
-        touched_bits_[block >> 6] &= ~(uint64_t{1} << (block & 63));
-        // The block's part of the mapping, in file offsets (a block may lie partly or wholly
-        // outside it).
-        const uint64_t begin = std::max(block * kResidencyBlockBytes, map_file_offset_);
-        const uint64_t end = std::min((block + 1) * kResidencyBlockBytes, map_file_offset_ + map_bytes_);
-        if (begin < end)
-            ::madvise(const_cast<std::byte*>(map + (begin - map_file_offset_)), static_cast<size_t>(end - begin), MADV_DONTNEED);
-    }
-    return record;
+    return data;
 }
 
 void VertexTable::get(uint64_t i, float* xyz, uint8_t* rgb) {
-    const std::byte* rec;
+    const std::byte* rec = nullptr;  // the record, when it is in memory
+    uint64_t at = 0;                 // else where it starts, from the start of cached page 0
     if (storage_ == Storage::kMemory) {
         rec = blocks_[i >> kBlockRecordsLog2].get() + (i & ((uint64_t{1} << kBlockRecordsLog2) - 1)) * stride_;
-    } else if (i < mapped_records_) {
-        rec = record_in_map(i * stride_);
+    } else if (i >= file_records_) {
+        rec = tail_.data() + (i - file_records_) * stride_;
     } else {
-        rec = tail_.data() + (i - mapped_records_) * stride_;
+        at = file_offset_ % kPageBytes + i * stride_;
     }
-    for (int a = 0; a < 3; ++a) std::memcpy(&xyz[a], rec + xyz_offsets_[a], 4);
+    // Copies n bytes of the record from `offset` on; from a file, out of the one or two cached
+    // pages they span.
+    auto field = [&](size_t offset, size_t n, void* dst) {
+        if (rec != nullptr) {
+            std::memcpy(dst, rec + offset, n);
+            return;
+        }
+        for (size_t done = 0; done < n;) {
+            const uint64_t pos = at + offset + done;
+            const size_t in_page = static_cast<size_t>(pos % kPageBytes);
+            const size_t take = std::min(n - done, kPageBytes - in_page);
+            std::memcpy(static_cast<std::byte*>(dst) + done, cached_page(pos / kPageBytes) + in_page, take);
+            done += take;
+        }
+    };
+    for (int a = 0; a < 3; ++a) field(xyz_offsets_[a], 4, &xyz[a]);
     if (rgb) {
         if (color_)
-            for (int a = 0; a < 3; ++a) rgb[a] = static_cast<uint8_t>(rec[rgb_offsets_[a]]);
+            for (int a = 0; a < 3; ++a) field(rgb_offsets_[a], 1, &rgb[a]);
         else
             rgb[0] = rgb[1] = rgb[2] = 0;
     }

@@ -1,17 +1,17 @@
 // The vertex table of the indexed readers (PLY, OBJ): faces refer to vertices at random, so
 // the reader keeps every vertex, in bounded memory. Up to the budget the records live in
-// memory (64 Ki-record blocks, no reallocation copies); past it they go to an io::TempFile that
-// is read through a shared read-only mmap (the OS page cache does the caching). A seekable
-// binary PLY whose x, y, z are float32 in host byte order is not copied at all: its own vertex
-// block is mapped (map_input_file). emit_polygon, at the end, turns a face into triangles for
-// both readers.
+// memory (64 Ki-record blocks, no reallocation copies); past it they go to an io::TempFile. A
+// seekable binary PLY whose x, y, z are float32 in host byte order is not copied at all: its
+// own vertex block is read in place (map_input_file). emit_polygon, at the end, turns a face
+// into triangles for both readers.
 //
-// Memory: mapped pages count towards RSS once touched, and Linux maps the faulted page's whole
-// page-cache folio (up to 2 MiB) and its cached neighbours within 64 KiB (fault-around). So
-// reads through a mapping larger than the budget note the 2 MiB blocks of the file they can
-// have made resident, and past the budget drop the block noted first with
-// madvise(MADV_DONTNEED). Resident memory is therefore at most max(budget, 6 MiB) + bitmap
-// (1/2^24 of the table) + one 1 MiB append buffer, whatever the input size.
+// Memory: records in a file are read through a direct-mapped cache of its 4 KiB pages, as
+// large as the budget and filled by pread, so resident memory is the budget plus one 1 MiB
+// append buffer, whatever the input size; the OS page cache, which RSS does not count, keeps
+// the file's pages between misses. A shared mmap did this before: its resident pages had to be
+// counted and dropped by hand, and Linux maps far more than the page a read faults in (the
+// page's whole page-cache folio, up to 2 MiB, and 64 KiB of neighbours), which made a budget
+// either leak (counted too finely) or cost 2 MiB mappings on every miss (counted per folio).
 #pragma once
 
 #include "io/byte_stream.hpp"
@@ -20,7 +20,6 @@
 
 #include <cstddef>
 #include <cstdint>
-#include <deque>
 #include <memory>
 #include <string>
 #include <vector>
@@ -37,7 +36,7 @@ public:
     // A read-only view of `count` records of `stride` bytes starting at byte `offset` of the
     // regular file `path`: float32 x, y, z (host byte order) at xyz_offsets, and when
     // `rgb_offsets` is non-null uint8 red, green, blue there. Throws io::Error when the file
-    // cannot be opened or mapped.
+    // cannot be opened.
     static std::unique_ptr<VertexTable> map_input_file(const std::string& path, uint64_t offset, uint64_t count,
                                                        size_t stride, const size_t (&xyz_offsets)[3],
                                                        const size_t* rgb_offsets, uint64_t budget_bytes);
@@ -58,8 +57,6 @@ private:
     VertexTable() = default;
     void spill();
     void flush_tail();
-    void map_temp(uint64_t min_bytes);
-    const std::byte* record_in_map(uint64_t byte_offset);
 
     uint64_t budget_bytes_ = 0;
     std::string tmpdir_;
@@ -74,22 +71,26 @@ private:
     static constexpr size_t kBlockRecordsLog2 = 16;
     std::vector<std::unique_ptr<std::byte[]>> blocks_;
 
-    // kTempFile / kInputFile: a mapping; records [0, mapped_records_) are readable through it,
-    // later ones (temp file only) sit in tail_ until flushed.
+    // kTempFile / kInputFile: records [0, file_records_) are read from a file through the page
+    // cache below; later ones (temp file only) sit in tail_ until flushed.
     std::unique_ptr<TempFile> temp_;
     int input_fd_ = -1;
-    void* map_ = nullptr;
-    size_t map_bytes_ = 0;
-    const std::byte* base_ = nullptr;  // first record (map_ plus the page-alignment delta)
-    uint64_t map_file_offset_ = 0;     // where map_ starts in the mapped file
-    uint64_t mapped_records_ = 0;
+    std::string input_path_;
+    uint64_t file_offset_ = 0;  // where record 0 is in the file
+    uint64_t file_records_ = 0;
     std::vector<std::byte> tail_;
-    // Residency accounting for mappings larger than the budget, in 2 MiB blocks of the file.
-    void start_accounting();
-    size_t block_count() const;
-    std::vector<uint64_t> touched_bits_;  // blocks that may be resident
-    std::deque<uint64_t> touched_order_;  // the same, in the order they were first touched
-    uint64_t block_limit_ = 0;
+    // A direct-mapped cache of the file's 4 KiB pages (numbered from the one holding record 0).
+    // Anonymous memory of its own, so that it goes back to the system with the reader (sort
+    // frees the reader before merging; from malloc's heap its pages stayed resident).
+    struct Unmap {
+        size_t bytes;
+        void operator()(std::byte* p) const;
+    };
+    std::unique_ptr<std::byte, Unmap> pages_;
+    std::vector<uint64_t> page_tags_;  // the page each slot holds; ~0: none
+    void start_cache(uint64_t table_bytes);
+    const std::byte* cached_page(uint64_t page);
+    void read_file(uint64_t offset, void* dst, size_t n);  // n bytes of the file at `offset`
 };
 
 // What emit_polygon keeps between calls: the current polygon's corners and its triangles. One
