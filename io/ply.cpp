@@ -503,8 +503,8 @@ private:
                 truncated();
             }
             const size_t xyz[3] = {offsets[0], offsets[1], offsets[2]};
-            table_ = VertexTable::map_input_file(src_.regular_file_path(), start, e.count, fixed, xyz,
-                                                 has_color_ ? offsets + 3 : nullptr, budget);
+            table_ = VertexTable::of_input_file(src_.regular_file_path(), start, e.count, fixed, xyz,
+                                                has_color_ ? offsets + 3 : nullptr, budget);
             header_.notes.emplace_back("vertex table", "input file, read in place");
             return;
         }

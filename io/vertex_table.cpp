@@ -26,9 +26,9 @@ VertexTable::VertexTable(uint64_t budget_bytes, std::string tmpdir, bool color)
     stride_ = color ? 16 : 12;  // xyz, then rgb + 1 pad byte
 }
 
-std::unique_ptr<VertexTable> VertexTable::map_input_file(const std::string& path, uint64_t offset, uint64_t count,
-                                                         size_t stride, const size_t (&xyz_offsets)[3],
-                                                         const size_t* rgb_offsets, uint64_t budget_bytes) {
+std::unique_ptr<VertexTable> VertexTable::of_input_file(const std::string& path, uint64_t offset, uint64_t count,
+                                                        size_t stride, const size_t (&xyz_offsets)[3],
+                                                        const size_t* rgb_offsets, uint64_t budget_bytes) {
     std::unique_ptr<VertexTable> t(new VertexTable());
     t->storage_ = Storage::kInputFile;
     t->budget_bytes_ = budget_bytes;

@@ -2,12 +2,12 @@
 // the reader keeps every vertex, in bounded memory. Up to the budget the records live in
 // memory (64 Ki-record blocks, no reallocation copies); past it they go to an io::TempFile. A
 // seekable binary PLY whose x, y, z are float32 in host byte order is not copied at all: its
-// own vertex block is read in place (map_input_file). emit_polygon, at the end, turns a face
+// own vertex block is read in place (of_input_file). emit_polygon, at the end, turns a face
 // into triangles for both readers.
 //
 // Memory: records in a file are read through a direct-mapped cache of its 4 KiB pages, as
-// large as the budget and filled by pread, so resident memory is the budget plus one 1 MiB
-// append buffer, whatever the input size; the OS page cache, which RSS does not count, keeps
+// large as the budget and filled by pread, so resident memory is the budget (and 1/512 of it
+// for the pages' tags) plus one 1 MiB append buffer, whatever the input size; the OS page cache, which RSS does not count, keeps
 // the file's pages between misses. A shared mmap did this before: its resident pages had to be
 // counted and dropped by hand, and Linux maps far more than the page a read faults in (the
 // page's whole page-cache folio, up to 2 MiB, and 64 KiB of neighbours), which made a budget
@@ -37,9 +37,9 @@ public:
     // regular file `path`: float32 x, y, z (host byte order) at xyz_offsets, and when
     // `rgb_offsets` is non-null uint8 red, green, blue there. Throws io::Error when the file
     // cannot be opened.
-    static std::unique_ptr<VertexTable> map_input_file(const std::string& path, uint64_t offset, uint64_t count,
-                                                       size_t stride, const size_t (&xyz_offsets)[3],
-                                                       const size_t* rgb_offsets, uint64_t budget_bytes);
+    static std::unique_ptr<VertexTable> of_input_file(const std::string& path, uint64_t offset, uint64_t count,
+                                                      size_t stride, const size_t (&xyz_offsets)[3],
+                                                      const size_t* rgb_offsets, uint64_t budget_bytes);
     ~VertexTable();
     VertexTable(const VertexTable&) = delete;
     VertexTable& operator=(const VertexTable&) = delete;

@@ -80,7 +80,7 @@ TEST(VertexTable, StaysInMemoryWithinTheBudget) {
     for (uint64_t i = 0; i < 1000; ++i) expect_vertex(t, i);
 }
 
-TEST(VertexTable, MapsRecordsOfAnInputFile) {
+TEST(VertexTable, ReadsRecordsOfAnInputFileInPlace) {
     test::TempDir dir;
     // 5 junk bytes, then records of 20 bytes: pad(2) x y z pad(3) r g b ... (stride 20).
     std::string bytes(5, 'j');
@@ -95,7 +95,7 @@ TEST(VertexTable, MapsRecordsOfAnInputFile) {
     test::spit(dir / "v.bin", bytes);
     const size_t xyz_offsets[3] = {2, 6, 10};
     const size_t rgb_offsets[3] = {16, 17, 18};
-    auto t = io::VertexTable::map_input_file(dir / "v.bin", 5, n, 20, xyz_offsets, rgb_offsets, 16 << 10);
+    auto t = io::VertexTable::of_input_file(dir / "v.bin", 5, n, 20, xyz_offsets, rgb_offsets, 16 << 10);
     EXPECT_EQ(t->storage(), io::VertexTable::Storage::kInputFile);
     for (uint64_t i = n; i-- > 0;) expect_vertex(*t, (i * 31) % n);
 }
@@ -117,7 +117,7 @@ uint64_t resident_bytes() {
 uint64_t resident_growth_of_sparse_reads(const std::string& path, uint64_t budget, uint64_t step_bytes) {
     const uint64_t n = uint64_t{4} << 20;  // 12-byte records: 48 MiB
     const size_t xyz_offsets[3] = {0, 4, 8};
-    auto t = io::VertexTable::map_input_file(path, 0, n, 12, xyz_offsets, nullptr, budget);
+    auto t = io::VertexTable::of_input_file(path, 0, n, 12, xyz_offsets, nullptr, budget);
     const uint64_t before = resident_bytes();
     EXPECT_GT(before, 0u);
     uint64_t peak = before;
@@ -141,7 +141,7 @@ std::string table_bytes() {
 // Reading one record per 64 KiB of a cached 48 MB table: when the table was read through mmap,
 // Linux mapped the cached neighbours of every faulted page too, and counting only the pages
 // touched let the whole table become resident. The table must stay near its 1 MiB budget.
-TEST(VertexTable, MappedTableStaysWithinItsBudgetWhenReadSparsely) {
+TEST(VertexTable, FileTableStaysWithinItsBudgetWhenReadSparsely) {
     test::TempDir dir;
     test::spit(dir / "v.bin", table_bytes());  // now in the page cache, where fault-around finds it
     const uint64_t growth = resident_growth_of_sparse_reads(dir / "v.bin", uint64_t{1} << 20, uint64_t{64} << 10);
@@ -152,7 +152,7 @@ TEST(VertexTable, MappedTableStaysWithinItsBudgetWhenReadSparsely) {
 // fills large folios, and through mmap Linux mapped a faulted page's whole folio (2 MiB,
 // measured on 6.18): accounting 64 KiB blocks, one record read per 256 KiB made 22 MiB
 // resident against a budget of 8 MiB.
-TEST(VertexTable, MappedTableStaysWithinItsBudgetWhenTheFileWasReadAhead) {
+TEST(VertexTable, FileTableStaysWithinItsBudgetWhenTheFileWasReadAhead) {
     test::TempDir dir;
     const std::string path = dir / "v.bin";
     test::spit(path, table_bytes());
