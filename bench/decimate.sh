@@ -8,7 +8,7 @@
 #   SIZES="1000000" RUNS=1 bench/decimate.sh
 #
 # Environment:
-#   BENCH_DIR  work dir for meshes and outputs (default /tmp/meshstream-bench; ~6 GB for 50 M)
+#   BENCH_DIR  work dir for meshes and outputs (default /tmp/meshstream-bench; about 4 GB with 50 M)
 #   BUILD_DIR  build dir, configured here with -DMESHSTREAM_BUILD_BENCH=ON (default $BENCH_DIR/build)
 #   SIZES      generated mesh sizes in triangles (default "1000000 10000000 50000000")
 #   RATIOS     decimation ratios (default "0.1 0.01")

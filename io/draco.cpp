@@ -245,7 +245,7 @@ std::string draco_flattened_note(const DracoEncoded& encoded, uint64_t triangles
     return std::to_string(encoded.flattened) + " of the " + std::to_string(triangles) +
            " triangles have zero area once decoded: thinner than Draco's " +
            std::to_string(options.draco_position_bits) +
-           "-bit quantization step (the largest extent / 2^bits); raise --draco-qp, or write without Draco";
+           "-bit quantization step (the largest extent / (2^bits - 1)); raise --draco-qp, or write without Draco";
 }
 
 DracoDecoded decode_draco(std::span<const std::byte> bytes, const std::string& file_name, uint64_t base_offset,
