@@ -55,6 +55,7 @@ StreamDecimator::StreamDecimator(const Options& options, std::optional<uint64_t>
     stats_.buffer_capacity = options.buffer_triangles;
     if (options.sorted_axis) {
         sweep_capacity_ = 3 * options.buffer_triangles + 3;
+        margin_block_ = std::max<uint64_t>(64, options.buffer_triangles / 8);
         sweep_queue_.reset(new SweepEntry[sweep_capacity_]);
     }
 }
@@ -145,29 +146,51 @@ void StreamDecimator::track_sweep(const float tri[9]) {
         first_hi_ = hi;
         sweep_started_ = true;
     }
-    sweep_margin_ = std::max(sweep_margin_, hi - lo);
+    // The margin is the largest extent of the triangles read lately (this block and the one
+    // before), not of all so far: one long triangle (a scanner's jump edge) must not hold the
+    // sweep off for the rest of the file.
+    block_extent_ = std::max(block_extent_, hi - lo);
+    if (++block_read_ == margin_block_) {
+        last_block_extent_ = block_extent_;
+        block_extent_ = 0;
+        block_read_ = 0;
+    }
+    sweep_margin_ = std::max(block_extent_, last_block_extent_);
     lo_max_ = std::max(lo_max_, lo);
     hi_min_ = std::min(hi_min_, hi);
     if (stats_.sweep_direction == 0) {
-        if (lo_max_ - first_hi_ > 2 * sweep_margin_) stats_.sweep_direction = 1;
-        else if (first_lo_ - hi_min_ > 2 * sweep_margin_) stats_.sweep_direction = -1;
+        // The front has left the first triangle by two margins (a long first triangle counts
+        // as one margin long).
+        if (lo_max_ - std::min(first_hi_, first_lo_ + sweep_margin_) > 2 * sweep_margin_) stats_.sweep_direction = 1;
+        else if (std::max(first_lo_, first_hi_ - sweep_margin_) - hi_min_ > 2 * sweep_margin_) stats_.sweep_direction = -1;
     }
 }
 
 void StreamDecimator::sweep() {
     // A future triangle has a sort key ≥ the front (every key lies within its triangle, and
     // the front is the largest triangle minimum read so far), so it can only reach vertices
-    // within one triangle extent behind the front. Twice the largest extent seen leaves room
-    // for somewhat larger triangles to come. Vertices further behind that are still open are
+    // within one triangle extent behind the front. Twice the largest extent read lately leaves
+    // room for somewhat larger triangles to come. Vertices further behind that are still open are
     // true boundary (holes): finalizing them lets their triangles be decimated and written.
     // Descending input is the mirror image (front = smallest triangle maximum).
     const int direction = stats_.sweep_direction;
     if (!sweep_enabled_ || direction == 0) return;
     const double threshold = direction > 0 ? lo_max_ - 2 * sweep_margin_ : hi_min_ + 2 * sweep_margin_;
+    const double ahead = direction > 0 ? lo_max_ + 2 * sweep_margin_ : hi_min_ - 2 * sweep_margin_;
+    size_t requeued = 0;
     while (sweep_size_ > 0) {
-        const SweepEntry& e = sweep_queue_[sweep_head_];
+        const SweepEntry e = sweep_queue_[sweep_head_];
         const bool behind = direction > 0 ? double(e.coordinate) < threshold : double(e.coordinate) > threshold;
-        if (!behind) break;
+        if (!behind) {
+            // A corner far ahead of the front (a long triangle's far end) would hold up the
+            // queue behind it: it goes to the back, once per sweep at most.
+            const bool far = direction > 0 ? double(e.coordinate) > ahead : double(e.coordinate) < ahead;
+            if (!far || requeued == sweep_size_) break;
+            ++requeued;
+            sweep_head_ = (sweep_head_ + 1) % sweep_capacity_;
+            sweep_queue_[(sweep_head_ + sweep_size_ - 1) % sweep_capacity_] = e;
+            continue;
+        }
         const Vertex& x = buffer_.vertex(e.vertex);
         if ((x.flags & (kAlive | kInHash)) == (kAlive | kInHash) && x.generation == e.generation) {
             buffer_.finalize_vertex(e.vertex);

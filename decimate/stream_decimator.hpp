@@ -109,6 +109,9 @@ private:
     // left the first triangle by more than two margins.
     double lo_max_ = -INFINITY, hi_min_ = INFINITY, sweep_margin_ = 0;
     double first_lo_ = 0, first_hi_ = 0;
+    // The margin's window: blocks of an eighth of the buffer (at least 64 triangles).
+    uint64_t margin_block_ = 0, block_read_ = 0;
+    double block_extent_ = 0, last_block_extent_ = 0;
     bool sweep_started_ = false, sweep_enabled_ = true;
     std::optional<double> swept_to_;  // threshold of the last sweep that finalized vertices
 };

@@ -289,6 +289,26 @@ TEST(StreamDecimator, DescendingSortedInputIsSweptToo) {
     EXPECT_EQ(up.stats.sort_violations, 0u);
 }
 
+TEST(StreamDecimator, OneLongTriangleDoesNotHoldTheSweepOff) {
+    // A sliver as long as the grid, first in x order (its minimum is the grid's start), as a
+    // scanner's jump edge: the margin was the longest extent ever read, so the sweep never
+    // started, and its far corners, queued early, blocked the queue once it did.
+    std::vector<float> soup = {0, -2, 0, 280, -2, 0.5f, 0, -1.5f, 0};
+    const std::vector<float> grid = holey_grid(300, 40);
+    soup.insert(soup.end(), grid.begin(), grid.end());
+    Options options;
+    options.ratio = 0.3;
+    options.buffer_triangles = 1500;
+    options.sorted_axis = 0;
+    const Decimated d = run_decimator(soup, options);
+    EXPECT_EQ(d.stats.sweep_direction, 1);
+    EXPECT_EQ(d.stats.sort_violations, 0u);
+    EXPECT_EQ(d.stats.forced_writes, 0u);
+    EXPECT_GT(d.stats.vertices_finalized_by_sweep, 0u);
+    EXPECT_EQ(d.triangle_count(), static_cast<uint64_t>(std::llround(0.3 * double(soup.size() / 9))));
+    EXPECT_EQ(topology(d.ids).nonmanifold_edges, 0u);
+}
+
 TEST(StreamDecimator, WronglyClaimedSortOrderIsDetectedAndTheSweepStops) {
     // The holey grid claimed sorted along y, but it is sorted along x: rows of y restart.
     const std::vector<float> soup = holey_grid(300, 40);
