@@ -130,9 +130,9 @@ void run_decimate(const DecimateOptions& opt) {
         wo.expected_triangle_count = options.target ? *options.target
                                                     : decimate::StreamDecimator::expected_output(options.ratio, *header.triangle_count);
     // No output count is promised to the writer: the decimator lands on round(p·N_in) except
-    // when the in-core rest is closed and the target odd (collapses remove two faces; it
-    // then ends one over, with a warning), and skipped input triangles change N_in. Writers
-    // patch their header counts at finish() (or spool when the output cannot seek).
+    // when the in-core rest is closed and one triangle too many is left (collapses remove two
+    // faces; it then ends one over, with a warning), and skipped input triangles change N_in.
+    // Writers patch their header counts at finish() (or spool when the output cannot seek).
     io::Output out = io::open_output(opt.output, opt.write.to, wo, opt.write.gzip_level);
 
     const decimate::Emit emit = [&out](const io::TriangleChunk& chunk) { out.write(chunk); };
@@ -187,6 +187,11 @@ void run_decimate(const DecimateOptions& opt) {
     for (const std::string& note : out.writer->notes()) warnings.note(note);
     filter.report(warnings);
     note_input_changes(in.reader->header(), in.source->name(), warnings);
+    const bool axis_conflict = opt.sorted_axis && header.sorted_axis && *opt.sorted_axis != *header.sorted_axis;
+    if (axis_conflict)
+        warnings.note(std::string("--sorted-axis ") + "xyz"[*opt.sorted_axis] + " was given, but " + in.source->name() +
+                      " says it is sorted along " + "xyz"[*header.sorted_axis] + ": the sweep used " +
+                      "xyz"[*opt.sorted_axis] + ", as given");
     if (s.forced_writes > 0)
         warnings.note("buffer full of undecimatable triangles: " + std::to_string(s.forced_writes) +
                      " triangles force-written at full resolution (" +
@@ -198,7 +203,14 @@ void run_decimate(const DecimateOptions& opt) {
                                 " of their vertices were evicted from the weld table to make room, so triangles "
                                 "read later at those positions are not joined to them (the output has cracks there)"
                           : std::string()) +
-                     (options.sorted_axis && s.sort_violations == 0
+                     (axis_conflict
+                          ? std::string("; --sorted-axis overrode the axis the file gives (see below)")
+                      : options.sorted_axis && s.sort_violations == 0 && s.sweep_direction == 0
+                          ? std::string("; the input is said to be sorted along ") + "xyz"[*options.sorted_axis] +
+                                ", but its triangles never moved along it by more than three of their lengths, so the "
+                                "sweep that finalizes hole boundaries never started: check the axis (" + order_command +
+                                " counts the key descents along each)"
+                      : options.sorted_axis && s.sort_violations == 0
                           ? "; the input is sorted, so the buffer is too small for it at this ratio: raise --buffer (" +
                                 order_command + " estimates the buffer it needs)"
                           : "; either the input is not in streaming order (run `meshstream sort` on it first) or the "
@@ -207,7 +219,9 @@ void run_decimate(const DecimateOptions& opt) {
         warnings.note(std::string("the input is not sorted along ") + "xyz"[*options.sorted_axis] +
                      " as stated: " + std::to_string(s.sort_violations) +
                      " triangles reached behind the sweep, which was switched off at the first (boundary "
-                     "finalized before it may show as cracks); run `meshstream sort` on it first");
+                     "finalized before it may show as cracks); " +
+                     (axis_conflict ? std::string("leave out --sorted-axis to use the file's own axis")
+                                    : std::string("run `meshstream sort` on it first")));
     if (s.nonmanifold_edges > 0)
         warnings.add("non-manifold, duplicate or mis-oriented edges frozen and passed through", s.nonmanifold_edges);
     if (s.degenerate_passed > 0)
@@ -237,6 +251,8 @@ void run_decimate(const DecimateOptions& opt) {
                       std::to_string(s.triangles_in) + " usable input triangles: nothing was decimated");
     else if (s.triangles_in > 0 && s.triangles_out == s.target_triangles + 1)
         warnings.note(missed + " (a collapse removes two triangles, and no boundary edge could be collapsed to remove the odd one)");
+    else if (s.triangles_in > 0 && s.triangles_out != s.target_triangles && s.forced_writes > 0)
+        warnings.note(missed + " (the triangles force-written at full resolution, above, count against it)");
     else if (s.triangles_in > 0 && s.triangles_out != s.target_triangles && s.no_valid_collapse_left)
         warnings.note(missed + " (no allowed collapse is left: each would fold a face over or change the topology, "
                                "or move a vertex that must stay, as on a non-manifold edge)");
@@ -267,8 +283,8 @@ void add_decimate(CLI::App& app) {
     CLI::App* cmd = app.add_subcommand(
         "decimate", "Decimate a mesh of any size in one streaming pass (Wu & Kobbelt 2003) with a fixed memory buffer.\n"
                     "Output size is round(ratio x input), or --target: exactly, unless the mesh cannot get there\n"
-                    "(one more for an odd target when no boundary edge is left in the buffer to remove a single\n"
-                    "triangle; a warning says so).");
+                    "(one more when an odd number is left to remove at the end and no boundary edge can be\n"
+                    "collapsed to remove a single triangle; a warning says so).");
     cmd->add_option("input", opt->input, "Input mesh ('-' = stdin)")->required();
     cmd->add_option("output", opt->output, "Output mesh ('-' = stdout, needs --to)")->required();
     auto* ratio = cmd->add_option("-r,--ratio", opt->ratio, "Fraction of input triangles to keep, in (0, 1] (default 0.1)")

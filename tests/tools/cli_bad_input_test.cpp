@@ -320,6 +320,38 @@ TEST(CliBadInput, ForcedWritesEndWithAWarningThatAdvisesSort) {
     EXPECT_EQ(s.err.find("run `meshstream sort`"), std::string::npos) << s.err;
 }
 
+// A sorted axis the sweep cannot use is named: one the triangles never move along (the sweep
+// never starts; raising --buffer, the advice for sorted input, would not help), and one that
+// overrides the axis the file gives.
+TEST(CliBadInput, ASortedAxisTheSweepCannotUseIsNamed) {
+    TempDir dir;
+    write_file(dir / "rows.stl", binary_stl(grid(24)));  // row order: sorted along y
+    CliRun z = run("decimate --buffer 40 --sorted-axis z -r 0.1 " + dir / "rows.stl" + " " + dir / "out.stl");
+    EXPECT_EQ(z.code, 0) << z.err;
+    EXPECT_NE(z.err.find("; the input is said to be sorted along z, but its triangles never moved along it by more than "
+                         "three of their lengths, so the sweep that finalizes hole boundaries never started: check the "
+                         "axis (`meshstream info --order --ratio 0.1 --buffer 40` counts the key descents along each)"),
+              std::string::npos) << z.err;
+    EXPECT_EQ(z.err.find("raise --buffer"), std::string::npos) << z.err;
+    EXPECT_NE(z.err.find("instead of the target 115 (the triangles force-written at full resolution, above, count "
+                         "against it)"),
+              std::string::npos) << z.err;
+
+    ASSERT_EQ(run("sort --axis y " + dir / "rows.stl" + " " + dir / "y.stl").code, 0);
+    CliRun x = run("decimate --buffer 40 --sorted-axis x -r 0.1 " + dir / "y.stl" + " " + dir / "out.stl");
+    EXPECT_EQ(x.code, 0) << x.err;
+    EXPECT_NE(x.err.find("meshstream: warning: --sorted-axis x was given, but " + dir / "y.stl" +
+                         " says it is sorted along y: the sweep used x, as given\n"),
+              std::string::npos) << x.err;
+    EXPECT_NE(x.err.find("; --sorted-axis overrode the axis the file gives (see below)"), std::string::npos) << x.err;
+    EXPECT_NE(x.err.find("leave out --sorted-axis to use the file's own axis"), std::string::npos) << x.err;
+    EXPECT_EQ(x.err.find("meshstream sort"), std::string::npos) << x.err;
+    // The file's own axis: no such warnings.
+    CliRun y = run("decimate --buffer 40 -r 0.1 " + dir / "y.stl" + " " + dir / "out.stl");
+    EXPECT_EQ(y.code, 0) << y.err;
+    EXPECT_EQ(y.err.find("--sorted-axis"), std::string::npos) << y.err;
+}
+
 // Whole-mesh outputs (Draco, glTF) whose known size cannot fit --memory are refused before
 // any work, not part way through a long decimation.
 TEST(CliBadInput, WholeMeshOutputTooBigForTheBudgetIsRefusedUpFront) {
