@@ -169,7 +169,7 @@ void run_info(const InfoOptions& opt) {
                     (unsigned long long)t.edges, (unsigned long long)t.boundary_edges,
                     (unsigned long long)t.non_manifold_edges);
     }
-    if (meter) std::printf("%s", format_order_text(meter->finish(), opt.buffer, opt.ratio, header.sorted_axis.has_value()).c_str());
+    if (meter) std::printf("%s", format_order_text(meter->finish(), opt.buffer, opt.ratio, header.sorted_axis).c_str());
 }
 
 }  // namespace

@@ -108,9 +108,10 @@ std::optional<OrderReport> measure_file_order(const std::string& path, std::stri
                                               const io::ReadOptions& options);
 
 // The text lines `info --order` prints ("width:", "buffer:", "key descents:"), judging
-// `buffer_triangles` for decimation at `ratio`. `flagged_sorted`: the file says it is sorted
-// (else a "suffices" warns that hole rims stay open to the end, which the width cannot tell).
+// `buffer_triangles` for decimation at `ratio`. `flagged_axis`: the axis the file says it is
+// sorted along, if any (without one, a "suffices" warns that hole rims stay open to the end,
+// which the width cannot tell; with one whose keys descend, the claim is called false).
 std::string format_order_text(const OrderReport& report, uint64_t buffer_triangles, double ratio,
-                              bool flagged_sorted = true);
+                              std::optional<int> flagged_axis = std::nullopt);
 
 }  // namespace meshstream::tools

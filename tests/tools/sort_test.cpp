@@ -265,6 +265,21 @@ TEST(InfoOrder, DistinguishesShuffledFromSorted) {
     EXPECT_GT(w_shuffled, 69451u / 2) << shuffled.out;
     EXPECT_LT(w_sorted, 69451u / 10) << sorted.out;
     EXPECT_NE(shuffled.out.find("--buffer 20000 is too small"), std::string::npos) << shuffled.out;
+    // A larger buffer is not the remedy for a shuffled file: sorting is.
+    EXPECT_NE(shuffled.out.find(": the file is in no streaming order (its width is a tenth of it or more), so "
+                                "`meshstream sort` it first\n"),
+              std::string::npos) << shuffled.out;
+    {
+        // The shuffled triangles under the sorted file's header, which says "sorted along y".
+        std::string bytes = slurp(dir / "shuffled.stl");
+        bytes.replace(0, 80, slurp(dir / "sorted.stl").substr(0, 80));
+        std::ofstream(dir / "false_flag.stl", std::ios::binary) << bytes;
+        CliRun f = run("info --order " + dir / "false_flag.stl", dir);
+        ASSERT_EQ(f.code, 0) << f.err;
+        EXPECT_NE(f.out.find("(the file says it is sorted along y, but it is not: `meshstream sort` it again)"),
+                  std::string::npos) << f.out;
+        EXPECT_NE(f.out.find(", unless the surface has holes: the file is not sorted as it says"), std::string::npos) << f.out;
+    }
     EXPECT_NE(sorted.out.find("--buffer 20000 suffices at --ratio 0.1 (needs about "), std::string::npos) << sorted.out;
     EXPECT_EQ(sorted.out.find("unless the surface has holes"), std::string::npos) << sorted.out;  // flagged sorted
     // Not flagged as sorted: holes would stay open to the end, which the width cannot tell.
