@@ -26,6 +26,9 @@ struct Bounds {
 // optional: formats fill what they know.
 struct MeshHeader {
     std::optional<uint64_t> triangle_count;  // total triangles (an n-gon counts n - 2)
+    // Where the count is not stated up front: about this many (PLY: its faces, each counted as
+    // one triangle, as the header cannot tell polygons). A hint, e.g. for which mesh to hold.
+    std::optional<uint64_t> triangle_estimate;
     std::optional<uint64_t> vertex_count;    // indexed formats
     std::optional<int> sorted_axis;          // 0,1,2 when the file says it is sorted (meshstream sort)
     Channels channels;                       // channels the reader will fill

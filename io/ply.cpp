@@ -270,6 +270,7 @@ private:
         header_.channels.color = has_color_;
         uint64_t faces = face_ >= 0 ? elements_[static_cast<size_t>(face_)].count : 0;
         if (faces == 0) header_.triangle_count = 0;
+        if (!strips_) header_.triangle_estimate = faces;
         header_.notes.emplace_back(strips_ ? "tristrips" : "faces", std::to_string(faces));
     }
 

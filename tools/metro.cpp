@@ -613,14 +613,19 @@ double MeshSummary::diagonal() const {
 // ---- compare_meshes ----------------------------------------------------------------------
 
 CompareResult compare_meshes(const MeshSource& a, const MeshSource& b, const CompareOptions& options) {
-    // Which one to hold: the smaller by header count when both are known, else B. A stream
-    // cannot be read twice (nor opened once just for its count), so it is always the held one.
+    // Which one to hold: the smaller by header count (or a PLY's face count) when both are
+    // known, else B. A stream cannot be read twice (nor opened once just for its count), so it
+    // is always the held one.
     if (a.once && b.once)
         throw io::Error(b.name, "compare cannot stream both meshes (stdin or pipes): one of them is read twice");
     bool hold_a = a.once;
     if (!a.once && !b.once) {
-        std::optional<uint64_t> count_a = a.open()->triangle_count();
-        std::optional<uint64_t> count_b = b.open()->triangle_count();
+        auto count = [](const MeshSource& m) {
+            const std::unique_ptr<io::Reader> reader = m.open();
+            const io::MeshHeader& h = reader->header();
+            return h.triangle_count ? h.triangle_count : h.triangle_estimate;
+        };
+        const std::optional<uint64_t> count_a = count(a), count_b = count(b);
         hold_a = count_a && count_b && *count_a < *count_b;
     }
     const MeshSource& held = hold_a ? a : b;

@@ -4,13 +4,14 @@
 // and symmetric Hausdorff distance, mean and RMS. Also counts edges after exact welding
 // (boundary = used by one triangle, non-manifold = used by three or more).
 //
-// Memory: only the smaller mesh (by header triangle count when both are known, else B) is held
-// in memory, with a BVH over its triangles and a BVH over its stored samples. The other mesh
-// is streamed twice: pass 1 counts it (area, bounds, edges, a fixed-size reservoir of surface
-// points) and pass 2 generates its samples per triangle on the fly (not stored) and keeps a
-// running minimum distance for each stored sample of the in-memory mesh. Edge counting of the
-// streamed mesh spills to hash-partitioned temporary files past the memory budget. So memory
-// is O(smaller mesh + sample count), independent of the streamed mesh's size.
+// Memory: only the smaller mesh (by header triangle count, or a PLY's face count, when both are
+// known, else B) is held in memory, with a BVH over its triangles and a BVH over its stored
+// samples. The other mesh is streamed twice: pass 1 counts it (area, bounds, edges, a
+// fixed-size reservoir of surface points) and pass 2 generates its samples per triangle on the
+// fly (not stored) and keeps a running minimum distance for each stored sample of the
+// in-memory mesh. Edge counting of the streamed mesh spills to hash-partitioned temporary
+// files past the memory budget. So memory is O(smaller mesh + sample count), independent of
+// the streamed mesh's size.
 #pragma once
 
 #include "io/format.hpp"

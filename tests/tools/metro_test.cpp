@@ -274,6 +274,22 @@ TEST(Metro, HoldsTheSmallerFileAndStreamsTheLarger) {
     // The coarse sphere lies inside the fine one; both directions see the same chord gap.
     EXPECT_NEAR(r1.hausdorff(), r2.hausdorff(), 0.1 * r1.hausdorff());
     EXPECT_GT(r1.hausdorff(), 0);
+    // A PLY states no triangle count (a face may be a polygon), but its face count is a fair
+    // estimate: a small PLY as A is held too (B, the 8 k-triangle STL, was).
+    {
+        const std::vector<float> small = sphere(2);
+        std::ofstream ply(tmp.path / "small.ply");
+        ply << "ply\nformat ascii 1.0\nelement vertex " << small.size() / 3
+            << "\nproperty float x\nproperty float y\nproperty float z\nelement face " << small.size() / 9
+            << "\nproperty list uchar int vertex_indices\nend_header\n";
+        for (size_t i = 0; i < small.size(); i += 3) ply << small[i] << ' ' << small[i + 1] << ' ' << small[i + 2] << '\n';
+        for (size_t t = 0; t < small.size() / 9; ++t) ply << "3 " << 3 * t << ' ' << 3 * t + 1 << ' ' << 3 * t + 2 << '\n';
+    }
+    CompareResult r3 = compare_meshes(file_source((tmp.path / "small.ply").string()),
+                                      file_source((tmp.path / "big.stl").string()), options);
+    EXPECT_TRUE(r3.a.in_memory);
+    EXPECT_FALSE(r3.b.in_memory);
+    EXPECT_EQ(r3.a.triangles, r2.a.triangles);
 }
 
 TEST(Metro, EmptyMeshIsAnErrorNamingTheFile) {
@@ -339,11 +355,11 @@ TEST(CompareCli, BadOptionExitsTwo) {
     r = run_cli(tmp.path, "compare a.stl");
     EXPECT_EQ(r.exit_code, 2);
     // More samples than memory can hold: refused before any work (it used to fail after a
-    // minute and 12 GB as a bare "out of memory"). 2^32 samples take 215 GB.
-    if (double(::sysconf(_SC_PHYS_PAGES)) * double(::sysconf(_SC_PAGESIZE)) < 2e11) {
+    // minute and 12 GB as a bare "out of memory"). 2^32 samples take 258 GB.
+    if (double(::sysconf(_SC_PHYS_PAGES)) * double(::sysconf(_SC_PAGESIZE)) < 2.5e11) {
         r = run_cli(tmp.path, "compare a.stl b.stl --samples 4294967296");
         EXPECT_EQ(r.exit_code, 2);
-        EXPECT_NE(r.err.find("--samples 4294967296: the held mesh's samples alone take about 214.75 GB (50 bytes each), "
+        EXPECT_NE(r.err.find("--samples 4294967296: the held mesh's samples alone take about 257.70 GB (60 bytes each), "
                              "more than this machine's memory"),
                   std::string::npos) << r.err;
     }
