@@ -110,7 +110,6 @@ uint64_t resident_bytes() {
     std::fclose(f);
     return got == 2 ? resident * static_cast<uint64_t>(sysconf(_SC_PAGESIZE)) : 0;
 }
-}  // namespace
 
 // Reads one record per `step_bytes` of a 48 MiB table in a file, with the given
 // budget; returns the peak growth of the resident set.
@@ -137,6 +136,7 @@ std::string table_bytes() {
     }
     return bytes;
 }
+}  // namespace
 
 // Reading one record per 64 KiB of a cached 48 MB table: when the table was read through mmap,
 // Linux mapped the cached neighbours of every faulted page too, and counting only the pages
