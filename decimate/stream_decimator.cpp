@@ -55,7 +55,7 @@ StreamDecimator::StreamDecimator(const Options& options, std::optional<uint64_t>
     stats_.buffer_capacity = options.buffer_triangles;
     if (options.sorted_axis) {
         sweep_capacity_ = 3 * options.buffer_triangles + 3;
-        margin_block_ = std::max<uint64_t>(64, options.buffer_triangles / 8);
+        if (options.sorted_by_minimum) stats_.sweep_direction = 1;
         sweep_queue_.reset(new SweepEntry[sweep_capacity_]);
     }
 }
@@ -136,8 +136,10 @@ void StreamDecimator::track_sweep(const float tri[9]) {
     const double lo = std::min({tri[axis], tri[3 + axis], tri[6 + axis]});
     const double hi = std::max({tri[axis], tri[3 + axis], tri[6 + axis]});
     // A triangle reaching into the region already swept may weld to a vertex finalized too
-    // early (a crack): the input is not sorted as stated. Count it and stop sweeping.
-    if (swept_to_ && (stats_.sweep_direction > 0 ? lo < *swept_to_ : hi > *swept_to_)) {
+    // early (a crack): the input is not sorted as stated. Count it and stop sweeping. Sorted
+    // by minimum, any descent of the minimum is one, swept or not.
+    const bool behind_front = options_.sorted_by_minimum && lo < lo_max_;
+    if (behind_front || (swept_to_ && (stats_.sweep_direction > 0 ? lo < *swept_to_ : hi > *swept_to_))) {
         ++stats_.sort_violations;
         sweep_enabled_ = false;
     }
@@ -146,32 +148,24 @@ void StreamDecimator::track_sweep(const float tri[9]) {
         first_hi_ = hi;
         sweep_started_ = true;
     }
-    // The margin is the largest extent of the triangles read lately (this block and the one
-    // before), not of all so far: one long triangle (a scanner's jump edge) must not hold the
-    // sweep off for the rest of the file.
-    block_extent_ = std::max(block_extent_, hi - lo);
-    if (++block_read_ == margin_block_) {
-        last_block_extent_ = block_extent_;
-        block_extent_ = 0;
-        block_read_ = 0;
-    }
-    sweep_margin_ = std::max(block_extent_, last_block_extent_);
+    // Sorted by minimum, no triangle to come reaches behind the front: the margin stays 0, and
+    // a long triangle cannot hold the sweep off.
+    if (!options_.sorted_by_minimum) sweep_margin_ = std::max(sweep_margin_, hi - lo);
     lo_max_ = std::max(lo_max_, lo);
     hi_min_ = std::min(hi_min_, hi);
     if (stats_.sweep_direction == 0) {
-        // The front has left the first triangle by two margins (a long first triangle counts
-        // as one margin long).
-        if (lo_max_ - std::min(first_hi_, first_lo_ + sweep_margin_) > 2 * sweep_margin_) stats_.sweep_direction = 1;
-        else if (std::max(first_lo_, first_hi_ - sweep_margin_) - hi_min_ > 2 * sweep_margin_) stats_.sweep_direction = -1;
+        if (lo_max_ - first_hi_ > 2 * sweep_margin_) stats_.sweep_direction = 1;
+        else if (first_lo_ - hi_min_ > 2 * sweep_margin_) stats_.sweep_direction = -1;
     }
 }
 
 void StreamDecimator::sweep() {
     // A future triangle has a sort key ≥ the front (every key lies within its triangle, and
     // the front is the largest triangle minimum read so far), so it can only reach vertices
-    // within one triangle extent behind the front. Twice the largest extent read lately leaves
-    // room for somewhat larger triangles to come. Vertices further behind that are still open are
-    // true boundary (holes): finalizing them lets their triangles be decimated and written.
+    // within one triangle extent behind the front. Twice the largest extent seen leaves room
+    // for somewhat larger triangles to come (no room at all when sorted by minimum: no vertex
+    // to come lies behind the front). Vertices further behind that are still open are true
+    // boundary (holes): finalizing them lets their triangles be decimated and written.
     // Descending input is the mirror image (front = smallest triangle maximum).
     const int direction = stats_.sweep_direction;
     if (!sweep_enabled_ || direction == 0) return;
@@ -182,8 +176,8 @@ void StreamDecimator::sweep() {
         const SweepEntry e = sweep_queue_[sweep_head_];
         const bool behind = direction > 0 ? double(e.coordinate) < threshold : double(e.coordinate) > threshold;
         if (!behind) {
-            // A corner far ahead of the front (a long triangle's far end) would hold up the
-            // queue behind it: it goes to the back, once per sweep at most.
+            // A corner far ahead of the front (a long triangle's far end, read early) would
+            // hold up the queue behind it: it goes to the back, once per sweep at most.
             const bool far = direction > 0 ? double(e.coordinate) > ahead : double(e.coordinate) < ahead;
             if (!far || requeued == sweep_size_) break;
             ++requeued;

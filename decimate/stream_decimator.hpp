@@ -32,6 +32,10 @@ struct Options {
     uint64_t seed = 1;
     double weld_eps = 0;                // 0: exact welding; > 0: grid cell size (absolute)
     std::optional<int> sorted_axis;     // 0,1,2 when the input is sorted on it (either direction)
+    // The order is known exactly: ascending by each triangle's minimum coordinate along
+    // sorted_axis, as `meshstream sort` writes it (the file's own flag says so). The sweep then
+    // needs no margin, and one triangle whose minimum descends shows the order is not that.
+    bool sorted_by_minimum = false;
     size_t output_chunk_triangles = io::TriangleChunk::kDefaultCapacity;  // ≥ 1
 };
 
@@ -109,9 +113,6 @@ private:
     // left the first triangle by more than two margins.
     double lo_max_ = -INFINITY, hi_min_ = INFINITY, sweep_margin_ = 0;
     double first_lo_ = 0, first_hi_ = 0;
-    // The margin's window: blocks of an eighth of the buffer (at least 64 triangles).
-    uint64_t margin_block_ = 0, block_read_ = 0;
-    double block_extent_ = 0, last_block_extent_ = 0;
     bool sweep_started_ = false, sweep_enabled_ = true;
     std::optional<double> swept_to_;  // threshold of the last sweep that finalized vertices
 };

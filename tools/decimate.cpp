@@ -112,6 +112,9 @@ void run_decimate(const DecimateOptions& opt) {
     options.seed = opt.seed;
     options.weld_eps = weld_epsilon(opt, in.source->name());
     options.sorted_axis = opt.sorted_axis ? opt.sorted_axis : header.sorted_axis;
+    // The file's flag comes from `meshstream sort` (or a convert that kept its order): ascending
+    // by triangle minimum. A --sorted-axis of the user's own says less: the key is not known.
+    options.sorted_by_minimum = header.sorted_axis && options.sorted_axis == header.sorted_axis;
     std::unique_ptr<decimate::StreamDecimator> made;  // on the heap only to catch a refused reservation here
     try {
         made = std::make_unique<decimate::StreamDecimator>(options, header.triangle_count);

@@ -289,10 +289,12 @@ TEST(StreamDecimator, DescendingSortedInputIsSweptToo) {
     EXPECT_EQ(up.stats.sort_violations, 0u);
 }
 
-TEST(StreamDecimator, OneLongTriangleDoesNotHoldTheSweepOff) {
+TEST(StreamDecimator, OneLongTriangleDoesNotHoldTheSweepOffInputSortedByMinimum) {
     // A sliver as long as the grid, first in x order (its minimum is the grid's start), as a
-    // scanner's jump edge: the margin was the longest extent ever read, so the sweep never
-    // started, and its far corners, queued early, blocked the queue once it did.
+    // scanner's jump edge. The margin was the longest extent ever read, so the sweep never
+    // started, and the sliver's far corners, queued early, blocked the queue once it did.
+    // Sorted by minimum (as `meshstream sort` writes), nothing to come reaches behind the
+    // front: no margin is needed.
     std::vector<float> soup = {0, -2, 0, 280, -2, 0.5f, 0, -1.5f, 0};
     const std::vector<float> grid = holey_grid(300, 40);
     soup.insert(soup.end(), grid.begin(), grid.end());
@@ -300,6 +302,7 @@ TEST(StreamDecimator, OneLongTriangleDoesNotHoldTheSweepOff) {
     options.ratio = 0.3;
     options.buffer_triangles = 1500;
     options.sorted_axis = 0;
+    options.sorted_by_minimum = true;
     const Decimated d = run_decimator(soup, options);
     EXPECT_EQ(d.stats.sweep_direction, 1);
     EXPECT_EQ(d.stats.sort_violations, 0u);
@@ -307,6 +310,15 @@ TEST(StreamDecimator, OneLongTriangleDoesNotHoldTheSweepOff) {
     EXPECT_GT(d.stats.vertices_finalized_by_sweep, 0u);
     EXPECT_EQ(d.triangle_count(), static_cast<uint64_t>(std::llround(0.3 * double(soup.size() / 9))));
     EXPECT_EQ(topology(d.ids).nonmanifold_edges, 0u);
+    // The same order reversed, said to be sorted by minimum: the second triangle descends, so
+    // the sweep stops before it ever ran (no vertex finalized, no crack).
+    std::vector<float> reversed;
+    for (size_t t = soup.size() / 9; t-- > 0;) reversed.insert(reversed.end(), &soup[9 * t], &soup[9 * t + 9]);
+    const Decimated r = run_decimator(reversed, options);
+    EXPECT_GT(r.stats.sort_violations, 0u);
+    EXPECT_EQ(r.stats.vertices_finalized_by_sweep, 0u);
+    EXPECT_EQ(topology(r.ids).nonmanifold_edges, 0u);
+    EXPECT_TRUE(ids_consistent(r));
 }
 
 TEST(StreamDecimator, WronglyClaimedSortOrderIsDetectedAndTheSweepStops) {
