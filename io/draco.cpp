@@ -62,13 +62,13 @@ public:
         budget_check_up_front(sink.name(), options, kWhy, draco_encode_estimate_bytes);
     }
 
-    void write(const TriangleChunk& chunk) override {
+    void write_chunk(const TriangleChunk& chunk) override {
         indexer_.add(chunk);
         budget_check(sink_.name(), options_, kWhy, indexer_.input_triangle_count(),
                      draco_encode_estimate_bytes(indexer_.vertex_count(), indexer_.triangle_count(), options_.normals));
     }
 
-    void finish() override {
+    void finish_output() override {
         IndexedMesh mesh = indexer_.take();
         std::vector<float> normals;
         if (options_.normals) normals = mesh.smooth_normals();

@@ -11,6 +11,7 @@
 #include <memory>
 #include <optional>
 #include <span>
+#include <stdexcept>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -64,14 +65,30 @@ protected:
 class Writer {
 public:
     virtual ~Writer() = default;
-    // Consumes one chunk. Throws io::Error.
-    virtual void write(const TriangleChunk& chunk) = 0;
-    // Completes the output (footer, header counts). The caller then commits the ByteSink;
-    // a writer destroyed without finish() leaves output that is discarded.
-    virtual void finish() = 0;
+    // Consumes one chunk. Throws io::Error; std::logic_error after finish().
+    void write(const TriangleChunk& chunk) {
+        if (finished_) throw std::logic_error("io::Writer::write after finish()");
+        write_chunk(chunk);
+    }
+    // Completes the output (footer, header counts), once (std::logic_error the second time).
+    // The caller then commits the ByteSink; a writer destroyed without finish() leaves output
+    // that is discarded.
+    void finish() {
+        if (finished_) throw std::logic_error("io::Writer::finish called twice");
+        finished_ = true;
+        finish_output();
+    }
     // After finish(): what the user should know about the output written (lossy encodings
     // that lost something), one sentence each. The commands print them as warnings.
     virtual std::vector<std::string> notes() const { return {}; }
+
+protected:
+    // What each format does: the calls above, checked.
+    virtual void write_chunk(const TriangleChunk& chunk) = 0;
+    virtual void finish_output() = 0;
+
+private:
+    bool finished_ = false;
 };
 
 struct ReadOptions {

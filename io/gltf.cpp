@@ -189,7 +189,7 @@ public:
         if (!binary_ && sink.name() != "<stdout>") check_side_file(sink.name());
     }
 
-    void write(const TriangleChunk& chunk) override {
+    void write_chunk(const TriangleChunk& chunk) override {
         indexer_.add(chunk);
         uint64_t v = indexer_.vertex_count(), f = indexer_.triangle_count();
         uint64_t need;
@@ -204,7 +204,7 @@ public:
         budget_check(sink_.name(), options_, kWhy, indexer_.input_triangle_count(), need);
     }
 
-    void finish() override;
+    void finish_output() override;
     std::vector<std::string> notes() const override {
         return note_.empty() ? std::vector<std::string>{} : std::vector<std::string>{sink_.name() + ": " + note_};
     }
@@ -229,7 +229,7 @@ void pad4(std::vector<unsigned char>& bin) {
     while (bin.size() % 4) bin.push_back(0);
 }
 
-void GltfWriter::finish() {
+void GltfWriter::finish_output() {
     IndexedMesh mesh = indexer_.take();
     std::vector<float> normals;
     if (options_.normals && mesh.triangle_count() > 0) normals = mesh.smooth_normals();

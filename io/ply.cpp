@@ -673,9 +673,9 @@ public:
         : sink_(sink), options_(options), ascii_(ascii),
           welder_(options.memory_budget_bytes, options.tmpdir, sink.name()) {}
 
-    void write(const TriangleChunk& chunk) override { welder_.add(chunk); }
+    void write_chunk(const TriangleChunk& chunk) override { welder_.add(chunk); }
 
-    void finish() override {
+    void finish_output() override {
         welder_.finish();
         const uint64_t vertices = welder_.vertex_count();
         if (vertices > 0x7fffffffULL)

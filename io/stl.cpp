@@ -428,7 +428,7 @@ public:
         batch_.resize(kBatchFacets * kFacetBytes);
     }
 
-    void write(const TriangleChunk& chunk) override {
+    void write_chunk(const TriangleChunk& chunk) override {
         const uint64_t limit = expected_.value_or(kMaxBinaryTriangles);
         if (written_ + chunk.size() > limit)
             throw Error(sink_.name(), sink_.offset(), 0,
@@ -455,7 +455,7 @@ public:
         written_ += chunk.size();
     }
 
-    void finish() override {
+    void finish_output() override {
         if (expected_) {
             if (written_ != *expected_)
                 throw Error(sink_.name(), "header promises " + std::to_string(*expected_) + " triangles, " +
@@ -503,7 +503,7 @@ public:
         out_ += '\n';
     }
 
-    void write(const TriangleChunk& chunk) override {
+    void write_chunk(const TriangleChunk& chunk) override {
         const float* xyz = chunk.xyz().data();
         for (size_t i = 0; i < chunk.size(); ++i, xyz += 9) {
             float normal[3];
@@ -521,7 +521,7 @@ public:
         }
     }
 
-    void finish() override {
+    void finish_output() override {
         out_ += "endsolid ";
         out_ += name_;
         out_ += '\n';

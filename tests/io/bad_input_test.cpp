@@ -168,6 +168,26 @@ TEST(BadInput, EmptyFileOfEachFormatIsAnErrorAtByteZeroOrLineOne) {
     EXPECT_EQ(read_path(dir / "empty.obj"), 0u);
 }
 
+// Writing to a finished writer, or finishing it twice, is a programming error, refused before
+// it reaches the file: a binary STL took the chunk after its patched header (a file whose count
+// no longer matched), PLY and OBJ dropped it, and finishing twice gave "Bad file descriptor".
+TEST(BadInput, WritingAfterFinishOrFinishingTwiceIsRefusedAndTheFileStaysWhole) {
+    TempDir dir;
+    for (const io::Format* f : io::formats()) {
+        if (f->open_writer == nullptr) continue;
+        const std::string ext(f->extensions.substr(0, f->extensions.find(' ')));
+        const std::string path = dir / ("after-" + std::string(f->name) + "." + ext);
+        io::Output out = io::open_output(path, f->name, io::WriteOptions{}, 6);
+        out.write(two_triangles());
+        out.finish();
+        const std::string bytes = slurp(path);
+        EXPECT_THROW(out.write(two_triangles()), std::logic_error) << f->name;
+        EXPECT_THROW(out.finish(), std::logic_error) << f->name;
+        EXPECT_EQ(slurp(path), bytes) << f->name;
+        EXPECT_EQ(read_path(path), 2u) << f->name;
+    }
+}
+
 TEST(BadInput, ZeroTrianglesIsAValidEmptyMesh) {
     TempDir dir;
     std::string stl(80, ' ');
