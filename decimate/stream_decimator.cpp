@@ -31,6 +31,8 @@ const Options& checked(const Options& options, std::optional<uint64_t> input_cou
     auto refuse = [](const char* what) { throw std::invalid_argument(std::string("decimate::Options: ") + what); };
     if (options.target ? !input_count.has_value() : !(options.ratio > 0 && options.ratio <= 1))
         refuse(options.target ? "target needs the input triangle count" : "ratio must be in (0, 1]");
+    if (options.target && *options.target > *input_count) refuse("target is more than the input triangle count");
+    if (options.sorted_by_minimum && !options.sorted_axis) refuse("sorted_by_minimum needs sorted_axis");
     if (options.buffer_triangles < 16) refuse("buffer_triangles must be at least 16");
     if (options.candidates < 1 || options.candidates > 64) refuse("candidates must be 1 to 64");
     if (options.sorted_axis && (*options.sorted_axis < 0 || *options.sorted_axis > 2)) refuse("sorted_axis must be 0, 1 or 2");

@@ -74,7 +74,8 @@ public:
     // throws std::invalid_argument before reading any: NaN/inf corners can be neither welded
     // nor finalized (the commands drop them first with tools::TriangleFilter).
     void push(const io::TriangleChunk& in, const Emit& out);
-    // End of input: decimates to the exact target, writes the rest, flushes `out`.
+    // End of input: decimates to the target (as close as the mesh allows: see Stats), writes
+    // the rest, flushes `out`.
     // Call once; push() or finish() after it throw std::logic_error.
     void finish(const Emit& out);
 

@@ -444,6 +444,8 @@ TEST(StreamDecimator, BadOptionsAndCallOrderThrow) {
     refused([](Options& o) { o.ratio = 0; });
     refused([](Options& o) { o.sorted_axis = 3; });
     refused([](Options& o) { o.target = 10; });  // without the input count
+    refused([](Options& o) { o.target = 50; }, 10);  // more than the input (it kept all, saying 50)
+    refused([](Options& o) { o.sorted_by_minimum = true; });  // without the axis
     Options options;
     options.ratio = 1;
     StreamDecimator decimator(options, std::nullopt);
