@@ -150,9 +150,10 @@ void StreamDecimator::track_sweep(const float tri[9]) {
         first_hi_ = hi;
         sweep_started_ = true;
     }
-    // Sorted by minimum, no triangle to come reaches behind the front: the margin stays 0, and
-    // a long triangle cannot hold the sweep off.
-    if (!options_.sorted_by_minimum) sweep_margin_ = std::max(sweep_margin_, hi - lo);
+    // Sorted by minimum, no triangle to come reaches behind the front: the margin is only the
+    // weld grid's (a corner snaps by up to half a cell), and a long triangle cannot hold the
+    // sweep off.
+    sweep_margin_ = options_.sorted_by_minimum ? options_.weld_eps : std::max(sweep_margin_, hi - lo);
     lo_max_ = std::max(lo_max_, lo);
     hi_min_ = std::min(hi_min_, hi);
     if (stats_.sweep_direction == 0) {
