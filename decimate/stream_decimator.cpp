@@ -166,9 +166,10 @@ void StreamDecimator::sweep() {
     // A future triangle has a sort key ≥ the front (every key lies within its triangle, and
     // the front is the largest triangle minimum read so far), so it can only reach vertices
     // within one triangle extent behind the front. Twice the largest extent seen leaves room
-    // for somewhat larger triangles to come (no room at all when sorted by minimum: no vertex
-    // to come lies behind the front). Vertices further behind that are still open are true
-    // boundary (holes): finalizing them lets their triangles be decimated and written.
+    // for somewhat larger triangles to come (sorted by minimum, no vertex to come lies behind
+    // the front: only the weld grid's cell is kept). Vertices further behind that are still
+    // open are true boundary (holes): finalizing them lets their triangles be decimated and
+    // written.
     // Descending input is the mirror image (front = smallest triangle maximum).
     const int direction = stats_.sweep_direction;
     if (!sweep_enabled_ || direction == 0) return;

@@ -52,8 +52,8 @@ public:
     virtual ~Reader() = default;
     // Fills `chunk` (cleared first) with up to chunk.capacity() triangles; returns false once
     // the input is exhausted (chunk then empty). Fills only the channels the chunk was made
-    // with (header().channels are those the reader can fill). Throws io::Error on bad input and never emits
-    // a partial triangle.
+    // with (header().channels are those the reader can fill). Throws io::Error on bad input
+    // and never emits a partial triangle.
     virtual bool next(TriangleChunk& chunk) = 0;
     // Facts from the header; triangle_count is set when the format states it up front.
     const MeshHeader& header() const { return header_; }

@@ -188,8 +188,8 @@ void add_compare(CLI::App& app) {
         "diagonal, plus triangle, boundary-edge and non-manifold-edge counts (after exact welding).\n"
         "Memory: only the smaller mesh (by header triangle count, or a PLY's face count, when both files state\n"
         "it, else B) is held in memory, with its samples and two BVHs (about 60 bytes per triangle + 60 per\n"
-        "sample); the other mesh is streamed twice, so it may be far larger than memory (not from stdin). Edge counting of the streamed mesh\n"
-        "spills to temporary files beyond --memory.");
+        "sample); the other mesh is streamed twice, so it may be far larger than memory (not from stdin).\n"
+        "Edge counting of the streamed mesh spills to temporary files beyond --memory.");
     cmd->add_option("a", opt->a, "Mesh A (the reference, e.g. the original; '-' = stdin)")->required();
     cmd->add_option("b", opt->b, "Mesh B (e.g. the decimated mesh)")->required();
     cmd->add_option("--samples", opt->samples,
