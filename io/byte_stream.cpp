@@ -12,6 +12,8 @@
 #include <cstring>
 #include <fcntl.h>
 #include <filesystem>
+#include <optional>
+#include <string_view>
 #include <sys/stat.h>
 #include <unistd.h>
 #include <zlib.h>
@@ -323,9 +325,28 @@ bool ByteSource::at_end() { return window().empty(); }
 
 void ByteSource::fail(const std::string& message) const { throw Error(name_, offset_, 0, message); }
 
+namespace {
+
+// The descriptor that /dev/stdout, /dev/stderr, /dev/fd/N or /proc/self/fd/N names, if open.
+std::optional<int> inherited_fd(const std::string& path) {
+    int fd = -1;
+    if (path == "/dev/stdout") fd = 1;
+    else if (path == "/dev/stderr") fd = 2;
+    else
+        for (std::string_view dir : {"/dev/fd/", "/proc/self/fd/"})
+            if (path.starts_with(dir) && path.size() > dir.size() && path.size() - dir.size() <= 9 &&
+                path.find_first_not_of("0123456789", dir.size()) == std::string::npos)
+                fd = std::stoi(path.substr(dir.size()));
+    if (fd < 0 || ::fcntl(fd, F_GETFD) < 0) return std::nullopt;
+    return fd;
+}
+
+}  // namespace
+
 bool is_stream(const std::string& path) {
     struct stat st;
-    return path == "-" || (::stat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode) && !S_ISDIR(st.st_mode));
+    return path == "-" || inherited_fd(path) ||
+           (::stat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode) && !S_ISDIR(st.st_mode));
 }
 
 // ---------------- ByteSink ----------------
@@ -339,25 +360,28 @@ std::unique_ptr<ByteSink> ByteSink::open(const std::string& path, const SinkOpti
     std::unique_ptr<ByteSink> sink(new ByteSink());
     sink->name_ = path == "-" ? "<stdout>" : path;
     sink->buf_.reserve(kBufferBytes);
+    struct stat st;
     if (path == "-") {
         sink->fd_ = 1;
+    } else if (const std::optional<int> fd = inherited_fd(path)) {
+        // The shell's own redirection (`>> log`, a pipe) is kept: renaming a file over the
+        // link's target would truncate an appended file, and a pipe has no name to rename to.
+        sink->fd_ = *fd;
+    } else if (::stat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode) && !S_ISDIR(st.st_mode)) {
+        // A device, FIFO or socket is written in place, like stdout: renaming a file over it
+        // would replace /dev/null or a pipe's reader's FIFO with a regular file. Opened by the
+        // given name, so the kernel follows links that name no file (/proc/PID/fd/N → pipe:[…]).
+        sink->fd_ = ::open(path.c_str(), O_WRONLY | O_CLOEXEC);
+        if (sink->fd_ < 0) throw Error(path, "cannot open for writing: " + errno_text());
+        sink->owns_fd_ = true;
     } else {
         sink->target_ = follow_symlinks(path);
-        struct stat st;
         const bool exists = ::stat(sink->target_.c_str(), &st) == 0;
         if (exists && S_ISDIR(st.st_mode)) throw Error(path, "is a directory");
-        if (exists && !S_ISREG(st.st_mode)) {
-            // A device, FIFO or socket is written in place, like stdout: renaming a file over
-            // it would replace /dev/null or a pipe's reader's FIFO with a regular file.
-            sink->fd_ = ::open(sink->target_.c_str(), O_WRONLY | O_CLOEXEC);
-            if (sink->fd_ < 0) throw Error(path, "cannot open for writing: " + errno_text());
-            sink->owns_fd_ = true;
-        } else {
-            sink->temp_path_ = make_temp(sink->target_ + ".tmp-XXXXXX", &sink->fd_, path);
-            // A replaced file keeps its permissions; a new one gets the umask's.
-            ::fchmod(sink->fd_, exists ? st.st_mode & 07777 : default_file_mode());
-            sink->temp_slot_ = register_temp_path(sink->temp_path_);
-        }
+        sink->temp_path_ = make_temp(sink->target_ + ".tmp-XXXXXX", &sink->fd_, path);
+        // A replaced file keeps its permissions; a new one gets the umask's.
+        ::fchmod(sink->fd_, exists ? st.st_mode & 07777 : default_file_mode());
+        sink->temp_slot_ = register_temp_path(sink->temp_path_);
     }
     if (options.gzip_level >= 0) {
         sink->gz_ = std::make_unique<Gzip>();

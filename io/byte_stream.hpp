@@ -83,14 +83,16 @@ struct SinkOptions {
     int gzip_level = -1;
 };
 
-// True for "-" and existing pipes, devices and sockets: what can be read (or written) once only.
+// True for "-", /dev/stdout and the like, and existing pipes, devices and sockets: what can be
+// read (or written) once only.
 bool is_stream(const std::string& path);
 
 // The consumer under every writer. Writes go to `<target>.tmp-XXXXXX` in the target's
 // directory; commit() flushes and renames into place, keeping a replaced file's permissions;
 // a sink destroyed without commit() deletes its temporary file. A symbolic link is followed
-// (the file it names is replaced). Stdout ("-") and existing devices, FIFOs and sockets are
-// written in place: nothing can be renamed over them.
+// (the file it names is replaced). Stdout ("-"), the descriptors /dev/stdout, /dev/fd/N and
+// the like name, and existing devices, FIFOs and sockets are written in place: nothing can be
+// renamed over them.
 class ByteSink {
 public:
     static constexpr size_t kBufferBytes = size_t{1} << 20;

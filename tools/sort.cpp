@@ -159,7 +159,10 @@ void run_sort(const SortOptions& opt) {
         throw UsageError((opt.output == "-" ? std::string("<stdout>") : opt.output) +
                          ": Draco compression reorders triangles, so the sorted order would be lost: write STL, PLY "
                          "or OBJ (or glTF with --no-draco)");
-    if (opt.output != "-") {
+    // Runs go beside a file output; a pipe or device (/dev/null, /dev/stdout) has no directory
+    // of its own for them: /dev is memory.
+    const bool output_stream = io::is_stream(opt.output);
+    if (!output_stream) {
         // Fail before a long sort, not after it.
         std::string dir = io::parent_dir(opt.output);
         if (::access(dir.c_str(), W_OK) != 0)
@@ -171,7 +174,7 @@ void run_sort(const SortOptions& opt) {
     io::ReadOptions ro = opt.read.options();
     ro.memory_budget_bytes = budget / 4;
     const std::string tmpdir = !opt.read.tmpdir.empty() ? opt.read.tmpdir
-                               : opt.output != "-"     ? io::parent_dir(opt.output)
+                               : !output_stream        ? io::parent_dir(opt.output)
                                                        : std::string();
     ro.tmpdir = tmpdir;
 
@@ -331,7 +334,7 @@ void add_sort(CLI::App& app) {
     cmd->add_flag("--stats", opt->stats, "Print runs, merge passes, temporary disk, time and peak RSS on stderr");
     add_read_flags(cmd, opt->read);
     cmd->get_option("--tmpdir")->description("Directory for sort runs and spills (default: the output's directory; $TMPDIR "
-                                             "or /tmp when writing to stdout)");
+                                             "or /tmp when writing to stdout, a pipe or a device)");
     add_write_flags(cmd, opt->write);
     cmd->callback([opt] { run_sort(*opt); });
 }

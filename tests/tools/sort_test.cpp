@@ -194,6 +194,33 @@ TEST(SortCommand, MultiPassMergeUnderOneMebibyte) {
     EXPECT_NE(r.err.find(" triangles), no runs, 0 merge passes, 0 B temporary written"), std::string::npos) << r.err;
 }
 
+// /dev/stdout, /dev/fd/1 and devices are written in place, like '-', and the runs go to
+// $TMPDIR: the command used to create a temporary file beside "pipe:[N]" (failing), rename
+// over a `>>` log (losing what it held) or spill its runs into /dev (memory).
+TEST(SortCommand, DeviceOutputsAreWrittenInPlaceWithRunsInTheTemporaryDirectory) {
+    TempDir dir;
+    write_stl(dir / "in.stl", random_triangles(30000, 12));  // two runs at --memory 1M
+    fs::create_directory(dir / "tmp");
+    ASSERT_EQ(run("sort --axis z --memory 1M " + dir / "in.stl" + " " + dir / "ref.stl", dir).code, 0);
+    const std::string ref = slurp(dir / "ref.stl");
+    const std::string sort = "TMPDIR=" + dir / "tmp" + " " + MESHSTREAM_BINARY + " -q sort --axis z --memory 1M --to stl " +
+                             dir / "in.stl";
+    for (const char* name : {"/dev/stdout", "/dev/fd/1"}) {
+        EXPECT_EQ(std::system((sort + " " + name + " 2> " + dir / "err.txt" + " | cat > " + dir / "piped.stl").c_str()), 0);
+        EXPECT_EQ(slurp(dir / "err.txt"), "") << name;
+        EXPECT_TRUE(slurp(dir / "piped.stl") == ref) << name;
+        std::ofstream(dir / "log.stl") << "kept";
+        EXPECT_EQ(std::system((sort + " " + name + " >> " + dir / "log.stl").c_str()), 0);
+        EXPECT_TRUE(slurp(dir / "log.stl") == "kept" + ref) << name;
+    }
+    EXPECT_EQ(file_count(dir / "tmp"), 0u);
+    // Runs in $TMPDIR, not in /dev: a $TMPDIR that does not exist is named in the error.
+    const int status = std::system(("TMPDIR=" + dir / "none" + " " + MESHSTREAM_BINARY + " -q sort --axis z --memory 1M --to stl " +
+                                    dir / "in.stl" + " /dev/null 2> " + dir / "err.txt").c_str());
+    EXPECT_EQ(WEXITSTATUS(status), 1);
+    EXPECT_NE(slurp(dir / "err.txt").find(dir / "none"), std::string::npos) << slurp(dir / "err.txt");
+}
+
 TEST(SortCommand, TruncatedInputLeavesNoOutputAndNoTemporaryFiles) {
     TempDir dir;
     write_stl(dir / "in.stl", random_triangles(100000, 5));
