@@ -21,6 +21,7 @@ constexpr size_t kStagingBytes = size_t{1} << 20;      // >= TempFile's buffer: 
 constexpr uint64_t kMinReadBytes = uint64_t{64} << 10;  // smallest per-run read buffer
 constexpr uint64_t kMaxReadBytes = uint64_t{16} << 20;  // larger reads gain nothing
 constexpr uint64_t kMinRunTriangles = 1024;
+constexpr uint64_t kPageBytes = 4096;  // hole punching frees whole pages only
 // Gathering records in key order is a random walk over the run buffer: prefetching the record
 // this many items ahead hides most of the cache and TLB misses (2-3x faster gathers).
 constexpr size_t kPrefetchDistance = 16;
@@ -55,7 +56,8 @@ inline void prefetch_record(const std::byte* records, size_t record_bytes, std::
 
 // One run being merged: a window of its records in a read buffer.
 struct ExternalSorter::Cursor {
-    uint64_t next_offset = 0;  // first unread byte of the run in the file
+    uint64_t start_offset = 0;  // first byte of the run in the file
+    uint64_t next_offset = 0;   // first unread byte of the run in the file
     uint64_t end_offset = 0;   // end of the run in the file
     std::byte* buf = nullptr;
     size_t capacity = 0;  // bytes, a multiple of the record size
@@ -70,14 +72,16 @@ public:
         : owner_(owner), file_(file) {
         const size_t rb = owner.record_bytes_;
         const size_t k = std::max<size_t>(1, segments.size());
-        uint64_t per_run = std::min(kMaxReadBytes, buffer_budget / k);
+        // At least 64 KiB even past a tiny budget (fan-in 2, so 128 KiB at most): smaller reads
+        // cost a system call per few records, and releasing less than a page frees nothing.
+        uint64_t per_run = std::clamp(buffer_budget / k, kMinReadBytes, kMaxReadBytes);
         size_t capacity = std::max<size_t>(1, per_run / rb) * rb;
         storage_.reset(new std::byte[capacity * segments.size()]);
         cursors_.resize(k);
         order_.assign(k, kExhausted);
         for (size_t i = 0; i < segments.size(); ++i) {
             Cursor& c = cursors_[i];
-            c.next_offset = segments[i].offset;
+            c.start_offset = c.next_offset = segments[i].offset;
             c.end_offset = segments[i].offset + segments[i].count * rb;
             c.buf = storage_.get() + i * capacity;
             c.capacity = capacity;
@@ -134,7 +138,13 @@ private:
 
     // Reads the cursor's next block; false when its run is exhausted. Releases the consumed one.
     bool refill(Cursor& c) {
-        if (c.len > 0) owner_.release_temp_range(file_, c.block_offset, c.len);
+        if (c.len > 0) {
+            // From the page holding the block's first byte, whose earlier bytes were this run's
+            // previous block (a page that begins before the run may hold another run's data).
+            const uint64_t first_page = (c.start_offset + kPageBytes - 1) / kPageBytes * kPageBytes;
+            const uint64_t from = std::max(c.block_offset / kPageBytes * kPageBytes, first_page);
+            owner_.release_temp_range(file_, from, c.block_offset + c.len, c.len);
+        }
         c.pos = c.len = 0;
         if (c.next_offset >= c.end_offset) return false;
         size_t n = static_cast<size_t>(std::min<uint64_t>(c.capacity, c.end_offset - c.next_offset));
@@ -250,15 +260,15 @@ void ExternalSorter::write_temp(io::TempFile& file, const void* data, size_t n) 
     stats_.peak_temp_bytes = std::max(stats_.peak_temp_bytes, live_temp_bytes_);
 }
 
-void ExternalSorter::release_temp_range(io::TempFile& file, uint64_t offset, uint64_t n) {
+void ExternalSorter::release_temp_range(io::TempFile& file, uint64_t begin, uint64_t end, uint64_t consumed) {
 #ifdef FALLOC_FL_PUNCH_HOLE
     // Consumed run data is never read again: give its blocks back so a merge pass needs about
     // one copy of the data on disk, not two. File systems without hole punching just keep it.
-    if (::fallocate(file.fd(), FALLOC_FL_PUNCH_HOLE | FALLOC_FL_KEEP_SIZE, static_cast<off_t>(offset),
-                    static_cast<off_t>(n)) == 0)
-        live_temp_bytes_ -= std::min(live_temp_bytes_, n);
+    if (begin >= end || ::fallocate(file.fd(), FALLOC_FL_PUNCH_HOLE | FALLOC_FL_KEEP_SIZE,
+                                    static_cast<off_t>(begin), static_cast<off_t>(end - begin)) == 0)
+        live_temp_bytes_ -= std::min(live_temp_bytes_, consumed);
 #else
-    (void)file, (void)offset, (void)n;
+    (void)file, (void)begin, (void)end, (void)consumed;
 #endif
 }
 

@@ -95,7 +95,8 @@ private:
     void encode(const io::TriangleChunk& chunk, size_t i, std::byte* dst) const;
     void decode(const std::byte* src, io::TriangleChunk& chunk) const;
     void write_temp(io::TempFile& file, const void* data, size_t n);
-    void release_temp_range(io::TempFile& file, uint64_t offset, uint64_t n);
+    // Punches [begin, end) out of the file; `consumed` bytes of run data are then gone.
+    void release_temp_range(io::TempFile& file, uint64_t begin, uint64_t end, uint64_t consumed);
 
     SorterOptions options_;
     SortStats stats_;
