@@ -27,7 +27,10 @@ uint64_t parse_bytes(const std::string& text) {
     else if (suffix == "G" || suffix == "GB" || suffix == "GIB") mult = 1024.0 * 1024 * 1024;
     else if (suffix == "T" || suffix == "TB" || suffix == "TIB") mult = 1024.0 * 1024 * 1024 * 1024;
     else throw CLI::ValidationError("--memory", "unknown size suffix in '" + text + "' (use K, M, G or T)");
-    return static_cast<uint64_t>(value * mult);
+    // Past 2^64 the conversion is undefined; the largest size is then refused as more than
+    // this machine's memory, like any size too large.
+    const double bytes = value * mult;
+    return bytes >= 18446744073709551616.0 ? UINT64_MAX : static_cast<uint64_t>(bytes);
 }
 
 namespace {

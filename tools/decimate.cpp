@@ -221,7 +221,7 @@ void run_decimate(const DecimateOptions& opt) {
     if (s.sort_violations > 0)
         warnings.note(std::string("the input is not sorted along ") + "xyz"[*options.sorted_axis] +
                      " as stated: " + std::to_string(s.sort_violations) +
-                     " triangles reached behind the sweep, which was switched off at the first (boundary "
+                     (s.sort_violations == 1 ? " triangle" : " triangles") + " reached behind the sweep, which was switched off at the first (boundary "
                      "finalized before it may show as cracks); " +
                      (axis_conflict ? std::string("leave out --sorted-axis to use the file's own axis")
                                     : std::string("run `meshstream sort` on it first")));

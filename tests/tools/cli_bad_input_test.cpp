@@ -255,6 +255,10 @@ TEST(CliBadInput, MemoryBudgetsThatAreNotSizesOrTooSmallAreRefusedClearly) {
                         {"--memory 12Q", 2, "--memory: unknown size suffix in '12Q'"},
                         // used to be "out of memory" (a run buffer of the budget's size)
                         {"--memory 100T", 2, "--memory: 100T is more than this machine's memory ("},
+                        // past 2^64 bytes: used to wrap round to "too small" (or a tiny budget)
+                        {"--memory 99999999999999999999", 2,
+                         "--memory: 99999999999999999999 is more than this machine's memory ("},
+                        {"--memory 16777216T", 2, "--memory: 16777216T is more than this machine's memory ("},
                         // used to be "out of memory"
                         {"--memory 1", 2, "in.stl: --memory 1 is too small to sort: give at least 97K"},
                         {"--memory 96K", 2, "in.stl: --memory 96K is too small to sort: give at least 97K"},
@@ -263,10 +267,15 @@ TEST(CliBadInput, MemoryBudgetsThatAreNotSizesOrTooSmallAreRefusedClearly) {
     EXPECT_EQ(ok.code, 0) << ok.err;
     for (const std::string& cmd : {"info --topology " + dir / "in.stl", "compare " + dir / "in.stl" + " " + dir / "in.stl",
                                   "convert " + dir / "in.stl" + " " + dir / "o.ply"}) {
-        CliRun r = run(cmd + " --memory 100T");
-        EXPECT_EQ(r.code, 2) << cmd;
-        EXPECT_NE(r.err.find("--memory: 100T is more than this machine's memory"), std::string::npos) << r.err;
+        for (const std::string size : {"100T", "1e30"}) {
+            CliRun r = run(cmd + " --memory " + size);
+            EXPECT_EQ(r.code, 2) << cmd;
+            EXPECT_NE(r.err.find("--memory: " + size + " is more than this machine's memory"), std::string::npos)
+                << r.err;
+        }
     }
+    CliRun order = run("info --order --memory 99999999999999999999 " + dir / "in.stl");
+    EXPECT_EQ(order.code, 2) << order.err;
 }
 
 TEST(CliBadInput, InputWithoutTrianglesGivesAnEmptyOutputAndAWarning) {
