@@ -427,7 +427,7 @@ void ByteSink::flush_buffer() {
 }
 
 void ByteSink::write(const void* data, size_t n) {
-    if (committed_) throw Error(name_, offset_, 0, "write after the output was finished");
+    if (written_) throw Error(name_, offset_, 0, "write after the output was finished");
     if (buf_.size() + n > kBufferBytes) {
         flush_buffer();
         if (n >= kBufferBytes) {
@@ -458,8 +458,9 @@ void ByteSink::patch(uint64_t offset, const void* data, size_t n) {
     }
 }
 
-void ByteSink::commit() {
+void ByteSink::finish_writing() {
     if (committed_) throw Error(name_, offset_, 0, "the output was already finished");
+    if (written_) return;
     flush_buffer();
     if (gz_) {
         z_stream& zs = gz_->zs;
@@ -473,21 +474,17 @@ void ByteSink::commit() {
             write_all(fd_, gz_->out.data(), gz_->out.size() - zs.avail_out, name_, offset_);
         } while (rc != Z_STREAM_END);
     }
-    if (temp_path_.empty()) {
-        if (owns_fd_) {
-            const int fd = fd_;
-            fd_ = -1;
-            if (::close(fd) != 0) throw Error(name_, "write failed on close: " + errno_text());
-        }
-        committed_ = true;
-        return;
-    }
-    if (::close(fd_) != 0) {
+    if (owns_fd_ || !temp_path_.empty()) {
+        const int fd = fd_;
         fd_ = -1;
-        throw Error(name_, "write failed on close: " + errno_text());
+        if (::close(fd) != 0) throw Error(name_, "write failed on close: " + errno_text());
     }
-    fd_ = -1;
-    if (::rename(temp_path_.c_str(), target_.c_str()) != 0)
+    written_ = true;
+}
+
+void ByteSink::commit() {
+    finish_writing();
+    if (!temp_path_.empty() && ::rename(temp_path_.c_str(), target_.c_str()) != 0)
         throw Error(name_, "cannot rename " + temp_path_ + " into place: " + errno_text());
     committed_ = true;
 }

@@ -111,10 +111,17 @@ public:
     bool patchable() const;
     // Overwrites bytes at `offset` (< offset() - n + 1). Precondition: patchable().
     void patch(uint64_t offset, const void* data, size_t n);
-    // Flushes, closes and renames into place. Throws io::Error (e.g. disk full). Once only:
+    // Flushes and closes: every byte is on disk (a full disk throws here), not yet under the
+    // target's name. For outputs of two files, committed only once both are written.
+    // write() after it throws io::Error; a second call does nothing.
+    void finish_writing();
+    // finish_writing(), then renames into place. Throws io::Error (e.g. disk full). Once only:
     // write() or commit() after it throw io::Error.
     void commit();
     const std::string& name() const { return name_; }
+    // True when written in place (stdout, a descriptor, a device or FIFO): no file of its own,
+    // so nothing can be put beside it either.
+    bool in_place() const { return temp_path_.empty(); }
 
 private:
     ByteSink() = default;
@@ -127,6 +134,7 @@ private:
     bool owns_fd_ = false;   // written in place to an opened device or FIFO
     int temp_slot_ = -1;     // register_temp_path() slot
     int fd_ = -1;
+    bool written_ = false;  // finish_writing() done
     bool committed_ = false;
     struct Gzip;
     std::unique_ptr<Gzip> gz_;

@@ -183,10 +183,12 @@ public:
             throw Error(sink.name(), "--draco-qn must be 2-30, got " + std::to_string(options_.draco_normal_bits));
         if (options_.draco_level < 0 || options_.draco_level > 10)
             throw Error(sink.name(), "--draco-cl must be 0-10, got " + std::to_string(options_.draco_level));
-        inline_buffer_ = !binary_ && sink.name() == "<stdout>";
+        // Written in place (stdout, a pipe, a device), the .gltf has no directory entry of its
+        // own that a .bin could sit beside: the buffer goes inside, as a data URI.
+        inline_buffer_ = !binary_ && sink.in_place();
         budget_check_up_front(sink.name(), options_, kWhy,
                               options_.draco ? draco_need : inline_buffer_ ? plain_stdout_need : plain_need);
-        if (!binary_ && sink.name() != "<stdout>") check_side_file(sink.name());
+        if (!binary_ && !inline_buffer_) check_side_file(sink.name());
     }
 
     void write_chunk(const TriangleChunk& chunk) override {
@@ -335,7 +337,6 @@ void GltfWriter::finish_output() {
     }
     mesh = IndexedMesh{};
 
-    const bool to_stdout = sink_.name() == "<stdout>";
     if (binary_) {
         std::string json = document_json(model, bin.size(), {});
         while (json.size() % 4) json.push_back(' ');
@@ -361,18 +362,21 @@ void GltfWriter::finish_output() {
         }
     } else if (bin.empty()) {
         sink_.write(document_json(model, 0, {}));
-    } else if (to_stdout) {
+    } else if (inline_buffer_) {
         std::string uri = "data:application/octet-stream;base64," + base64(bin.data(), bin.size());
         sink_.write(document_json(model, bin.size(), uri));
     } else {
         std::string bin_path = bin_path_for(sink_.name());
         std::string json = document_json(model, bin.size(), uri_encode(base_name(bin_path)));
-        // The side file goes through its own ByteSink: it appears only when complete, and the
-        // .gltf (committed by the caller right after) never points at a half-written .bin.
+        // The side file goes through its own ByteSink. Both files are written out in full
+        // before either is renamed, so a full disk leaves neither behind (nor an old .gltf
+        // beside a new .bin); the caller renames the .gltf right after the .bin.
         std::unique_ptr<ByteSink> side = ByteSink::open(bin_path);
         side->write(bin.data(), bin.size());
-        side->commit();
         sink_.write(json);
+        side->finish_writing();
+        sink_.finish_writing();
+        side->commit();
     }
 }
 

@@ -12,8 +12,13 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <sys/stat.h>
+#include <sys/statvfs.h>
+
 #include <cstdlib>
 #include <cstring>
+#include <fstream>
+#include <thread>
 
 using namespace web_test;
 using nlohmann::json;
@@ -427,6 +432,52 @@ TEST(GltfWriter, UnfinishedGltfLeavesNeitherFile) {
         out.write(chunk);
     }  // destroyed without finish()
     EXPECT_TRUE(fs::is_empty(dir.path()));
+}
+
+// Both files of a .gltf pair are written out before either is renamed: the .bin used to be
+// renamed into place first, so a disk with room for it alone kept a .bin that belonged to no
+// .gltf, and the next try was refused because of it.
+TEST(GltfWriter, AFullDiskLeavesNeitherFileOfThePair) {
+    TempDir dir;
+    Soup bunny = read_soup(fixture("bunny_from_draco.bin.stl"));
+    write_soup(bunny, dir / "probe.gltf");
+    const uint64_t bin_pages = (fs::file_size(dir / "probe.bin") + 4095) / 4096;
+    fs::create_directory(dir / "small");
+    if (std::system(("mount -t tmpfs -o size=1M tmpfs '" + dir / "small" + "' 2>/dev/null").c_str()) != 0)
+        GTEST_SKIP() << "cannot mount a small tmpfs here";
+    struct statvfs vfs;
+    ASSERT_EQ(::statvfs((dir / "small").c_str(), &vfs), 0);
+    const uint64_t room = uint64_t{vfs.f_bavail} * vfs.f_frsize;
+    ASSERT_GT(room, bin_pages * 4096);
+    std::ofstream(dir / "small/filler", std::ios::binary) << std::string(room - bin_pages * 4096, '\0');
+    std::string error;
+    try {
+        write_soup(bunny, dir / "small/b.gltf");
+    } catch (const io::Error& e) {
+        error = e.what();
+    }
+    std::vector<std::string> left;
+    for (const auto& entry : fs::directory_iterator(dir / "small")) left.push_back(entry.path().filename());
+    std::system(("umount '" + dir / "small" + "'").c_str());
+    EXPECT_NE(error.find("No space left on device"), std::string::npos) << error;
+    EXPECT_EQ(left, std::vector<std::string>{"filler"});
+}
+
+// A .gltf written into a FIFO (or a device, or stdout) has no directory entry that a .bin
+// could sit beside: its buffer goes inside as a data URI. It used to create "ff.bin" beside
+// the FIFO (and /dev/null.bin for /dev/null).
+TEST(GltfWriter, AGltfIntoAFifoCarriesItsBuffer) {
+    TempDir dir;
+    ASSERT_EQ(::mkfifo((dir / "ff.gltf").c_str(), 0600), 0);
+    std::string got;
+    std::thread reader([&] { got = slurp(dir / "ff.gltf"); });
+    io::WriteOptions o;
+    o.draco = false;
+    write_soup(read_soup(fixture("cube.bin.stl")), dir / "ff.gltf", o);
+    reader.join();
+    const json doc = json::parse(got);
+    EXPECT_TRUE(doc["buffers"][0]["uri"].get<std::string>().starts_with("data:application/octet-stream;base64,"));
+    EXPECT_FALSE(fs::exists(dir / "ff.bin"));
 }
 
 TEST(GltfWriter, RefusesPastMemoryBudget) {
