@@ -53,19 +53,14 @@ class DracoWriter final : public Writer {
 public:
     DracoWriter(ByteSink& sink, const WriteOptions& options)
         : sink_(sink), options_(options), indexer_(sink.name()) {
-        if (options.draco_position_bits < 1 || options.draco_position_bits > 30)
-            throw Error(sink.name(), "--draco-qp must be 1-30, got " + std::to_string(options.draco_position_bits));
-        if (options.draco_normal_bits < 2 || options.draco_normal_bits > 30)
-            throw Error(sink.name(), "--draco-qn must be 2-30, got " + std::to_string(options.draco_normal_bits));
-        if (options.draco_level < 0 || options.draco_level > 10)
-            throw Error(sink.name(), "--draco-cl must be 0-10, got " + std::to_string(options.draco_level));
+        check_draco_settings(sink.name(), options);
         budget_check_up_front(sink.name(), options, kWhy, draco_encode_estimate_bytes);
     }
 
     void write_chunk(const TriangleChunk& chunk) override {
         indexer_.add(chunk);
         budget_check(sink_.name(), options_, kWhy, indexer_.input_triangle_count(),
-                     draco_encode_estimate_bytes(indexer_.vertex_count(), indexer_.triangle_count(), options_.normals));
+                     draco_encode_estimate_bytes(indexer_.vertex_count(), indexer_.triangle_count(), options_));
     }
 
     void finish_output() override {
@@ -152,12 +147,43 @@ bool probe_draco(std::span<const std::byte> head, std::optional<uint64_t>) {
     return head.size() >= 5 && std::memcmp(head.data(), kMagic, 5) == 0;
 }
 
-uint64_t draco_encode_estimate_bytes(uint64_t vertex_count, uint64_t triangle_count, bool normals) {
-    // Measured with bench/web.sh on the bunny and a 1 M triangle grid (peak RSS growth over
-    // the triangle count, Draco 1.5.5, level 7), rounded up: the index tables (~28 B/vertex,
-    // 12 B/triangle), Draco's mesh copy (12 B/vertex, 12 B/triangle), its corner table and
-    // traversal state (~70 B/triangle); normals add two float3 arrays per vertex.
-    return vertex_count * (40 + (normals ? 24 : 0)) + triangle_count * 100;
+namespace {
+
+// Peak RSS of Draco 1.5.5's entropy coding tables, measured (bench/web.sh's inputs, qp and qn
+// 22-29): about 4 bytes per quantized value of positions (levels 0-8; 11 at levels 9 and 10,
+// more than twice that at 30 bits) and of normals, for meshes past a few thousand vertices.
+uint64_t draco_table_bytes(const WriteOptions& options) {
+    const uint64_t per_value = options.draco_level < 9 ? 4 : options.draco_position_bits < 30 ? 12 : 24;
+    return per_value * (uint64_t{1} << options.draco_position_bits) +
+           (options.normals ? 4 * (uint64_t{1} << options.draco_normal_bits) : 0);
+}
+
+}  // namespace
+
+uint64_t draco_encode_estimate_bytes(uint64_t vertex_count, uint64_t triangle_count, const WriteOptions& options) {
+    // Peak RSS growth, measured on a 1 M-triangle soup of separate triangles (3 M vertices) and
+    // closed 1 M and 2 M-triangle meshes (half as many vertices), Draco 1.5.5, level 7, fitted
+    // and rounded up: the index tables and Draco's mesh copy and corner table per vertex and
+    // per triangle; smooth normals add the area-weighted sums and Draco's normal attribute.
+    return vertex_count * (96 + (options.normals ? 88 : 0)) + triangle_count * 76 + draco_table_bytes(options);
+}
+
+void check_draco_settings(const std::string& file, const WriteOptions& options) {
+    if (options.draco_position_bits < 1 || options.draco_position_bits > 30)
+        throw Error(file, "--draco-qp must be 1-30, got " + std::to_string(options.draco_position_bits));
+    if (options.draco_normal_bits < 2 || options.draco_normal_bits > 30)
+        throw Error(file, "--draco-qn must be 2-30, got " + std::to_string(options.draco_normal_bits));
+    if (options.draco_level < 0 || options.draco_level > 10)
+        throw Error(file, "--draco-cl must be 0-10, got " + std::to_string(options.draco_level));
+    const uint64_t tables = draco_table_bytes(options);
+    if (tables <= options.memory_budget_bytes) return;
+    throw Error(file, "Draco's coding tables for --draco-qp " + std::to_string(options.draco_position_bits) +
+                          (options.normals ? " and --draco-qn " + std::to_string(options.draco_normal_bits) : "") +
+                          " at --draco-cl " + std::to_string(options.draco_level) + " take about " +
+                          binary_size(tables) + " (they double with each bit), over the memory budget of " +
+                          binary_size(options.memory_budget_bytes) +
+                          ": give fewer bits (float positions hold 24) or --memory " +
+                          std::to_string((tables >> 20) + 1) + "M or more");
 }
 
 DracoEncoded encode_draco(const IndexedMesh& mesh, const std::vector<float>* normals, const WriteOptions& options,

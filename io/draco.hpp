@@ -30,9 +30,13 @@ extern const Format kDracoFormat;  // "draco": .drc
 // True when `head` starts with the magic "DRACO".
 bool probe_draco(std::span<const std::byte> head, std::optional<uint64_t> file_size);
 
-// Bytes the Draco writer is estimated to need at its peak for a mesh of this size (index
-// tables, Draco's copy of the mesh, its corner table and the encoded output).
-uint64_t draco_encode_estimate_bytes(uint64_t vertex_count, uint64_t triangle_count, bool normals);
+// Bytes the Draco writer is estimated to need at its peak for a mesh of this size with these
+// settings (index tables, Draco's copy of the mesh, its corner table, the encoded output, and
+// its entropy coder's tables, which double with each quantization bit).
+uint64_t draco_encode_estimate_bytes(uint64_t vertex_count, uint64_t triangle_count, const WriteOptions& options);
+
+// Refuses --draco-qp/-qn/-cl out of range, and bit counts whose tables alone pass --memory.
+void check_draco_settings(const std::string& file, const WriteOptions& options);
 
 struct DracoEncoded {
     std::vector<char> bytes;       // the Draco bitstream

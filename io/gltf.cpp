@@ -150,7 +150,8 @@ class GltfWriter final : public Writer {
     static constexpr const char* kWhy = "glTF is written from the whole mesh in memory";
     // The indexer's tables (positions, 4-byte hash slots, a power of two at least twice the
     // vertices, indices) plus the output buffer, as in write().
-    static uint64_t plain_need(uint64_t vertices, uint64_t triangles, bool normals) {
+    static uint64_t plain_need(uint64_t vertices, uint64_t triangles, const WriteOptions& options) {
+        const bool normals = options.normals;
         return vertices * (12 + 12 + (normals ? 24 : 0)) + 4 * std::bit_ceil(std::max<uint64_t>(2 * vertices, 1024)) +
                triangles * (12 + 12);
     }
@@ -160,14 +161,14 @@ class GltfWriter final : public Writer {
     static uint64_t buffer_bytes(uint64_t vertices, uint64_t triangles, bool normals) {
         return vertices * (12 + (normals ? 12 : 0)) + triangles * 12;
     }
-    static uint64_t plain_stdout_need(uint64_t vertices, uint64_t triangles, bool normals) {
-        return plain_need(vertices, triangles, normals) + 6 * buffer_bytes(vertices, triangles, normals);
+    static uint64_t plain_stdout_need(uint64_t vertices, uint64_t triangles, const WriteOptions& options) {
+        return plain_need(vertices, triangles, options) + 6 * buffer_bytes(vertices, triangles, options.normals);
     }
-    static uint64_t draco_need(uint64_t vertices, uint64_t triangles, bool normals) {
+    static uint64_t draco_need(uint64_t vertices, uint64_t triangles, const WriteOptions& options) {
 #if MESHSTREAM_WITH_DRACO
-        return draco_encode_estimate_bytes(vertices, triangles, normals);
+        return draco_encode_estimate_bytes(vertices, triangles, options);
 #else
-        return plain_need(vertices, triangles, normals);
+        return plain_need(vertices, triangles, options);
 #endif
     }
 
@@ -177,12 +178,9 @@ public:
 #if !MESHSTREAM_WITH_DRACO
         options_.draco = false;
 #endif
-        if (options_.draco_position_bits < 1 || options_.draco_position_bits > 30)
-            throw Error(sink.name(), "--draco-qp must be 1-30, got " + std::to_string(options_.draco_position_bits));
-        if (options_.draco_normal_bits < 2 || options_.draco_normal_bits > 30)
-            throw Error(sink.name(), "--draco-qn must be 2-30, got " + std::to_string(options_.draco_normal_bits));
-        if (options_.draco_level < 0 || options_.draco_level > 10)
-            throw Error(sink.name(), "--draco-cl must be 0-10, got " + std::to_string(options_.draco_level));
+#if MESHSTREAM_WITH_DRACO
+        if (options_.draco) check_draco_settings(sink.name(), options_);
+#endif
         // Written in place (stdout, a pipe, a device), the .gltf has no directory entry of its
         // own that a .bin could sit beside: the buffer goes inside, as a data URI.
         inline_buffer_ = !binary_ && sink.in_place();
@@ -196,7 +194,7 @@ public:
         uint64_t v = indexer_.vertex_count(), f = indexer_.triangle_count();
         uint64_t need;
 #if MESHSTREAM_WITH_DRACO
-        if (options_.draco) need = draco_encode_estimate_bytes(v, f, options_.normals);
+        if (options_.draco) need = draco_encode_estimate_bytes(v, f, options_);
         else
 #endif
             // Index tables, plus the output buffer (positions, optional normals, indices), and

@@ -170,10 +170,10 @@ IndexedMesh MeshIndexer::take() {
 }
 
 void budget_check_up_front(const std::string& file, const WriteOptions& options, const char* why,
-                           uint64_t (*need)(uint64_t vertices, uint64_t triangles, bool normals)) {
+                           uint64_t (*need)(uint64_t vertices, uint64_t triangles, const WriteOptions& options)) {
     const std::optional<uint64_t> n = options.triangle_count ? options.triangle_count : options.expected_triangle_count;
     if (!n) return;
-    const uint64_t least = need(*n / 2, *n, options.normals);
+    const uint64_t least = need(*n / 2, *n, options);
     if (least <= options.memory_budget_bytes) return;
     const uint64_t mib = (least + (uint64_t{1} << 20) - 1) >> 20;
     throw Error(file, std::string(why) + ": the " + std::to_string(*n) + " triangles to be written need at least " +

@@ -35,7 +35,7 @@ struct IndexedMesh {
 //   triangle count, a closed surface with half as many vertices, needs more than the budget;
 // - budget_check: when the `triangles` read so far need more (`need` bytes).
 void budget_check_up_front(const std::string& file, const WriteOptions& options, const char* why,
-                           uint64_t (*need)(uint64_t vertices, uint64_t triangles, bool normals));
+                           uint64_t (*need)(uint64_t vertices, uint64_t triangles, const WriteOptions& options));
 void budget_check(const std::string& file, const WriteOptions& options, const char* why, uint64_t triangles,
                   uint64_t need);
 

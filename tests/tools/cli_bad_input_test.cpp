@@ -379,8 +379,33 @@ TEST(CliBadInput, WholeMeshOutputTooBigForTheBudgetIsRefusedUpFront) {
     EXPECT_EQ(c.code, 1) << c.err;
     EXPECT_NE(c.err.find("the 1152 triangles to be written need at least"), std::string::npos) << c.err;
     // Where it fits, it is written.
-    CliRun ok = run("decimate -r 0.25 --memory 100K " + dir / "in.stl" + " " + dir / "out.drc");
+    CliRun ok = run("decimate -r 0.1 --memory 100K " + dir / "in.stl" + " " + dir / "out.drc");
     EXPECT_EQ(ok.code, 0) << ok.err;
+}
+
+// Draco's entropy coder takes about 4 bytes per quantized value (2^bits of them, 11 at levels
+// 9-10): --draco-qp 28 took 1 GB on the bunny and 29 at level 10 5.8 GB, whatever --memory said.
+TEST(CliBadInput, DracoBitCountsWhoseTablesPassTheBudgetAreRefusedUpFront) {
+    TempDir dir;
+    write_file(dir / "in.stl", binary_stl(grid(4)));
+    for (const char* out : {"out.drc", "out.glb"}) {
+        for (const auto& [flags, message] : std::vector<std::pair<std::string, std::string>>{
+                 {"--draco-qp 28", "Draco's coding tables for --draco-qp 28 at --draco-cl 7 take about 1 GiB (they "
+                                   "double with each bit), over the memory budget of 256 MiB: give fewer bits (float "
+                                   "positions hold 24) or --memory 1025M or more"},
+                 {"--draco-qp 24 --draco-cl 10 --memory 150M", "take about 192 MiB"},
+                 {"--normals --draco-qn 27", "Draco's coding tables for --draco-qp 14 and --draco-qn 27 at --draco-cl 7"},
+             }) {
+            CliRun r = run("convert " + flags + " " + dir / "in.stl" + " " + dir / out);
+            EXPECT_EQ(r.code, 1) << flags << " " << out << ": " << r.err;
+            EXPECT_NE(r.err.find(dir / out + ": " + (message[0] == 'D' ? message : "")), std::string::npos) << r.err;
+            EXPECT_NE(r.err.find(message), std::string::npos) << r.err;
+            EXPECT_EQ(listing(dir.path), std::vector<std::string>{"in.stl"}) << out;
+        }
+        CliRun ok = run("convert --draco-qp 24 " + dir / "in.stl" + " " + dir / out);
+        EXPECT_EQ(ok.code, 0) << ok.err;
+        fs::remove(dir / out);
+    }
 }
 
 // --weld P% on a format without a stated bounding box (STL): a regular file is read twice,
