@@ -67,6 +67,11 @@ void note_unused_write_flags(const WriteFlags& flags, const io::Format& output, 
     if (output.traits & (io::Format::kAlwaysDraco | io::Format::kDracoUnlessOff)) {
         if ((output.traits & io::Format::kAlwaysDraco) && !flags.draco)
             warnings.note("--no-draco applies to glTF outputs; a .drc is Draco");
+        const WriteFlags defaults;
+        if ((output.traits & io::Format::kDracoUnlessOff) && !flags.draco &&
+            (flags.draco_qp != defaults.draco_qp || flags.draco_qn != defaults.draco_qn ||
+             flags.draco_cl != defaults.draco_cl))
+            warnings.note("--draco-qp, --draco-qn and --draco-cl apply to Draco compression: ignored with --no-draco");
         return;
     }
     const WriteFlags defaults;

@@ -164,6 +164,11 @@ TEST(CliConvert, DracoOptionsForOtherOutputsAreSaidToDoNothing) {
     cli_test::CliRun glb = run("convert --normals --draco-qp 10 " + cube + " " + dir / "c.glb");
     EXPECT_EQ(glb.code, 0) << glb.err;
     EXPECT_EQ(glb.err.find("warning"), std::string::npos) << glb.err;
+    cli_test::CliRun plain = run("convert --no-draco --draco-cl 9 " + cube + " " + dir / "p.glb");
+    EXPECT_EQ(plain.code, 0) << plain.err;
+    EXPECT_NE(plain.err.find("warning: --draco-qp, --draco-qn and --draco-cl apply to Draco compression: ignored "
+                             "with --no-draco"),
+              std::string::npos) << plain.err;
 }
 
 // Double coordinates rounded to float are said when they moved, and only then.
