@@ -143,7 +143,8 @@ struct Format {
 std::span<const Format* const> formats();
 // "draco, glb, ..." of the formats that can be read (or written), for messages.
 std::string format_names(bool for_writing);
-// The format named `name` (exact, case-sensitive), or null.
+// The format named `name` (exact, case-sensitive), else the first claiming it as an extension
+// ("drc"), or null.
 const Format* find_format(std::string_view name);
 // The first readable format whose extension matches `path` (".gz" stripped), or null.
 const Format* format_for_extension(std::string_view path, bool for_writing);

@@ -76,6 +76,9 @@ std::span<const Format* const> formats() { return kFormats; }
 const Format* find_format(std::string_view name) {
     for (const Format* f : kFormats)
         if (f->name == name) return f;
+    // An extension names its format too ("drc" is draco), the first that claims it.
+    for (const Format* f : kFormats)
+        if (has_extension(*f, std::string(name))) return f;
     return nullptr;
 }
 

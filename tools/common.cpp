@@ -90,6 +90,7 @@ void note_unused_write_flags(const WriteFlags& flags, const io::Format& output, 
 }
 
 void require_output_format(const std::string& output, const WriteFlags& flags) {
+    if (output.empty()) throw UsageError("the output name is empty");
     if (!flags.to.empty()) return;  // checked by its validator
     if (output == "-") throw UsageError("<stdout>: writing to stdout needs --to (one of: " + format_names(true) + ")");
     if (io::format_for_extension(output, true) == nullptr)

@@ -484,6 +484,8 @@ TEST(CliBadInput, CommandLinesThatCannotWorkExit2BeforeAnyWork) {
         const char* message;
     } cases[] = {
         {"convert " + in + " " + out + " --to foo", "--to: unknown output format 'foo' (one of: draco, glb"},
+        // used to do the whole job, then fail to rename "<input>: … .tmp-XXXXXX into place" (exit 1)
+        {"convert " + in + " '' --to glb", "the output name is empty"},
         {"convert " + in + " " + out + " --from foo", "--from: unknown input format 'foo'"},
         {"convert " + in + " -", "<stdout>: writing to stdout needs --to (one of: draco"},
         {"decimate -r 0.5 " + in + " -", "<stdout>: writing to stdout needs --to"},

@@ -171,6 +171,18 @@ TEST(CliConvert, DracoOptionsForOtherOutputsAreSaidToDoNothing) {
               std::string::npos) << plain.err;
 }
 
+// --to and --from take a format's extension as well as its name: "--to drc" was refused
+// although .drc is the extension every Draco file has.
+TEST(CliConvert, FormatsAreNamedByTheirExtensionToo) {
+    TempDir dir;
+    const std::string cube = std::string(MESHSTREAM_FIXTURES_DIR) + "/cube.bin.stl";
+    cli_test::CliRun drc = run("convert --to drc " + cube + " " + dir / "cube.out");
+    ASSERT_EQ(drc.code, 0) << drc.err;
+    EXPECT_EQ(slurp(dir / "cube.out").substr(0, 5), "DRACO");
+    cli_test::CliRun back = run("convert --from drc --to stl " + dir / "cube.out" + " " + dir / "back.stl");
+    EXPECT_EQ(back.code, 0) << back.err;
+}
+
 // Double coordinates rounded to float are said when they moved, and only then.
 TEST(CliConvert, RoundedDoubleCoordinatesAreAWarning) {
     TempDir dir;
