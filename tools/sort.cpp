@@ -297,6 +297,11 @@ void run_sort(const SortOptions& opt) {
     progress.done();
     Warnings warnings;
     note_unused_write_flags(opt.write, *out.format, opt.output, warnings);
+    // Only STL, PLY and OBJ have a place for the axis (a header or a comment).
+    if (out.format->traits & io::Format::kDracoUnlessOff)
+        warnings.note(std::string(opt.output == "-" ? "<stdout>" : opt.output) +
+                      ": glTF has no place for the sorted axis: decimate it with --sorted-axis " + "xyz"[axis] +
+                      ", or sort to STL, PLY or OBJ, which record it");
     filter.report(warnings);
     note_input_changes(end_header, input_name, warnings);
     warnings.print();

@@ -136,6 +136,22 @@ TEST(SortCommand, SortsShuffledFixtureAndRecordsAxis) {
     EXPECT_EQ(file_count(dir / "tmp"), 0u);
 }
 
+// glTF keeps the sorted order (without Draco) but has no place for the axis: said, with the
+// option that stands in for it. It used to be dropped silently, and `info --order` then
+// advised flagging the file with `meshstream sort`.
+TEST(SortCommand, AGltfOutputSaysItCannotRecordTheAxis) {
+    TempDir dir;
+    write_stl(dir / "in.stl", random_triangles(2000, 14));
+    CliRun g = run("sort --axis y --no-draco " + dir / "in.stl" + " " + dir / "out.gltf", dir);
+    ASSERT_EQ(g.code, 0) << g.err;
+    EXPECT_NE(g.err.find("out.gltf: glTF has no place for the sorted axis: decimate it with --sorted-axis y, or sort "
+                         "to STL, PLY or OBJ, which record it"),
+              std::string::npos)
+        << g.err;
+    CliRun p = run("sort --axis y " + dir / "in.stl" + " " + dir / "out.ply", dir);
+    EXPECT_EQ(p.err, "");
+}
+
 TEST(SortCommand, AutoAxisIsTheLongestExtent) {
     TempDir dir;
     std::vector<Tri> tris = random_triangles(20000, 1);
