@@ -555,6 +555,34 @@ std::string_view json_text(const std::vector<unsigned char>& bytes, bool glb) {
     return {text + 20, std::min<size_t>(get_u32(&bytes[12]), bytes.size() - 20)};
 }
 
+// Deepest nesting of JSON arrays and objects read. tinygltf (and nlohmann::json under it)
+// recurse once per level when turning the parsed JSON into values, so a document of 15 000
+// '[' overflowed the stack (SIGSEGV); a glTF document needs about 10 levels, extras a few more.
+constexpr size_t kMaxJsonDepth = 512;
+
+// Throws at the first array or object nested deeper than kMaxJsonDepth, before any JSON
+// parser sees `json`, which starts at byte `offset` of the file. Brackets inside strings (with
+// their escapes) do not count; everything else is left to the parser.
+void check_json_depth(std::string_view json, uint64_t offset, const std::string& file) {
+    size_t depth = 0;
+    bool in_string = false;
+    for (size_t i = 0; i < json.size(); ++i) {
+        const char c = json[i];
+        if (in_string) {
+            if (c == '\\') ++i;  // the escaped character, which may be a quote
+            else if (c == '"') in_string = false;
+        } else if (c == '"') {
+            in_string = true;
+        } else if (c == '[' || c == '{') {
+            if (++depth > kMaxJsonDepth)
+                throw Error(file, offset + i, 0, "JSON nested deeper than " + std::to_string(kMaxJsonDepth) +
+                                                     " arrays and objects (a glTF document needs about 10)");
+        } else if ((c == ']' || c == '}') && depth > 0) {
+            --depth;
+        }
+    }
+}
+
 // Whether some "uri" of the document names something other than a data: URI (a file).
 bool names_files(std::string_view json) {
     for (size_t at = json.find("\"uri\""); at != std::string_view::npos; at = json.find("\"uri\"", at + 5)) {
@@ -612,6 +640,8 @@ public:
                 throw Error(name_, first, 0, "not glTF: expected the GLB magic 'glTF' or a JSON object");
         }
         if (!glb && bytes.size() > 0xFFFFFFFFull) throw Error(name_, "glTF JSON over 4 GiB is not supported");
+        // Before any JSON parser runs: ours below (Draco indices, buffer sizes) and tinygltf's.
+        check_json_depth(json_text(bytes, glb), glb ? 20 : 0, name_);
         header_.variant = glb ? "binary (GLB)" : "JSON";
 
         hide_draco_indices(bytes, glb);

@@ -19,7 +19,8 @@
 // transforms. TRIANGLES, TRIANGLE_STRIP and TRIANGLE_FAN are read (with or without indices,
 // Draco or plain accessors, KHR_mesh_quantization's integer positions); points and lines,
 // sparse accessors and other required extensions (e.g. EXT_meshopt_compression) are refused
-// with an io::Error naming the file and the mesh, primitive or extension.
+// with an io::Error naming the file and the mesh, primitive or extension; JSON nested deeper
+// than 512 arrays and objects is refused at its byte before any parser sees it.
 #pragma once
 
 #include "io/format.hpp"

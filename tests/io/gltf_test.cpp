@@ -291,6 +291,42 @@ TEST(GltfReader, NamesABufferViewPastTheEndOfItsBuffer) {
     EXPECT_NE(what.find("bufferView 0 ends at byte 400, past the end of buffer 0 (36 bytes)"), std::string::npos) << what;
 }
 
+// A GLB of `json` alone (no BIN chunk), padded as GLB requires.
+std::string glb_of(std::string json) {
+    while (json.size() % 4) json.push_back(' ');
+    auto u32 = [](uint32_t v) { return std::string(reinterpret_cast<const char*>(&v), 4); };
+    return "glTF" + u32(2) + u32(static_cast<uint32_t>(20 + json.size())) + u32(static_cast<uint32_t>(json.size())) +
+           "JSON" + json;
+}
+
+TEST(GltfReader, RefusesJsonNestedTooDeepBeforeParsingIt) {
+    // 15 000 nested arrays (or 20 000 objects) in extras overflowed the stack inside tinygltf:
+    // SIGSEGV. The 512th level is refused at its byte, in a .gltf and in a GLB's JSON chunk.
+    TempDir dir;
+    const std::string arrays = std::string(15000, '[') + std::string(15000, ']');
+    std::string objects;
+    for (int i = 0; i < 20000; ++i) objects += R"({"a":)";
+    objects += "1" + std::string(20000, '}');
+    for (const std::string& deep : {arrays, objects}) {
+        HandMade doc(R"("extras":)" + deep + ",");
+        const size_t first = slurp(doc.path).find(deep.substr(0, 1), 10);  // after asset's '{'
+        std::string what = error_of(doc.path);
+        EXPECT_NE(what.find(": byte " + std::to_string(first + (deep[0] == '[' ? 511 : 5 * 511)) +
+                            ": JSON nested deeper than 512 arrays and objects"),
+                  std::string::npos) << what.substr(0, 300);
+        const std::string json = R"({"asset":{"version":"2.0"},"extras":)" + deep + "}";
+        std::ofstream(dir / "deep.glb", std::ios::binary) << glb_of(json);
+        what = error_of(dir / "deep.glb");
+        EXPECT_NE(what.find(": byte " + std::to_string(20 + json.find(deep.substr(0, 1), 10) + (deep[0] == '[' ? 511 : 5 * 511)) +
+                            ": JSON nested deeper than 512"),
+                  std::string::npos) << what.substr(0, 300);
+    }
+    // Brackets in strings, escaped quotes among them, do not count; 100 real levels are fine.
+    const std::string in_strings = R"("\"[[[)" + std::string(1000, '{') + R"(\\",)";
+    HandMade fine(R"("extras":[)" + in_strings + std::string(100, '[') + std::string(100, ']') + "],");
+    EXPECT_EQ(read_soup(fine.path).triangles(), 1u);
+}
+
 TEST(GltfReader, RefusesTruncatedGlbAtEveryLength) {
     TempDir dir;
     std::string bytes = slurp(fixture("gltf/BoxTextured_draco_transcoder.glb"));
