@@ -613,6 +613,32 @@ uint64_t external_buffer_bytes(std::string_view json) {
     return total;
 }
 
+// tinygltf looks each buffer (and image) file up in the directory it is given and then in the
+// current one ("." is always its second search path), so a .gltf whose sub/a.bin was missing
+// quietly read ./a.bin. These file callbacks let through only paths in the document's own
+// directory, as glTF's relative URIs mean, and remember the ones missing there for the error.
+struct DocumentDir {
+    std::string prefix;                // the directory as tinygltf joins it to a URI: "sub/", "./", "/"
+    std::vector<std::string> missing;  // paths asked for in it that do not exist
+};
+
+bool document_file_exists(const std::string& path, void* user) {
+    auto* dir = static_cast<DocumentDir*>(user);
+    if (!path.starts_with(dir->prefix)) return false;
+    struct stat st;
+    if (::stat(path.c_str(), &st) == 0) return true;
+    dir->missing.push_back(path);
+    return false;
+}
+
+// URIs name files as they are: no "~" or "$VAR" expansion (older tinygltf ran wordexp on them).
+std::string unexpanded_path(const std::string& path, void*) { return path; }
+
+bool read_document_file(std::vector<unsigned char>* out, std::string* err, const std::string& path, void* user) {
+    if (!path.starts_with(static_cast<DocumentDir*>(user)->prefix)) return false;
+    return tinygltf::ReadWholeFile(out, err, path, nullptr);
+}
+
 class GltfReader final : public Reader {
 public:
     GltfReader(ByteSource& source, const ReadOptions& options) : name_(source.name()) {
@@ -654,13 +680,20 @@ public:
         tinygltf::TinyGLTF gltf;
         gltf.SetImageLoader(&skip_image, nullptr);
         std::string err, warn;
-        std::string base_dir = parent_dir(source.name());
+        const std::string base_dir = parent_dir(source.name());  // "." for stdin: the current directory
+        DocumentDir files{base_dir.ends_with('/') ? base_dir : base_dir + "/", {}};
+        gltf.SetFsCallbacks({&document_file_exists, &unexpanded_path, &read_document_file, nullptr, &files});
         bool ok = glb ? gltf.LoadBinaryFromMemory(&model_, &err, &warn, bytes.data(), static_cast<unsigned>(bytes.size()), base_dir)
                       : gltf.LoadASCIIFromString(&model_, &err, &warn, reinterpret_cast<const char*>(bytes.data()),
                                                  static_cast<unsigned>(bytes.size()), base_dir);
         if (!ok) {
             for (const std::string& ext : required_extensions_in(json_text(bytes, glb)))
                 if (!extension_supported(ext)) throw_unsupported_extension(ext);
+            for (const std::string& path : files.missing)
+                if (err.find("File not found : " + path.substr(files.prefix.size())) != std::string::npos)
+                    throw Error(name_, "buffer file " + path + " does not exist (buffer files are read from the " +
+                                           (name_ == "<stdin>" ? "current directory for a document on stdin)"
+                                                               : "document's directory only)"));
             while (!err.empty() && (err.back() == '\n' || err.back() == ' ')) err.pop_back();
             throw Error(name_, "invalid glTF: " + (err.empty() ? std::string("tinygltf failed to parse it") : err));
         }

@@ -291,6 +291,36 @@ TEST(GltfReader, NamesABufferViewPastTheEndOfItsBuffer) {
     EXPECT_NE(what.find("bufferView 0 ends at byte 400, past the end of buffer 0 (36 bytes)"), std::string::npos) << what;
 }
 
+TEST(GltfReader, MissingBufferFileIsNotLookedUpInTheCurrentDirectory) {
+    // tinygltf tries the current directory after the document's: with sub/a.bin gone and an
+    // a.bin in the working directory, that one was read, silently.
+    HandMade doc("");
+    TempDir elsewhere;
+    fs::rename(doc.dir / "hand.bin", elsewhere / "hand.bin");
+    const fs::path was = fs::current_path();
+    fs::current_path(elsewhere.path());
+    const std::string relative = fs::relative(doc.path).string();  // ../meshstream-web-XXXXXX/hand.gltf
+    std::string what[2];
+    for (int i = 0; i < 2; ++i) {
+        try {
+            read_soup(i ? relative : doc.path);
+        } catch (const io::Error& e) {
+            what[i] = e.what();
+        }
+    }
+    fs::current_path(was);
+    EXPECT_EQ(what[0], doc.path + ": buffer file " + doc.dir / "hand.bin" +
+                           " does not exist (buffer files are read from the document's directory only)");
+    EXPECT_EQ(what[1], relative + ": buffer file " + fs::path(relative).parent_path().string() +
+                           "/hand.bin does not exist (buffer files are read from the document's directory only)");
+    // Beside the document it is found, also when the document is named without a directory.
+    fs::rename(elsewhere / "hand.bin", doc.dir / "hand.bin");
+    fs::current_path(doc.dir.path());
+    const size_t triangles = read_soup("hand.gltf").triangles();
+    fs::current_path(was);
+    EXPECT_EQ(triangles, 1u);
+}
+
 // A GLB of `json` alone (no BIN chunk), padded as GLB requires.
 std::string glb_of(std::string json) {
     while (json.size() % 4) json.push_back(' ');
