@@ -919,6 +919,12 @@ AccessorView GltfReader::view(int accessor, const std::string& what) const {
         throw Error(name_, where_acc + ": bufferView refers to a missing buffer");
     const std::vector<unsigned char>& data = model_.buffers[bv.buffer].data;
     const size_t elem = csize * v.components;
+    // glTF 2.0 §3.6.2.4: a stride spaces elements apart, it never overlaps them (the validator's
+    // ACCESSOR_SMALL_BYTESTRIDE); byteStride 4 under VEC3 floats read each from the last one's y.
+    if (bv.byteStride != 0 && bv.byteStride < elem)
+        throw Error(name_, where_acc + ": bufferView " + std::to_string(a.bufferView) + " has byteStride " +
+                               std::to_string(bv.byteStride) + ", less than the accessor's " + std::to_string(elem) +
+                               "-byte elements");
     v.stride = bv.byteStride ? bv.byteStride : elem;
     uint64_t end = uint64_t{bv.byteOffset} + a.byteOffset + (a.count ? (a.count - 1) * uint64_t{v.stride} + elem : 0);
     if (uint64_t{bv.byteOffset} + bv.byteLength > data.size())

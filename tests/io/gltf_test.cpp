@@ -291,6 +291,29 @@ TEST(GltfReader, NamesABufferViewPastTheEndOfItsBuffer) {
     EXPECT_NE(what.find("bufferView 0 ends at byte 400, past the end of buffer 0 (36 bytes)"), std::string::npos) << what;
 }
 
+TEST(GltfReader, RefusesAByteStrideSmallerThanTheElement) {
+    // byteStride 4 under VEC3 floats read overlapping elements: a cube gave 10 triangles of
+    // garbage, exit 0. A stride wider than the element (interleaved data) is read.
+    TempDir dir;
+    const float padded[12] = {0, 0, 0, 9, 1, 0, 0, 9, 0, 1, 0, 9};  // x y z and a fourth float
+    std::ofstream(dir / "s.bin", std::ios::binary).write(reinterpret_cast<const char*>(padded), sizeof padded);
+    auto write = [&](int stride) {
+        std::ofstream(dir / "s.gltf") << R"({"asset":{"version":"2.0"},"buffers":[{"uri":"s.bin","byteLength":48}],)"
+                                      << R"("bufferViews":[{"buffer":0,"byteLength":48,"byteStride":)" << stride << "}],"
+                                      << R"("accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3"}],)"
+                                      << R"("meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],"nodes":[{"mesh":0}]})";
+    };
+    write(16);
+    EXPECT_EQ(read_soup(dir / "s.gltf").xyz, (std::vector<float>{0, 0, 0, 1, 0, 0, 0, 1, 0}));
+    for (int stride : {4, 8}) {
+        write(stride);
+        std::string what = error_of(dir / "s.gltf");
+        EXPECT_NE(what.find("mesh 0 primitive 0 POSITION (accessor 0): bufferView 0 has byteStride " + std::to_string(stride) +
+                            ", less than the accessor's 12-byte elements"),
+                  std::string::npos) << what;
+    }
+}
+
 TEST(GltfReader, MissingBufferFileIsNotLookedUpInTheCurrentDirectory) {
     // tinygltf tries the current directory after the document's: with sub/a.bin gone and an
     // a.bin in the working directory, that one was read, silently.
