@@ -446,6 +446,12 @@ int component_count(int type) {
     }
 }
 
+// a + b for a message, where the two numbers come from a file and their sum may pass 2^64.
+std::string sum_text(uint64_t a, uint64_t b) {
+    uint64_t sum;
+    return __builtin_add_overflow(a, b, &sum) ? std::to_string(a) + " + " + std::to_string(b) : std::to_string(sum);
+}
+
 // A bounds-checked window onto one accessor's elements.
 struct AccessorView {
     const unsigned char* base = nullptr;  // null: no bufferView, all zeros (glTF 2.0 §3.6.2.4)
@@ -641,7 +647,8 @@ bool read_document_file(std::vector<unsigned char>* out, std::string* err, const
 
 class GltfReader final : public Reader {
 public:
-    GltfReader(ByteSource& source, const ReadOptions& options) : name_(source.name()) {
+    GltfReader(ByteSource& source, const ReadOptions& options)
+        : name_(source.name()), budget_bytes_(options.memory_budget_bytes) {
         std::vector<unsigned char> bytes;
         unsigned char buf[1 << 16];
         while (size_t n = source.read(buf, sizeof buf)) {
@@ -757,6 +764,7 @@ private:
     void load_current();
 
     std::string name_;
+    uint64_t budget_bytes_;  // --memory
     tinygltf::Model model_;
     std::vector<Instance> instances_;
     std::map<std::pair<int, int>, std::shared_ptr<const PrimitiveGeometry>> draco_cache_;
@@ -911,7 +919,15 @@ AccessorView GltfReader::view(int accessor, const std::string& what) const {
     if (csize == 0 || v.components == 0)
         throw Error(name_, where_acc + " has unsupported component type " + std::to_string(a.componentType) + " / type " +
                                std::to_string(a.type));
-    if (a.bufferView < 0) return v;  // all zeros
+    if (a.bufferView < 0) {
+        // All zeros: nothing is stored, so only the count bounds what is decoded (4 bytes a
+        // component), and a 200-byte file could ask for 8 GB, or for 2^64 / 3 + 1 vertices,
+        // whose float count wrapped to 2 and was written past. Held to --memory, as files are.
+        if (a.count > budget_bytes_ / (4 * uint64_t(v.components)))
+            throw Error(name_, where_acc + " has no bufferView (all zeros) and count " + std::to_string(a.count) +
+                                   ", over the memory budget of " + binary_size(budget_bytes_) + " once decoded; raise --memory");
+        return v;
+    }
     if (a.bufferView >= static_cast<int>(model_.bufferViews.size()))
         throw Error(name_, where_acc + " refers to bufferView " + std::to_string(a.bufferView) + ", which does not exist");
     const tinygltf::BufferView& bv = model_.bufferViews[a.bufferView];
@@ -926,14 +942,20 @@ AccessorView GltfReader::view(int accessor, const std::string& what) const {
                                std::to_string(bv.byteStride) + ", less than the accessor's " + std::to_string(elem) +
                                "-byte elements");
     v.stride = bv.byteStride ? bv.byteStride : elem;
-    uint64_t end = uint64_t{bv.byteOffset} + a.byteOffset + (a.count ? (a.count - 1) * uint64_t{v.stride} + elem : 0);
-    if (uint64_t{bv.byteOffset} + bv.byteLength > data.size())
+    // Offsets, lengths and the count are 64-bit numbers from the JSON, so no sum or product of
+    // them may wrap: a byteOffset near 2^64 made the view start before its buffer.
+    const uint64_t view_offset = bv.byteOffset, view_length = bv.byteLength;
+    if (view_offset > data.size() || view_length > data.size() - view_offset)
         throw Error(name_, where_acc + ": bufferView " + std::to_string(a.bufferView) + " ends at byte " +
-                               std::to_string(uint64_t{bv.byteOffset} + bv.byteLength) + ", past the end of buffer " +
-                               std::to_string(bv.buffer) + " (" + std::to_string(data.size()) + " bytes)");
-    if (end > uint64_t{bv.byteOffset} + bv.byteLength)
-        throw Error(name_, where_acc + " reaches byte " + std::to_string(end) + " of a buffer view ending at " +
-                               std::to_string(uint64_t{bv.byteOffset} + bv.byteLength));
+                               sum_text(view_offset, view_length) + ", past the end of buffer " + std::to_string(bv.buffer) +
+                               " (" + std::to_string(data.size()) + " bytes)");
+    uint64_t end = a.byteOffset, span = 0;  // the end of the last element, from the view's start
+    const bool wraps = a.count > 0 && (__builtin_mul_overflow(uint64_t{a.count - 1}, uint64_t{v.stride}, &span) ||
+                                       __builtin_add_overflow(span, uint64_t{elem}, &span) ||
+                                       __builtin_add_overflow(end, span, &end));
+    if (wraps || end > view_length)
+        throw Error(name_, where_acc + " reaches byte " + (wraps ? std::string("2^64 or more") : sum_text(view_offset, end)) +
+                               " of a buffer view ending at " + std::to_string(view_offset + view_length));
     v.base = data.data() + bv.byteOffset + a.byteOffset;
     return v;
 }
@@ -957,7 +979,8 @@ std::shared_ptr<const PrimitiveGeometry> GltfReader::geometry(int mesh, int prim
             throw Error(name_, at + ": KHR_draco_mesh_compression refers to bufferView " + std::to_string(bvi) + ", which does not exist");
         const tinygltf::BufferView& bv = model_.bufferViews[bvi];
         if (bv.buffer < 0 || bv.buffer >= static_cast<int>(model_.buffers.size()) ||
-            bv.byteOffset + bv.byteLength > model_.buffers[bv.buffer].data.size())
+            bv.byteOffset > model_.buffers[bv.buffer].data.size() ||
+            bv.byteLength > model_.buffers[bv.buffer].data.size() - bv.byteOffset)  // no sum to wrap
             throw Error(name_, at + ": KHR_draco_mesh_compression bufferView " + std::to_string(bvi) + " lies outside its buffer");
         const auto* start = reinterpret_cast<const std::byte*>(model_.buffers[bv.buffer].data.data() + bv.byteOffset);
         DracoDecoded d;

@@ -314,6 +314,54 @@ TEST(GltfReader, RefusesAByteStrideSmallerThanTheElement) {
     }
 }
 
+TEST(GltfReader, OffsetsAndCountsNearTwoToThe64AreRefusedNotWrapped) {
+    // Sums and products of these 64-bit numbers wrapped: a view 4 bytes before its buffer, an
+    // accessor 8 bytes before its view, 2^60 + 1 elements 16 bytes apart "ending" at byte 12,
+    // all read or allocated as if in bounds (exit 0, or std::length_error); an accessor without
+    // a bufferView of 2^64 / 3 + 1 zeros wrote past a vector of 2 floats (SIGSEGV).
+    TempDir dir;
+    const float tri[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    std::ofstream(dir / "o.bin", std::ios::binary).write(reinterpret_cast<const char*>(tri), sizeof tri);
+    struct Case {
+        const char* view;
+        const char* accessor;
+        const char* expected;
+    } cases[] = {
+        {R"({"buffer":0,"byteOffset":18446744073709551612,"byteLength":40})", R"("bufferView":0,"count":3)",
+         "POSITION (accessor 0): bufferView 0 ends at byte 18446744073709551612 + 40, past the end of buffer 0 (36 bytes)"},
+        {R"({"buffer":0,"byteLength":36})", R"("bufferView":0,"byteOffset":18446744073709551608,"count":3)",
+         "POSITION (accessor 0) reaches byte 2^64 or more of a buffer view ending at 36"},
+        {R"({"buffer":0,"byteLength":36,"byteStride":16})", R"("bufferView":0,"count":1152921504606846977)",
+         "POSITION (accessor 0) reaches byte 2^64 or more of a buffer view ending at 36"},
+        {R"({"buffer":0,"byteLength":36})", R"("count":6148914691236517206)",
+         "POSITION (accessor 0) has no bufferView (all zeros) and count 6148914691236517206, over the memory budget of "
+         "256 MiB once decoded; raise --memory"},
+        {R"({"buffer":0,"byteLength":36})", R"("count":300000000)",  // 3.6 GB of floats from 300 bytes
+         "has no bufferView (all zeros) and count 300000000, over the memory budget"},
+    };
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.accessor);
+        std::ofstream(dir / "o.gltf") << R"({"asset":{"version":"2.0"},"buffers":[{"uri":"o.bin","byteLength":36}],)"
+                                      << R"("bufferViews":[)" << c.view << "],"
+                                      << R"("accessors":[{"componentType":5126,"type":"VEC3",)" << c.accessor << "}],"
+                                      << R"("meshes":[{"primitives":[{"attributes":{"POSITION":0},"mode":6}]}],)"
+                                      << R"("nodes":[{"mesh":0}]})";
+        std::string what = error_of(dir / "o.gltf");
+        EXPECT_NE(what.find(c.expected), std::string::npos) << what;
+    }
+    // The same view in front of a Draco primitive's blob.
+    const std::string engine = fixture("gltf/2CylinderEngine_draco/2CylinderEngine");
+    std::filesystem::copy_file(engine + ".bin", dir / "2CylinderEngine.bin");
+    json doc = json::parse(slurp(engine + ".gltf"));
+    const int blob = doc["meshes"][0]["primitives"][0]["extensions"]["KHR_draco_mesh_compression"]["bufferView"];
+    doc["bufferViews"][blob]["byteOffset"] = uint64_t{18446744073709551612u};
+    doc["bufferViews"][blob]["byteLength"] = 40;
+    std::ofstream(dir / "engine.gltf") << doc.dump();
+    const std::string what = error_of(dir / "engine.gltf");
+    EXPECT_NE(what.find("KHR_draco_mesh_compression bufferView " + std::to_string(blob) + " lies outside its buffer"),
+              std::string::npos) << what;
+}
+
 TEST(GltfReader, MissingBufferFileIsNotLookedUpInTheCurrentDirectory) {
     // tinygltf tries the current directory after the document's: with sub/a.bin gone and an
     // a.bin in the working directory, that one was read, silently.
