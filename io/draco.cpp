@@ -279,6 +279,8 @@ DracoDecoded decode_draco(std::span<const std::byte> bytes, const std::string& f
     DracoDecoded out;
     draco::DecoderBuffer buffer;
     buffer.Init(reinterpret_cast<const char*>(bytes.data()), bytes.size());
+    if (!bytes.empty() && bytes.size() < 5 && std::memcmp(bytes.data(), kMagic, bytes.size()) == 0)
+        throw Error(file_name, base_offset + bytes.size(), 0, "bitstream ends inside its 5-byte magic 'DRACO'");
     if (bytes.size() < 5 || std::memcmp(bytes.data(), kMagic, 5) != 0)
         throw Error(file_name, base_offset, 0, "not a Draco bitstream (expected magic 'DRACO', found " +
                                                    quote_token({reinterpret_cast<const char*>(bytes.data()),

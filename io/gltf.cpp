@@ -567,9 +567,11 @@ std::string_view json_text(const std::vector<unsigned char>& bytes, bool glb) {
 constexpr size_t kMaxJsonDepth = 512;
 
 // Throws at the first array or object nested deeper than kMaxJsonDepth, before any JSON
-// parser sees `json`, which starts at byte `offset` of the file. Brackets inside strings (with
-// their escapes) do not count; everything else is left to the parser.
-void check_json_depth(std::string_view json, uint64_t offset, const std::string& file) {
+// parser sees `json`, which starts at byte `offset` of the file, and at its end when it ends
+// inside a string or an open array or object (a cut file: tinygltf said only "JSON string
+// too short"). `container` names what ends there: "file" or "JSON chunk". Brackets inside
+// strings (with their escapes) do not count; everything else is left to the parser.
+void check_json_nesting(std::string_view json, uint64_t offset, const std::string& file, const char* container) {
     size_t depth = 0;
     bool in_string = false;
     for (size_t i = 0; i < json.size(); ++i) {
@@ -587,6 +589,11 @@ void check_json_depth(std::string_view json, uint64_t offset, const std::string&
             --depth;
         }
     }
+    if (in_string || depth > 0)
+        throw Error(file, offset + json.size(), 0, std::string(container) + " ends inside the JSON document (" +
+                                                       (in_string ? "in a string, " : "") + std::to_string(depth) +
+                                                       (depth == 1 ? " array or object" : " arrays or objects") +
+                                                       " still open)");
 }
 
 // Whether some "uri" of the document names something other than a data: URI (a file).
@@ -657,7 +664,8 @@ public:
                 throw Error(name_, "glTF documents are read whole into memory and this one is over the memory budget of " +
                                        binary_size(options.memory_budget_bytes) + "; raise --memory");
         }
-        const bool glb = bytes.size() >= 4 && std::memcmp(bytes.data(), kGlbMagic, 4) == 0;
+        // A cut inside the magic ("g" of "glTF") is a GLB cut short too: no JSON starts so.
+        const bool glb = !bytes.empty() && std::memcmp(bytes.data(), kGlbMagic, std::min<size_t>(bytes.size(), 4)) == 0;
         if (glb) {
             // tinygltf tolerates a GLB shorter than its header says when the cut falls in
             // padding; a file that disagrees with its own length is truncated or corrupt.
@@ -674,7 +682,7 @@ public:
         }
         if (!glb && bytes.size() > 0xFFFFFFFFull) throw Error(name_, "glTF JSON over 4 GiB is not supported");
         // Before any JSON parser runs: ours below (Draco indices, buffer sizes) and tinygltf's.
-        check_json_depth(json_text(bytes, glb), glb ? 20 : 0, name_);
+        check_json_nesting(json_text(bytes, glb), glb ? 20 : 0, name_, glb ? "JSON chunk" : "file");
         header_.variant = glb ? "binary (GLB)" : "JSON";
 
         hide_draco_indices(bytes, glb);

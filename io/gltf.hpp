@@ -20,8 +20,9 @@
 // Draco or plain accessors, KHR_mesh_quantization's integer positions); points and lines,
 // sparse accessors and other required extensions (e.g. EXT_meshopt_compression) are refused
 // with an io::Error naming the file and the mesh, primitive or extension; JSON nested deeper
-// than 512 arrays and objects is refused at its byte before any parser sees it. Buffer files
-// are read from the document's directory only (the current one for stdin).
+// than 512 arrays and objects, or ending inside one, is refused at its byte before any parser
+// sees it. Buffer files are read from the document's directory only (the current one for
+// stdin).
 #pragma once
 
 #include "io/format.hpp"

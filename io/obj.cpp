@@ -295,7 +295,7 @@ std::unique_ptr<Writer> open_obj_writer(ByteSink& sink, const WriteOptions& opti
 
 }  // namespace
 
-bool probe_obj(std::span<const std::byte> head, std::optional<uint64_t>) {
+bool guess_obj(std::span<const std::byte> head) {
     if (head.empty()) return false;
     for (std::byte b : head) {
         unsigned char c = static_cast<unsigned char>(b);
@@ -322,9 +322,11 @@ const Format kObjFormat = {
     "obj",
     "obj",
     "Wavefront OBJ (geometry: v and f)",
-    &probe_obj,
+    nullptr,  // no magic bytes
     &open_obj_reader,
     &open_obj_writer,
+    0,
+    &guess_obj,
 };
 
 }  // namespace meshstream::io

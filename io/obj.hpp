@@ -19,7 +19,9 @@ namespace meshstream::io {
 extern const Format kObjFormat;  // "obj"
 
 // OBJ has no magic: true when the head is text whose first statement is an OBJ keyword
-// (v, vt, vn, f, o, g, s, usemtl, mtllib, l, p) or which holds only '#' comments.
-bool probe_obj(std::span<const std::byte> head, std::optional<uint64_t> file_size);
+// (v, vt, vn, f, o, g, s, usemtl, mtllib, l, p) or which holds only '#' comments. So weak a
+// test ("g" is the first byte of a GLB, "p" of a PLY) is kObjFormat's guess, tried only when
+// neither magic bytes nor the extension identify the input.
+bool guess_obj(std::span<const std::byte> head);
 
 }  // namespace meshstream::io

@@ -273,6 +273,42 @@ TEST(BadInput, TruncationAtEveryByteOfEachBinaryFormatThrowsWithFileName) {
     }
 }
 
+// The same cuts named by extension and detected, as the commands read them: a GLB cut to its
+// first byte, "g", was read as an empty OBJ, exit 0 (OBJ's first-statement test ran before the
+// extension, and "g" is its group statement); so were a PLY cut to "p" and an ASCII STL cut to
+// "s". A file named for a format is read by that format's reader and reported as cut.
+TEST(BadInput, TruncationAtEveryByteIsAnErrorOfTheFormatTheNameSays) {
+    TempDir dir;
+    struct Case {
+        const char* format;
+        const char* ext;
+        const char* at_byte_one;  // the error for the first byte alone
+    };
+    for (Case c : {Case{"stl", "stl", "byte 1: file ends inside the 84-byte binary STL header"},
+                   Case{"stl-ascii", "stl", "byte 1: file ends inside the 84-byte binary STL header"},
+                   Case{"ply", "ply", ":1: file ends inside the header"},
+                   Case{"ply-ascii", "ply", ":1: file ends inside the header"},
+                   Case{"draco", "drc", "byte 1: bitstream ends inside its 5-byte magic 'DRACO'"},
+                   Case{"glb", "glb", "byte 1: file ends inside the 12-byte GLB header"},
+                   Case{"gltf", "gltf", "byte 1: file ends inside the JSON document (1 array or object still open)"}}) {
+        const std::string full = written(dir, c.format, c.ext);
+        const std::string path = dir / (std::string("cut.") + c.ext);
+        const bool text = std::string_view(c.format).ends_with("ascii") || std::string_view(c.format) == "gltf";
+        // Every byte through the headers, then every 7th (each cut is a file opened by name).
+        for (size_t cut = 1; cut < full.size(); cut += cut < 128 ? 1 : 7) {
+            if (text && full.find_first_not_of(" \r\n", cut) == std::string::npos) continue;  // as above
+            if (std::string_view(c.format) == "stl-ascii" && cut >= full.rfind("endsolid") + 8) continue;
+            write_file(path, full.substr(0, cut));
+            io::Error e = error_of([&] { read_path(path); });
+            EXPECT_EQ(e.file(), path) << c.format << " cut at " << cut;
+            EXPECT_TRUE(has_position(e)) << c.format << " cut at " << cut << ": " << e.what();
+            if (cut == 1) {
+                EXPECT_NE(std::string(e.what()).find(c.at_byte_one), std::string::npos) << e.what();
+            }
+        }
+    }
+}
+
 // OBJ has no counts: a cut at a line boundary is a valid shorter file. Every cut must still give
 // either io::Error or at most the full triangle count.
 TEST(BadInput, TruncatedObjReadsFewerTrianglesOrThrows) {

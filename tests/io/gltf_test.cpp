@@ -431,13 +431,16 @@ TEST(GltfReader, RefusesJsonNestedTooDeepBeforeParsingIt) {
 TEST(GltfReader, RefusesTruncatedGlbAtEveryLength) {
     TempDir dir;
     std::string bytes = slurp(fixture("gltf/BoxTextured_draco_transcoder.glb"));
-    // From 4 bytes on, the magic says glTF (shorter prefixes such as "g" are other formats).
-    for (size_t n = 4; n < bytes.size(); n += (n < 64 ? 1 : 61)) {
+    // From the first byte: "g" alone was read as an empty OBJ (see BadInput.TruncationAtEvery…).
+    for (size_t n = 1; n < bytes.size(); n += (n < 64 ? 1 : 61)) {
         std::ofstream(dir / "t.glb", std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(n));
         EXPECT_THROW(read_soup(dir / "t.glb"), io::Error) << "truncated to " << n;
     }
-    std::ofstream(dir / "t.glb", std::ios::binary).write(bytes.data(), 3968);
+    std::ofstream(dir / "t.glb", std::ios::binary).write(bytes.data(), 1);
     std::string what = error_of(dir / "t.glb");
+    EXPECT_NE(what.find("t.glb: byte 1: file ends inside the 12-byte GLB header"), std::string::npos) << what;
+    std::ofstream(dir / "t.glb", std::ios::binary).write(bytes.data(), 3968);
+    what = error_of(dir / "t.glb");
     EXPECT_NE(what.find("byte 8: GLB header states 3976 bytes, the file holds 3968"), std::string::npos) << what;
 }
 

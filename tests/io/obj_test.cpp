@@ -243,10 +243,26 @@ TEST(ObjMemory, TinyBudgetSpillsTheVertexTableWithTheSameResult) {
     EXPECT_TRUE(test::slurp(dir / "tiny.obj") == test::slurp(dir / "grid.obj"));
 }
 
-TEST(ObjFormat, ProbeAcceptsObjTextAndRejectsBinaryAndStl) {
-    auto probe = [](std::string_view s) {
-        return io::probe_obj({reinterpret_cast<const std::byte*>(s.data()), s.size()}, std::nullopt);
-    };
+TEST(ObjFormat, TextIsGuessedObjWhenTheNameSaysNothingElse) {
+    // Without an extension, or with one no format claims, OBJ text is still read as OBJ; a name
+    // that claims a format wins over the guess ("g" is OBJ's group statement and a GLB's first
+    // byte).
+    TempDir dir;
+    auto detected = [](const std::string& path) { return std::string(io::detect_input_format(*io::ByteSource::open(path)).name); };
+    for (const char* name : {"mesh", "mesh.txt", "mesh.obj"}) {
+        test::spit(dir / name, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+        EXPECT_EQ(detected(dir / name), "obj") << name;
+        EXPECT_EQ(read_soup(dir / name).triangles(), 1u) << name;
+    }
+    const std::pair<const char*, const char*> named[] = {{"g.glb", "glb"}, {"p.ply", "ply"}, {"s.stl", "stl"}, {"g", "obj"}};
+    for (const auto& [name, format] : named) {
+        test::spit(dir / name, std::string_view(name, 1));
+        EXPECT_EQ(detected(dir / name), format) << name;
+    }
+}
+
+TEST(ObjFormat, GuessAcceptsObjTextAndRejectsBinaryAndStl) {
+    auto probe = [](std::string_view s) { return io::guess_obj({reinterpret_cast<const std::byte*>(s.data()), s.size()}); };
     EXPECT_TRUE(probe("# Blender\nmtllib a.mtl\no Cube\nv 1 2 3\n"));
     EXPECT_TRUE(probe("\r\n  v 1 2 3\r\n"));
     EXPECT_TRUE(probe("# only a comment\n"));
