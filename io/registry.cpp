@@ -118,10 +118,23 @@ Input open_input(const std::string& path, std::string_view from, const ReadOptio
         in.format = find_format(from);
         if (!in.format || !in.format->open_reader)
             throw Error(path, "unknown input format '" + std::string(from) + "' (one of: " + format_names(false) + ")");
-    } else {
-        in.format = &detect_input_format(*in.source);
+        in.reader = in.format->open_reader(*in.source, options);
+        return in;
     }
-    in.reader = in.format->open_reader(*in.source, options);
+    in.format = &detect_input_format(*in.source);
+    // Chosen by its extension, a file whose content another format's guess takes (OBJ text
+    // named .stl) fails in the named format's reader: the error says what else it reads as.
+    const Format* guessed = nullptr;
+    for (const Format* f : kFormats)
+        if (!guessed && f != in.format && f->open_reader && f->guess && f->guess(in.source->peek(4096))) guessed = f;
+    try {
+        in.reader = in.format->open_reader(*in.source, options);
+    } catch (const Error& e) {
+        if (!guessed) throw;
+        throw Error(e.file(), e.byte_offset(), e.line(),
+                    e.message() + "; its content reads as " + std::string(guessed->name) + " (--from " +
+                        std::string(guessed->name) + ")");
+    }
     return in;
 }
 

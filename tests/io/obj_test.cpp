@@ -259,6 +259,18 @@ TEST(ObjFormat, TextIsGuessedObjWhenTheNameSaysNothingElse) {
         test::spit(dir / name, std::string_view(name, 1));
         EXPECT_EQ(detected(dir / name), format) << name;
     }
+    // OBJ text named .stl fails as STL, and the error says what it reads as.
+    test::spit(dir / "objtext.stl", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    try {
+        io::open_input(dir / "objtext.stl", {}, {});
+        ADD_FAILURE() << "read as STL";
+    } catch (const io::Error& e) {
+        EXPECT_NE(std::string(e.what()).find("binary STL header (neither binary nor ASCII STL); its content reads as "
+                                             "obj (--from obj)"),
+                  std::string::npos)
+            << e.what();
+    }
+    EXPECT_EQ(read_soup(dir / "objtext.stl", io::TriangleChunk::kDefaultCapacity, {}, "obj").triangles(), 1u);
 }
 
 TEST(ObjFormat, GuessAcceptsObjTextAndRejectsBinaryAndStl) {
