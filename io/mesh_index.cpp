@@ -173,7 +173,10 @@ void budget_check_up_front(const std::string& file, const WriteOptions& options,
                            uint64_t (*need)(uint64_t vertices, uint64_t triangles, const WriteOptions& options)) {
     const std::optional<uint64_t> n = options.triangle_count ? options.triangle_count : options.expected_triangle_count;
     if (!n) return;
-    const uint64_t least = need(*n / 2, *n, options);
+    // A count from a broken header can be near 2^64, where the estimates wrap: past 2^40
+    // triangles any estimate is beyond every machine, and the one of 2^40 is still a lower bound.
+    const uint64_t counted = std::min(*n, uint64_t{1} << 40);
+    const uint64_t least = need(counted / 2, counted, options);
     if (least <= options.memory_budget_bytes) return;
     const uint64_t mib = (least + (uint64_t{1} << 20) - 1) >> 20;
     throw Error(file, std::string(why) + ": the " + std::to_string(*n) + " triangles to be written need at least " +

@@ -95,4 +95,24 @@ TEST(MeshIndexer, GrowsPastTheInitialTable) {
     EXPECT_EQ(b.min[1], 0.0f);
 }
 
+// A count near 2^64 (a broken header) made the estimate wrap: "need at least 16777216 TiB …
+// give --memory 0M or more".
+TEST(BudgetCheck, AnAbsurdCountIsRefusedWithALowerBoundThatDoesNotWrap) {
+    io::WriteOptions options;
+    options.memory_budget_bytes = uint64_t{256} << 20;
+    options.triangle_count = uint64_t{1} << 62;
+    auto need = [](uint64_t vertices, uint64_t triangles, const io::WriteOptions&) {
+        return vertices * 96 + triangles * 76;
+    };
+    try {
+        io::budget_check_up_front("big.glb", options, "why", need);
+        ADD_FAILURE() << "accepted";
+    } catch (const io::Error& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("the 4611686018427387904 triangles to be written need at least 124 TiB"), std::string::npos)
+            << what;
+        EXPECT_NE(what.find("give --memory 130023424M or more"), std::string::npos) << what;
+    }
+}
+
 }  // namespace
