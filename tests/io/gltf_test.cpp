@@ -258,6 +258,21 @@ TEST(GltfReader, AppliesMorphTargetsAtTheirDefaultWeights) {
         << what;
 }
 
+// tinygltf quotes what it could not read: a broken 100 kB data URI came back whole, raw bytes
+// and all. The message is cut and its bytes made printable.
+TEST(GltfReader, TinygltfMessagesAreCutAndPrintable) {
+    TempDir dir;
+    const std::string head = R"({"asset":{"version":"2.0"},"buffers":[{"byteLength":36,"uri":"data:application/octet-stream;base64,)";
+    std::ofstream(dir / "long.gltf") << head << std::string(100000, '!') << R"("}]})";
+    const std::string long_error = error_of(dir / "long.gltf");
+    EXPECT_NE(long_error.find("invalid glTF: Failed to decode 'uri'"), std::string::npos) << long_error.substr(0, 300);
+    EXPECT_LT(long_error.size(), 1000u);
+    std::ofstream(dir / "raw.gltf") << head << std::string(10, '\xff') << R"("}]})";
+    const std::string raw_error = error_of(dir / "raw.gltf");
+    EXPECT_EQ(raw_error.find('\xff'), std::string::npos) << raw_error;
+    EXPECT_NE(raw_error.find("\\xff"), std::string::npos) << raw_error;
+}
+
 TEST(GltfReader, BufferFilesCountAgainstTheMemoryBudget) {
     // The document (3 695 bytes) was held to --memory, its buffer files (840 bytes here, 18 MB
     // for a 1 M mesh) were not.
