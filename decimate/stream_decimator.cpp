@@ -50,6 +50,7 @@ double choose_ratio(const Options& options, std::optional<uint64_t> input_count)
 
 StreamDecimator::StreamDecimator(const Options& options, std::optional<uint64_t> input_triangle_count)
     : options_(checked(options, input_triangle_count)),
+      input_count_(input_triangle_count),
       ratio_(choose_ratio(options, input_triangle_count)),
       buffer_(options.buffer_triangles, options.weld_eps),
       rng_(options.seed),
@@ -230,7 +231,16 @@ void StreamDecimator::write_one(const Emit& out, bool allow_forced) {
     stats_.vertices_moved += write_face(buffer_, f, next_id_, output_, out);
 }
 
+void StreamDecimator::follow_skipped() {
+    if (!options_.target || skipped_ == 0 || *input_count_ == 0) return;
+    // The most the input can still hold: never below the triangles already read, so the
+    // writes this ratio allows never pass the target.
+    const uint64_t usable = *input_count_ - std::min(*input_count_, skipped_);
+    ratio_ = usable > 0 ? std::min(1.0, double(*options_.target) / double(usable)) : 1.0;
+}
+
 void StreamDecimator::make_room(const Emit& out) {
+    follow_skipped();
     if (options_.sorted_axis) sweep();
     const RoomPlan plan = plan_full_buffer(buffer_.face_capacity(), ratio_, stats_.triangles_in,
                                            output_.triangle_count());

@@ -74,6 +74,11 @@ public:
     // throws std::invalid_argument before reading any: NaN/inf corners can be neither welded
     // nor finalized (the commands drop them first with tools::TriangleFilter).
     void push(const io::TriangleChunk& in, const Emit& out);
+    // Input triangles the caller dropped instead of pushing (non-finite, degenerate). With
+    // Options::target the ratio becomes target / (input count − skipped so far), so the output
+    // lands on the target when the dropped ones come early or spread through the input; ones
+    // that all come late leave it short (the mesh before them was decimated for more input).
+    void skipped(uint64_t count) { skipped_ += count; }
     // End of input: decimates to the target (as close as the mesh allows: see Stats), writes
     // the rest, flushes `out`.
     // Call once; push() or finish() after it throw std::logic_error.
@@ -82,7 +87,7 @@ public:
     const Stats& stats() const { return stats_; }
     // round(ratio · input_triangle_count): the output size finish() lands on.
     static uint64_t expected_output(double ratio, uint64_t input_triangle_count);
-    // The ratio in use (target / input count with Options::target).
+    // The ratio in use (target / input count with Options::target, less what was skipped()).
     double ratio() const { return ratio_; }
 
 private:
@@ -91,8 +96,11 @@ private:
     void write_one(const Emit& out, bool allow_forced);
     void sweep();
     void track_sweep(const float tri[9]);
+    void follow_skipped();
 
     Options options_;
+    std::optional<uint64_t> input_count_;
+    uint64_t skipped_ = 0;
     double ratio_;
     HalfEdgeBuffer buffer_;
     Rng rng_;

@@ -145,7 +145,7 @@ void run_decimate(const DecimateOptions& opt) {
     TriangleFilter filter(in.source->name(), opt.read.strict);
     while (in.reader->next(chunk)) {
         done += chunk.size();
-        filter.apply(chunk);
+        decimator.skipped(filter.apply(chunk));
         decimator.push(chunk, emit);
         progress.update(done);
     }
@@ -249,9 +249,18 @@ void run_decimate(const DecimateOptions& opt) {
                       "decimation removes surface along every open edge; --weld EPS snaps corners to a grid of EPS");
     const std::string missed = "output has " + std::to_string(s.triangles_out) + " triangles instead of the target " +
                                std::to_string(s.target_triangles);
+    // Skipped triangles that come late leave --target short: the part read before them was
+    // decimated for the larger input the header promised.
+    const std::string skipped_late = std::to_string(filter.skipped()) +
+                                     " input triangles were skipped (above), most of them after the part before "
+                                     "them had been decimated for the larger input the header promised; `meshstream "
+                                     "convert` drops them into a copy that lands on the target";
     if (s.triangles_in > 0 && s.target_triangles > s.triangles_in)
         warnings.note("the target " + std::to_string(s.target_triangles) + " is more than the " +
-                      std::to_string(s.triangles_in) + " usable input triangles: nothing was decimated");
+                      std::to_string(s.triangles_in) + " usable input triangles: " +
+                      (s.collapses == 0 ? std::string("nothing was decimated") : missed + "; " + skipped_late));
+    else if (s.triangles_in > 0 && s.triangles_out < s.target_triangles && filter.skipped() > 0)
+        warnings.note(missed + " (" + skipped_late + ")");
     else if (s.triangles_in > 0 && s.triangles_out == s.target_triangles + 1)
         warnings.note(missed + " (a collapse removes two triangles, and no boundary edge could be collapsed to remove the odd one)");
     else if (s.triangles_in > 0 && s.triangles_out != s.target_triangles && s.forced_writes > 0)
