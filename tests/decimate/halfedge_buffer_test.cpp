@@ -6,6 +6,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <vector>
+
 using namespace meshstream::decimate;
 using namespace meshstream::decimate::test;
 
@@ -79,6 +84,52 @@ TEST(HalfEdgeBuffer, DuplicateAndMisorientedFacesAreFrozen) {
     // The same triangle twice: every edge of the second conflicts with the first.
     add_indexed(buffer, {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {{0, 1, 2}, {0, 1, 2}});
     EXPECT_EQ(buffer.nonmanifold_edges(), 3u);
+}
+
+// Vertices in more faces than kLongCornerList have their edges found from the other corners'
+// lists (a hub of thousands of faces made reading quadratic). A closed double cone with two
+// hubs of 300 faces each, the hub at every corner position in turn, connects like any mesh;
+// a third face on a spoke and a duplicate face at a hub are non-manifold as elsewhere.
+TEST(HalfEdgeBuffer, EdgesAtVerticesInHundredsOfFacesConnectAsElsewhere) {
+    constexpr uint32_t n = 300;
+    std::vector<std::array<float, 3>> points = {{0, 0, 1}, {0, 0, -1}};
+    for (uint32_t i = 0; i < n; ++i)
+        points.push_back({std::cos(6.2831853f * float(i) / n), std::sin(6.2831853f * float(i) / n), 0});
+    std::vector<std::array<int, 3>> faces;
+    for (uint32_t i = 0; i < n; ++i) {
+        const int a = int(2 + i), b = int(2 + (i + 1) % n);
+        std::array<int, 3> top = {0, a, b}, bottom = {1, b, a};
+        std::rotate(top.begin(), top.begin() + i % 3, top.end());
+        std::rotate(bottom.begin(), bottom.begin() + (i + 1) % 3, bottom.end());
+        faces.push_back(top);
+        faces.push_back(bottom);
+    }
+    HalfEdgeBuffer buffer(4 * n, 0);
+    add_indexed(buffer, points, faces);
+    EXPECT_EQ(buffer.face_count(), 2 * n);
+    EXPECT_EQ(buffer.nonmanifold_edges(), 0u);
+    for (const auto& p : points) {
+        const uint32_t v = vertex_at(buffer, p);
+        EXPECT_EQ(buffer.vertex(v).open_edges, 0u);
+        EXPECT_FALSE(buffer.vertex(v).flags & kInHash);  // closed: off P_in
+    }
+    EXPECT_EQ(buffer.vertex(vertex_at(buffer, points[0])).face_count, n);
+    EXPECT_TRUE(buffer_consistent(buffer));
+
+    // The top half less one face is an open fan: its rim and the two spokes at the gap stay
+    // open (the hub stays on P_in), the other spokes connect; a duplicate face at the hub and
+    // a third face on a spoke are then non-manifold.
+    HalfEdgeBuffer disk(4 * n, 0);
+    std::vector<std::array<int, 3>> fan;
+    for (size_t i = 0; i + 2 < faces.size(); i += 2) fan.push_back(faces[i]);
+    add_indexed(disk, points, fan);
+    EXPECT_EQ(disk.nonmanifold_edges(), 0u);
+    EXPECT_EQ(disk.vertex(vertex_at(disk, points[0])).open_edges, 2u);
+    EXPECT_EQ(disk.vertex(vertex_at(disk, points[9])).open_edges, 2u);
+    add_indexed(disk, points, {fan[20], {9, 0, 1}});
+    EXPECT_EQ(disk.nonmanifold_edges(), 3u + 1u);
+    EXPECT_TRUE(disk.vertex(vertex_at(disk, points[0])).flags & kNonManifold);
+    EXPECT_TRUE(buffer_consistent(disk));
 }
 
 TEST(HalfEdgeBuffer, DegenerateTriangleIsNotInserted) {
