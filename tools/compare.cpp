@@ -156,8 +156,9 @@ void run_compare(const CompareCliOptions& opt) {
     mesh_line("B:", r.b);
     std::printf("A bbox diagonal: %.9g (percentages below are of it)\n", diag);
     auto pct = [&](double v) {
-        char text[32];
-        if (diag > 0) std::snprintf(text, sizeof text, "%8.5f%%", 100.0 * v / diag);
+        char text[40];
+        // Past a million % (a far outlier in B against a tiny A) fixed notation would run on.
+        if (diag > 0) std::snprintf(text, sizeof text, 100.0 * v / diag < 1e6 ? "%8.5f%%" : "%.4g%%", 100.0 * v / diag);
         else std::snprintf(text, sizeof text, "%9s", "n/a");  // a point: no size to relate to
         return std::string(text);
     };

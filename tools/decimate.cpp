@@ -276,11 +276,21 @@ void run_decimate(const DecimateOptions& opt) {
     warnings.print();
 
     if (opt.report) {
+        // An output without triangles (or only zero-area ones) has nothing to compare: that is
+        // said, and the written output stands (compare itself refuses such a mesh).
+        if (s.triangles_out == 0) {
+            std::fprintf(stderr, "  error vs input: not measured (the output has no triangles)\n");
+            return;
+        }
         CompareOptions co;
         co.memory_budget_bytes = opt.read.options().memory_budget_bytes;
         co.tmpdir = opt.read.tmpdir;
         const CompareResult r = compare_meshes(file_source(opt.input, opt.read.from, opt.read.options()),
                                                file_source(opt.output, {}, opt.read.options()), co);
+        if (r.a_to_b.samples == 0 && r.b_to_a.samples == 0) {
+            std::fprintf(stderr, "  error vs input: not measured (no samples: the triangles have no area)\n");
+            return;
+        }
         const double diag = r.diagonal > 0 ? r.diagonal : 1;
         std::fprintf(stderr, "  error vs input (%% of bbox diagonal %.6g): Hausdorff %.6g (%.4f %%), mean %.6g (%.4f %%), "
                              "rms %.6g (%.4f %%)\n", r.diagonal, r.hausdorff(), 100 * r.hausdorff() / diag,

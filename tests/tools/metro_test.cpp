@@ -422,6 +422,33 @@ TEST(CompareCli, ADirectionWithoutSamplesIsNotMeasuredNotZero) {
     EXPECT_NE(r.out.find("symmetric  no samples: not measured"), std::string::npos) << r.out;
     EXPECT_NE(r.err.find("B -> A is not measured\n"), std::string::npos) << r.err;
     EXPECT_EQ(r.err.find("other direction"), std::string::npos) << r.err;
+    // decimate --report used to print "Hausdorff 0 (0.0000 %)" for the same meshes, and to
+    // fail (exit 1, after writing) when the output had no triangles.
+    r = run_cli(tmp.path, "decimate -r 0.5 --report " + (tmp.path / "flat.stl").string() + " " +
+                              (tmp.path / "flat_out.stl").string());
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.err.find("error vs input: not measured (no samples: the triangles have no area)"), std::string::npos)
+        << r.err;
+    write_mesh(tmp.path / "one.stl", {0, 0, 0, 1, 0, 0, 0, 1, 0});
+    r = run_cli(tmp.path, "decimate -r 0.1 --report " + (tmp.path / "one.stl").string() + " " +
+                              (tmp.path / "none.stl").string());
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.err.find("error vs input: not measured (the output has no triangles)"), std::string::npos) << r.err;
+}
+
+// Percentages of a tiny A's diagonal can be huge: fixed notation ran past its 32-byte buffer
+// ("(1059636245964496754530782254475" with no "%)").
+TEST(CompareCli, HugePercentagesAreWrittenInFull) {
+    TempDir tmp;
+    write_mesh(tmp.path / "small.stl", {0, 0, 0, 1, 0, 0, 0, 1, 0});
+    write_mesh(tmp.path / "far.stl", {0, 0, 0, 3e30f, 0, 0, 0, 3e30f, 0});
+    RunResult r = run_cli(tmp.path, "compare " + (tmp.path / "small.stl").string() + " " + (tmp.path / "far.stl").string());
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const size_t b_to_a = r.out.find("B -> A     max ");
+    ASSERT_NE(b_to_a, std::string::npos) << r.out;
+    const std::string line = r.out.substr(b_to_a, r.out.find('\n', b_to_a) - b_to_a);
+    EXPECT_NE(line.find("(2.12e+32%)  mean"), std::string::npos) << line;
+    EXPECT_NE(line.find("(1.225e+32%)  "), std::string::npos) << line;
 }
 
 TEST(Metro, HeldSamplesFarFromTheStreamedSurfaceAreExactToo) {
