@@ -268,6 +268,10 @@ void run_decimate(const DecimateOptions& opt) {
     else if (s.triangles_in > 0 && s.triangles_out != s.target_triangles && s.no_valid_collapse_left)
         warnings.note(missed + " (no allowed collapse is left: each would fold a face over or change the topology, "
                                "or move a vertex that must stay, as on a non-manifold edge)");
+    else if (s.triangles_in > 0 && s.triangles_out > s.target_triangles && s.nonmanifold_edges > 0)
+        warnings.note(missed + " (the " + std::to_string(s.nonmanifold_edges) +
+                      " non-manifold, duplicate or mis-oriented edges above are frozen with their vertices: "
+                      "faces wound against their neighbours join none of them)");
     else if (s.triangles_in > 0 && s.triangles_out != s.target_triangles)
         warnings.note(missed + " (too little left that could be decimated)");
     else if (s.triangles_in > 0 && s.target_triangles == 0)
