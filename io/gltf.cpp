@@ -731,7 +731,8 @@ public:
                                            (name_ == "<stdin>" ? "current directory for a document on stdin)"
                                                                : "document's directory only)"));
             while (!err.empty() && (err.back() == '\n' || err.back() == ' ')) err.pop_back();
-            throw Error(name_, "invalid glTF: " + (err.empty() ? std::string("tinygltf failed to parse it") : printable(err)));
+            throw Error(name_,
+                        "invalid glTF: " + (err.empty() ? std::string("tinygltf failed to parse it") : printable(err)));
         }
         bytes = std::vector<unsigned char>();  // the file is parsed: free it (`= {}` keeps the capacity)
         for (const std::string& ext : model_.extensionsRequired)
@@ -954,7 +955,8 @@ AccessorView GltfReader::view(int accessor, const std::string& what) const {
         // whose float count wrapped to 2 and was written past. Held to --memory, as files are.
         if (a.count > budget_bytes_ / (4 * uint64_t(v.components)))
             throw Error(name_, where_acc + " has no bufferView (all zeros) and count " + std::to_string(a.count) +
-                                   ", over the memory budget of " + binary_size(budget_bytes_) + " once decoded; raise --memory");
+                                   ", over the memory budget of " + binary_size(budget_bytes_) +
+                                   " once decoded; raise --memory");
         return v;
     }
     if (a.bufferView >= static_cast<int>(model_.bufferViews.size()))

@@ -221,8 +221,9 @@ void run_decimate(const DecimateOptions& opt) {
     if (s.sort_violations > 0)
         warnings.note(std::string("the input is not sorted along ") + "xyz"[*options.sorted_axis] +
                      " as stated: " + std::to_string(s.sort_violations) +
-                     (s.sort_violations == 1 ? " triangle" : " triangles") + " reached behind the sweep, which was switched off at the first (boundary "
-                     "finalized before it may show as cracks); " +
+                     (s.sort_violations == 1 ? " triangle" : " triangles") +
+                     " reached behind the sweep, which was switched off at the first (boundary finalized before it "
+                     "may show as cracks); " +
                      (axis_conflict ? std::string("leave out --sorted-axis to use the file's own axis")
                                     : std::string("run `meshstream sort` on it first")));
     if (s.nonmanifold_edges > 0)
@@ -259,7 +260,7 @@ void run_decimate(const DecimateOptions& opt) {
         warnings.note("the target " + std::to_string(s.target_triangles) + " is more than the " +
                       std::to_string(s.triangles_in) + " usable input triangles: " +
                       (s.collapses == 0 ? std::string("nothing was decimated") : missed + "; " + skipped_late));
-    else if (s.triangles_in > 0 && s.triangles_out < s.target_triangles && filter.skipped() > 0)
+    else if (options.target && s.triangles_in > 0 && s.triangles_out < s.target_triangles && filter.skipped() > 0)
         warnings.note(missed + " (" + skipped_late + ")");
     else if (s.triangles_in > 0 && s.triangles_out == s.target_triangles + 1)
         warnings.note(missed + " (a collapse removes two triangles, and no boundary edge could be collapsed to remove the odd one)");
