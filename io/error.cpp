@@ -31,11 +31,11 @@ Error::Error(std::string file, uint64_t byte_offset, uint64_t line, std::string 
 
 Error::Error(std::string file, std::string message) : Error(std::move(file), kNoOffset, 0, std::move(message)) {}
 
-std::string quote_token(std::string_view token) {
-    std::string out = "'";
+std::string printable(std::string_view text, size_t max_chars) {
+    std::string out;
     size_t n = 0;
-    for (char c : token) {
-        if (++n > 32) { out += "..."; break; }
+    for (char c : text) {
+        if (++n > max_chars) { out += "..."; break; }
         unsigned char u = static_cast<unsigned char>(c);
         if (u >= 0x20 && u < 0x7f) {
             out += c;
@@ -45,7 +45,14 @@ std::string quote_token(std::string_view token) {
             out += buf;
         }
     }
-    return out + "'";
+    return out;
+}
+
+std::string quote_token(std::string_view token) {
+    std::string out = "'";  // piece by piece, as in format_what: GCC 12's -Wrestrict
+    out += printable(token, 32);
+    out += '\'';
+    return out;
 }
 
 }  // namespace meshstream::io

@@ -30,8 +30,11 @@ private:
     std::string message_;
 };
 
-// Formats a (possibly binary) token for an error message: printable ASCII quoted, at most
-// 32 characters, anything else as \xNN.
+// Text from a file (or a library quoting one) for an error message, on one line: printable
+// ASCII as it is, anything else (newlines too) as \xNN, cut with "..." after `max_chars`.
+std::string printable(std::string_view text, size_t max_chars);
+
+// Formats a (possibly binary) token for an error message: printable(token, 32), quoted.
 std::string quote_token(std::string_view token);
 
 }  // namespace meshstream::io

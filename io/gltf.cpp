@@ -648,26 +648,6 @@ bool document_file_exists(const std::string& path, void* user) {
 // URIs name files as they are: no "~" or "$VAR" expansion (older tinygltf ran wordexp on them).
 std::string unexpanded_path(const std::string& path, void*) { return path; }
 
-// tinygltf's messages quote the document: a bad data URI came back whole (1.1 MB for the
-// bunny's buffer), with whatever bytes the file held. Control and non-ASCII bytes become \xNN,
-// and the text is cut after 400 characters.
-std::string printable(const std::string& text) {
-    constexpr size_t kMaxChars = 400;
-    std::string out;
-    for (const char c : text) {
-        if (out.size() >= kMaxChars) return out + "...";
-        const auto u = static_cast<unsigned char>(c);
-        if ((u >= 0x20 && u < 0x7f) || c == '\n') {
-            out += c;
-        } else {
-            char buf[8];
-            std::snprintf(buf, sizeof buf, "\\x%02x", u);
-            out += buf;
-        }
-    }
-    return out;
-}
-
 bool read_document_file(std::vector<unsigned char>* out, std::string* err, const std::string& path, void* user) {
     if (!path.starts_with(static_cast<DocumentDir*>(user)->prefix)) return false;
     return tinygltf::ReadWholeFile(out, err, path, nullptr);
@@ -731,8 +711,10 @@ public:
                                            (name_ == "<stdin>" ? "current directory for a document on stdin)"
                                                                : "document's directory only)"));
             while (!err.empty() && (err.back() == '\n' || err.back() == ' ')) err.pop_back();
-            throw Error(name_,
-                        "invalid glTF: " + (err.empty() ? std::string("tinygltf failed to parse it") : printable(err)));
+            // tinygltf quotes the document: a bad data URI came back whole (1.1 MB for the
+            // bunny's buffer), with whatever bytes the file held.
+            throw Error(name_, "invalid glTF: " +
+                                   (err.empty() ? std::string("tinygltf failed to parse it") : printable(err, 400)));
         }
         bytes = std::vector<unsigned char>();  // the file is parsed: free it (`= {}` keeps the capacity)
         for (const std::string& ext : model_.extensionsRequired)

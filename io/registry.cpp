@@ -125,8 +125,9 @@ Input open_input(const std::string& path, std::string_view from, const ReadOptio
     // Chosen by its extension, a file whose content another format's guess takes (OBJ text
     // named .stl) fails in the named format's reader: the error says what else it reads as.
     const Format* guessed = nullptr;
+    const auto head = in.source->peek(4096);
     for (const Format* f : kFormats)
-        if (!guessed && f != in.format && f->open_reader && f->guess && f->guess(in.source->peek(4096))) guessed = f;
+        if (!guessed && f != in.format && f->open_reader && f->guess && f->guess(head)) guessed = f;
     try {
         in.reader = in.format->open_reader(*in.source, options);
     } catch (const Error& e) {
