@@ -23,6 +23,25 @@ struct Bounds {
     std::array<float, 3> min{}, max{};
 };
 
+// An image a material refers to. `uri` is the name the source gave it (relative to the source
+// file's directory, or a data: URI's media type only); `bytes` its content when the reader
+// could load it (GLB, data URIs, a file beside an OBJ's MTL or a .gltf), else empty.
+struct Texture {
+    std::string uri;
+    std::string mime_type;  // "image/png", "image/jpeg", or empty when not known
+    std::vector<std::byte> bytes;
+    bool operator==(const Texture&) const = default;
+};
+
+// One entry of a stream's material table; triangles refer to it by index (the chunk's material
+// channel). Readers keep what the formats share: a name, a base colour and its texture.
+struct Material {
+    std::string name;
+    std::array<float, 4> base_color{1.0f, 1.0f, 1.0f, 1.0f};  // linear RGBA (OBJ's Kd and d)
+    std::optional<Texture> texture;                           // base colour texture (map_Kd)
+    bool operator==(const Material&) const = default;
+};
+
 // What a reader knows from the file's header, before or while streaming. Every field is
 // optional: formats fill what they know.
 struct MeshHeader {
@@ -33,6 +52,7 @@ struct MeshHeader {
     std::optional<uint64_t> vertex_count;    // indexed formats
     std::optional<int> sorted_axis;          // 0,1,2 when the file says it is sorted (meshstream sort)
     Channels channels;                       // channels the reader will fill
+    std::vector<Material> materials;         // the table the material channel indexes
     std::string variant;                     // e.g. "binary", "ascii", "binary_big_endian"
     std::vector<std::pair<std::string, std::string>> notes;  // extra facts for `info`
     // Set by readers of double coordinates (PLY) once they are read: the largest change that
@@ -108,6 +128,10 @@ struct WriteOptions {
     std::optional<uint64_t> expected_triangle_count;
     std::optional<int> sorted_axis;          // recorded in the header when the format has room
     std::string comment;                     // free text for formats with comments
+    // The stream's channels: every chunk written has exactly these (the command chooses them
+    // with Format::keep_channels), and the material table their material channel indexes.
+    Channels channels;
+    std::vector<Material> materials;
     // Draco / glTF
     int draco_position_bits = 14;  // --draco-qp
     int draco_normal_bits = 10;    // --draco-qn
@@ -129,7 +153,6 @@ struct Format {
     std::unique_ptr<Writer> (*open_writer)(ByteSink& sink, const WriteOptions& options);
     // What the writer keeps or does beyond positions, for the commands' checks and warnings.
     enum Trait : uint8_t {
-        kWritesColour = 1,     // vertex colours
         kAlwaysDraco = 2,      // Draco-compressed (reorders triangles; takes --draco-* and --normals)
         kDracoUnlessOff = 4,   // the same unless --no-draco (glTF)
     };
@@ -137,6 +160,9 @@ struct Format {
     // For formats without magic bytes: a weaker test, tried only when no probe and no
     // extension identify the input. May be null.
     bool (*guess)(std::span<const std::byte> head) = nullptr;
+    // Of the channels `in`, those the writer keeps (with the options it will be given: glTF
+    // with Draco keeps fewer). Null: positions only (vertex ids are a hint, never "kept").
+    Channels (*keep_channels)(const Channels& in, const WriteOptions& options) = nullptr;
 };
 
 // All registered formats, in probe priority order.
@@ -151,6 +177,8 @@ const Format* format_for_extension(std::string_view path, bool for_writing);
 // Detection for reading: magic bytes first, then the extension. Throws io::Error naming the
 // file when neither identifies a readable format.
 const Format& detect_input_format(ByteSource& source);
+// The channels of `in` that `format` writes (none when it has no keep_channels).
+Channels writable_channels(const Format& format, const Channels& in, const WriteOptions& options);
 // For writing: by extension (".gz" stripped). Throws io::Error when unknown.
 const Format& detect_output_format(const std::string& path);
 // True when an output path asks for gzip (ends in ".gz").
@@ -177,6 +205,8 @@ struct Output {
         sink->commit();
     }
 };
+// The format open_output(path, to, ...) writes. Throws io::Error as open_output does.
+const Format& output_format(const std::string& path, std::string_view to);
 // Opens `path` ("-" = stdout) as format `to` (empty: by extension). gzip_level applies when
 // the path ends in ".gz" (or always when force_gzip). Throws io::Error.
 Output open_output(const std::string& path, std::string_view to, const WriteOptions& options,

@@ -40,7 +40,7 @@ std::string_view next_word(std::string_view& rest) {
 class ObjReader : public Reader {
 public:
     ObjReader(ByteSource& source, const ReadOptions& options)
-        : src_(source), options_(options), table_(options.memory_budget_bytes, options.tmpdir, false) {
+        : src_(source), options_(options), table_(options.memory_budget_bytes, options.tmpdir, 0) {
         header_.channels.vertex_id = true;
         auto bom = src_.peek(3);  // a UTF-8 byte order mark would hide the first statement
         if (bom.size() == 3 && std::memcmp(bom.data(), "\xEF\xBB\xBF", 3) == 0) src_.consume(3);
@@ -56,7 +56,7 @@ public:
         chunk.clear();
         for (;;) {
             if (polygon_next_ + 2 < polygon_.size() &&
-                !emit_polygon(table_, polygon_, polygon_scratch_, &polygon_next_, chunk))
+                !emit_polygon(table_, nullptr, polygon_, polygon_scratch_, &polygon_next_, chunk))
                 return true;
             if (chunk.full()) return true;
             if (!next_statement()) return !chunk.empty();
@@ -232,7 +232,8 @@ private:
 class ObjWriter : public Writer {
 public:
     ObjWriter(ByteSink& sink, const WriteOptions& options)
-        : sink_(sink), options_(options), welder_(options.memory_budget_bytes, options.tmpdir, sink.name()) {}
+        : sink_(sink), options_(options),
+          welder_(options.memory_budget_bytes, options.tmpdir, sink.name(), options.channels) {}
 
     void write_chunk(const TriangleChunk& chunk) override { welder_.add(chunk); }
 
@@ -247,13 +248,14 @@ public:
             if (nl == std::string_view::npos) break;
             text.remove_prefix(nl + 1);
         }
-        std::vector<WeldedVertex> vs(8192);
-        while (size_t n = welder_.next_vertices(vs)) {
+        std::vector<float> xyz(3 * 8192);
+        std::vector<std::byte> attributes(welder_.layout().bytes() * 8192);
+        while (size_t n = welder_.next_vertices(xyz, attributes)) {
             for (size_t i = 0; i < n; ++i) {
                 out += 'v';
                 for (int a = 0; a < 3; ++a) {
                     out += ' ';
-                    append_number(out, vs[i].xyz[a]);
+                    append_number(out, xyz[3 * i + a]);
                 }
                 out += '\n';
             }

@@ -91,11 +91,17 @@ std::vector<std::string_view> split_words(std::string_view line) {
     return words;
 }
 
-uint8_t to_color(double v, PlyType t) {
-    if (is_float_type(t)) v = std::round(std::clamp(v, 0.0, 1.0) * 255.0);
-    else if (t == PlyType::kUint16 || t == PlyType::kInt16) v = std::round(v / 257.0);
-    if (!(v >= 0)) return 0;
-    return static_cast<uint8_t>(std::min(v, 255.0));
+// How a colour property of type t travels: 8-bit and wider integers as value / 255 (PLY's
+// convention for colour), 16-bit ones as value / 65535, floats as they are.
+ColorFormat color_format(PlyType t, bool alpha) {
+    if (is_float_type(t)) return {ScalarType::kFloat32, alpha};
+    if (t == PlyType::kUint16 || t == PlyType::kInt16) return {ScalarType::kUInt16, alpha};
+    return {ScalarType::kUInt8, alpha};
+}
+
+float to_color(double v, const ColorFormat& f) {
+    if (f.type == ScalarType::kFloat32) return static_cast<float>(v);
+    return static_cast<float>(v / (f.type == ScalarType::kUInt16 ? 65535.0 : 255.0));
 }
 
 // ---------------- reader ----------------
@@ -111,7 +117,8 @@ public:
         chunk.clear();
         for (;;) {
             if (polygon_next_ + 2 < polygon_.size()) {
-                if (!emit_polygon(*table_, polygon_, polygon_scratch_, &polygon_next_, chunk)) return true;
+                const CornerLayout* layout = layout_ ? &*layout_ : nullptr;
+                if (!emit_polygon(*table_, layout, polygon_, polygon_scratch_, &polygon_next_, chunk)) return true;
             }
             if (chunk.full()) return true;
             if (strip_next_ < strip_triangles_.size()) {  // the current strip, a triangle at a time
@@ -256,7 +263,14 @@ private:
             const Element& v = elements_[static_cast<size_t>(vertex_)];
             for (size_t p = 0; p < v.props.size(); ++p) {
                 const std::string& n = v.props[p].name;
-                int slot = n == "x" ? 0 : n == "y" ? 1 : n == "z" ? 2 : n == "red" ? 3 : n == "green" ? 4 : n == "blue" ? 5 : -1;
+                int slot = n == "x"       ? 0
+                           : n == "y"     ? 1
+                           : n == "z"     ? 2
+                           : n == "red"   ? 3
+                           : n == "green" ? 4
+                           : n == "blue"  ? 5
+                           : n == "alpha" ? 6
+                                          : -1;
                 if (slot >= 0 && !v.props[p].is_list) vertex_props_[slot] = static_cast<int>(p);
             }
             for (int a = 0; a < 3; ++a)
@@ -267,7 +281,11 @@ private:
         }
         has_color_ = vertex_props_[3] >= 0 && vertex_props_[4] >= 0 && vertex_props_[5] >= 0;
         header_.channels.vertex_id = true;
-        header_.channels.color = has_color_;
+        if (has_color_) {
+            const Element& v = elements_[static_cast<size_t>(vertex_)];
+            header_.channels.color =
+                color_format(v.props[static_cast<size_t>(vertex_props_[3])].type, vertex_props_[6] >= 0);
+        }
         uint64_t faces = face_ >= 0 ? elements_[static_cast<size_t>(face_)].count : 0;
         if (faces == 0) header_.triangle_count = 0;
         if (!strips_) header_.triangle_estimate = faces;
@@ -484,15 +502,16 @@ private:
         const Element& e = elements_[index];
         size_t fixed = e.fixed_bytes();
         const uint64_t budget = options_.memory_budget_bytes;
-        // A plain file in host byte order with float x, y, z (and uchar colour) is read in place.
-        bool direct = encoding_ != Encoding::kAscii && !swap_ && fixed > 0 && !src_.regular_file_path().empty();
-        size_t offsets[6] = {};
-        for (int s = 0; s < 6; ++s) {
+        // A plain file in host byte order with float x, y, z and no attributes is read in place.
+        const CornerLayout layout(header_.channels);
+        bool direct = encoding_ != Encoding::kAscii && !swap_ && fixed > 0 && !src_.regular_file_path().empty() &&
+                      layout.bytes() == 0;
+        size_t offsets[kSlots] = {};
+        for (int s = 0; s < kSlots; ++s) {
             if (vertex_props_[s] < 0) continue;
             for (int p = 0; p < vertex_props_[s]; ++p) offsets[s] += type_size(e.props[static_cast<size_t>(p)].type);
             PlyType t = e.props[static_cast<size_t>(vertex_props_[s])].type;
             if (s < 3 && t != PlyType::kFloat32) direct = false;
-            if (s >= 3 && has_color_ && t != PlyType::kUint8) direct = false;
         }
         if (fixed > 0 && encoding_ != Encoding::kAscii) check_size(e, fixed);
         if (direct) {
@@ -504,25 +523,26 @@ private:
                 truncated();
             }
             const size_t xyz[3] = {offsets[0], offsets[1], offsets[2]};
-            table_ = VertexTable::of_input_file(src_.regular_file_path(), start, e.count, fixed, xyz,
-                                                has_color_ ? offsets + 3 : nullptr, budget);
+            table_ = VertexTable::of_input_file(src_.regular_file_path(), start, e.count, fixed, xyz, budget);
             header_.notes.emplace_back("vertex table", "input file, read in place");
             return;
         }
-        table_ = std::make_unique<VertexTable>(budget, options_.tmpdir, has_color_);
+        table_ = std::make_unique<VertexTable>(budget, options_.tmpdir, layout.bytes());
+        layout_ = layout;
         // meshstream's chunks hold float coordinates: double ones are rounded, which far from
         // the origin moves them by a lot (0.25 m at 4 000 000); the largest change is said.
         bool doubles = false;
         for (int s = 0; s < 3; ++s)
             doubles |= e.props[static_cast<size_t>(vertex_props_[s])].type == PlyType::kFloat64;
         double worst_rounding = 0, worst_at = 0;
-        double values[6] = {0, 0, 0, 0, 0, 0};
+        double values[kSlots] = {0, 0, 0, 0, 0, 0, 1};
         float xyz[3];
-        uint8_t rgb[3];
+        float rgba[4] = {0, 0, 0, 1};
+        std::vector<std::byte> record(layout.bytes());
         for (item_ = 0; item_ < e.count; ++item_) {
             if (fixed > 0 && encoding_ != Encoding::kAscii) {
                 const std::byte* rec = need(fixed);
-                for (int s = 0; s < 6; ++s)
+                for (int s = 0; s < kSlots; ++s)
                     if (vertex_props_[s] >= 0)
                         values[s] = decode(rec + offsets[s], e.props[static_cast<size_t>(vertex_props_[s])].type);
                 src_.consume(fixed);
@@ -530,7 +550,7 @@ private:
                 for (size_t p = 0; p < e.props.size(); ++p) {
                     const Property& prop = e.props[p];
                     int slot = -1;
-                    for (int s = 0; s < 6; ++s)
+                    for (int s = 0; s < kSlots; ++s)
                         if (vertex_props_[s] == static_cast<int>(p)) slot = s;
                     if (slot >= 0 && slot < 3 && encoding_ == Encoding::kAscii && prop.type != PlyType::kFloat64)
                         values[slot] = parse_float(token());  // decimal -> float directly: no double rounding
@@ -546,10 +566,12 @@ private:
                         worst_rounding = std::fabs(double(xyz[a]) - values[a]);
                         worst_at = values[a];
                     }
-            if (has_color_)
-                for (int a = 0; a < 3; ++a)
-                    rgb[a] = to_color(values[3 + a], e.props[static_cast<size_t>(vertex_props_[3 + a])].type);
-            table_->append(xyz, has_color_ ? rgb : nullptr);
+            if (has_color_) {
+                for (int a = 0; a < 4; ++a)
+                    if (a < 3 || vertex_props_[6] >= 0) rgba[a] = to_color(values[3 + a], *header_.channels.color);
+                layout.pack_values(nullptr, rgba, nullptr, nullptr, record.data());
+            }
+            table_->append(xyz, record.data());
         }
         header_.notes.emplace_back("vertex table", table_->storage() == VertexTable::Storage::kMemory
                                                        ? "in memory"
@@ -651,7 +673,9 @@ private:
     bool trailing_checked_ = false;
     std::vector<Element> elements_;
     int vertex_ = -1, face_ = -1, index_prop_ = -1;
-    int vertex_props_[6] = {-1, -1, -1, -1, -1, -1};  // x y z red green blue
+    static constexpr int kSlots = 7;
+    int vertex_props_[kSlots] = {-1, -1, -1, -1, -1, -1, -1};  // x y z red green blue alpha
+    std::optional<CornerLayout> layout_;  // the vertex table's corner records, when it has them
     bool has_color_ = false;
     size_t element_ = 0;  // element being read (for messages)
     uint64_t item_ = 0;   // item number within it
@@ -671,7 +695,7 @@ class PlyWriter : public Writer {
 public:
     PlyWriter(ByteSink& sink, const WriteOptions& options, bool ascii)
         : sink_(sink), options_(options), ascii_(ascii),
-          welder_(options.memory_budget_bytes, options.tmpdir, sink.name()) {}
+          welder_(options.memory_budget_bytes, options.tmpdir, sink.name(), options.channels) {}
 
     void write_chunk(const TriangleChunk& chunk) override { welder_.add(chunk); }
 
@@ -681,7 +705,12 @@ public:
         if (vertices > 0x7fffffffULL)
             throw Error(sink_.name(), "PLY int indices hold at most 2^31 - 1 vertices, the mesh has " +
                                           std::to_string(vertices));
-        const bool color = welder_.color();
+        const std::optional<ColorFormat> color = options_.channels.color;
+        const char* color_type = !color                                  ? ""
+                                 : color->type == ScalarType::kUInt8 ? "uchar"
+                                 : color->type == ScalarType::kUInt16 ? "ushort"
+                                                                      : "float";
+        const int color_n = color ? (color->alpha ? 4 : 3) : 0;
         std::string h = "ply\nformat ";
         h += ascii_ ? "ascii 1.0\n" : "binary_little_endian 1.0\n";
         h += "comment generated by meshstream\n";
@@ -695,33 +724,56 @@ public:
         }
         h += "element vertex " + std::to_string(vertices) + "\n";
         h += "property float x\nproperty float y\nproperty float z\n";
-        if (color) h += "property uchar red\nproperty uchar green\nproperty uchar blue\n";
+        for (int a = 0; a < color_n; ++a) {
+            static const char* const kNames[4] = {"red", "green", "blue", "alpha"};
+            h += "property " + std::string(color_type) + " " + kNames[a] + "\n";
+        }
         h += "element face " + std::to_string(welder_.triangle_count()) + "\n";
         h += "property list uchar int vertex_indices\nend_header\n";
         sink_.write(h);
 
-        std::vector<WeldedVertex> vs(8192);
+        const CornerLayout& layout = welder_.layout();
+        std::vector<float> xyz(3 * 8192);
+        std::vector<std::byte> records(layout.bytes() * 8192);
         std::string out;
         out.reserve(size_t{1} << 20);
-        while (size_t n = welder_.next_vertices(vs)) {
+        while (size_t n = welder_.next_vertices(xyz, records)) {
             for (size_t i = 0; i < n; ++i) {
-                const WeldedVertex& v = vs[i];
+                const float* p = &xyz[3 * i];
+                float rgba[4] = {0, 0, 0, 1};
+                if (color) layout.unpack_values(&records[layout.bytes() * i], nullptr, rgba, nullptr, nullptr);
                 if (ascii_) {
                     for (int a = 0; a < 3; ++a) {
                         if (a) out += ' ';
-                        append_number(out, v.xyz[a]);
+                        append_number(out, p[a]);
                     }
-                    if (color)
-                        for (int a = 0; a < 3; ++a) {
-                            out += ' ';
-                            append_number(out, unsigned{v.rgb[a]});
-                        }
+                    for (int a = 0; a < color_n; ++a) {
+                        out += ' ';
+                        if (color->type == ScalarType::kFloat32)
+                            append_number(out, rgba[a]);
+                        else
+                            append_number(out, unsigned(std::lround(std::clamp(rgba[a], 0.0f, 1.0f) *
+                                                                    (color->type == ScalarType::kUInt8 ? 255.0f : 65535.0f))));
+                    }
                     out += '\n';
                 } else {
-                    char buf[15];
-                    for (int a = 0; a < 3; ++a) store_le(buf + 4 * a, std::bit_cast<uint32_t>(v.xyz[a]));
-                    std::memcpy(buf + 12, v.rgb, 3);
-                    out.append(buf, color ? 15 : 12);
+                    char buf[12 + 16];
+                    for (int a = 0; a < 3; ++a) store_le(buf + 4 * a, std::bit_cast<uint32_t>(p[a]));
+                    size_t at = 12;
+                    for (int a = 0; a < color_n; ++a) {
+                        const float c = std::clamp(rgba[a], 0.0f, 1.0f);
+                        if (color->type == ScalarType::kUInt8) {
+                            buf[at++] = static_cast<char>(std::lround(c * 255.0f));
+                        } else if (color->type == ScalarType::kUInt16) {
+                            const auto v = static_cast<uint16_t>(std::lround(c * 65535.0f));
+                            buf[at++] = static_cast<char>(v & 0xff);
+                            buf[at++] = static_cast<char>(v >> 8);
+                        } else {
+                            store_le(buf + at, std::bit_cast<uint32_t>(rgba[a]));
+                            at += 4;
+                        }
+                    }
+                    out.append(buf, at);
                 }
             }
             flush(out);
@@ -775,6 +827,14 @@ std::unique_ptr<Writer> open_ply_ascii_writer(ByteSink& sink, const WriteOptions
     return std::make_unique<PlyWriter>(sink, options, true);
 }
 
+// PLY holds every channel as vertex and face properties; this writer writes colour so far.
+Channels ply_keep_channels(const Channels& in, const WriteOptions&) {
+    Channels out;
+    out.color = in.color;
+    out.vertex_id = in.vertex_id;
+    return out;
+}
+
 }  // namespace
 
 bool probe_ply(std::span<const std::byte> head, std::optional<uint64_t>) {
@@ -791,7 +851,9 @@ const Format kPlyFormat = {
     &probe_ply,
     &open_ply_reader,
     &open_ply_writer,
-    Format::kWritesColour,
+    0,
+    nullptr,
+    &ply_keep_channels,
 };
 
 const Format kPlyAsciiFormat = {
@@ -801,7 +863,9 @@ const Format kPlyAsciiFormat = {
     nullptr,
     &open_ply_reader,
     &open_ply_ascii_writer,
-    Format::kWritesColour,
+    0,
+    nullptr,
+    &ply_keep_channels,
 };
 
 }  // namespace meshstream::io

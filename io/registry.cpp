@@ -104,6 +104,12 @@ const Format& detect_input_format(ByteSource& source) {
                                    format_names(false) + ")");
 }
 
+Channels writable_channels(const Format& format, const Channels& in, const WriteOptions& options) {
+    Channels out = format.keep_channels ? format.keep_channels(in, options) : Channels{};
+    out.vertex_id = in.vertex_id;
+    return out;
+}
+
 const Format& detect_output_format(const std::string& path) {
     if (const Format* f = format_for_extension(path, true)) return *f;
     throw Error(path, "cannot tell the output format from the name (use --to, one of: " + format_names(true) + ")");
@@ -139,17 +145,21 @@ Input open_input(const std::string& path, std::string_view from, const ReadOptio
     return in;
 }
 
+const Format& output_format(const std::string& path, std::string_view to) {
+    if (!to.empty()) {
+        const Format* f = find_format(to);
+        if (!f || !f->open_writer)
+            throw Error(path, "unknown output format '" + std::string(to) + "' (one of: " + format_names(true) + ")");
+        return *f;
+    }
+    if (path == "-") throw Error("<stdout>", "writing to stdout needs --to (one of: " + format_names(true) + ")");
+    return detect_output_format(path);
+}
+
 Output open_output(const std::string& path, std::string_view to, const WriteOptions& options, int gzip_level,
                    bool force_gzip) {
     Output out;
-    if (!to.empty()) {
-        out.format = find_format(to);
-        if (!out.format || !out.format->open_writer)
-            throw Error(path, "unknown output format '" + std::string(to) + "' (one of: " + format_names(true) + ")");
-    } else {
-        if (path == "-") throw Error("<stdout>", "writing to stdout needs --to (one of: " + format_names(true) + ")");
-        out.format = &detect_output_format(path);
-    }
+    out.format = &output_format(path, to);
     SinkOptions sink_options;
     if (force_gzip || (path != "-" && wants_gzip(path))) sink_options.gzip_level = gzip_level;
     out.sink = ByteSink::open(path, sink_options);

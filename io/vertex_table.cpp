@@ -21,14 +21,14 @@ constexpr size_t kTailBytes = size_t{1} << 20;
 
 }  // namespace
 
-VertexTable::VertexTable(uint64_t budget_bytes, std::string tmpdir, bool color)
-    : budget_bytes_(budget_bytes), tmpdir_(std::move(tmpdir)), color_(color) {
-    stride_ = color ? 16 : 12;  // xyz, then rgb + 1 pad byte
+VertexTable::VertexTable(uint64_t budget_bytes, std::string tmpdir, size_t attribute_bytes)
+    : budget_bytes_(budget_bytes), tmpdir_(std::move(tmpdir)), attribute_bytes_(attribute_bytes) {
+    stride_ = 12 + attribute_bytes;  // xyz, then the corner record
 }
 
 std::unique_ptr<VertexTable> VertexTable::of_input_file(const std::string& path, uint64_t offset, uint64_t count,
                                                         size_t stride, const size_t (&xyz_offsets)[3],
-                                                        const size_t* rgb_offsets, uint64_t budget_bytes) {
+                                                        uint64_t budget_bytes) {
     std::unique_ptr<VertexTable> t(new VertexTable());
     t->storage_ = Storage::kInputFile;
     t->budget_bytes_ = budget_bytes;
@@ -38,10 +38,6 @@ std::unique_ptr<VertexTable> VertexTable::of_input_file(const std::string& path,
     t->file_offset_ = offset;
     t->input_path_ = path;
     std::copy(std::begin(xyz_offsets), std::end(xyz_offsets), t->xyz_offsets_);
-    if (rgb_offsets) {
-        t->color_ = true;
-        std::copy(rgb_offsets, rgb_offsets + 3, t->rgb_offsets_);
-    }
     if (count == 0) return t;
     t->input_fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
     if (t->input_fd_ < 0) throw Error(path, "cannot open to read the vertex block: " + std::string(std::strerror(errno)));
@@ -53,10 +49,11 @@ VertexTable::~VertexTable() {
     if (input_fd_ >= 0) ::close(input_fd_);
 }
 
-void VertexTable::append(const float* xyz, const uint8_t* rgb) {
-    std::byte rec[16] = {};
+void VertexTable::append(const float* xyz, const std::byte* attributes) {
+    if (record_.size() != stride_) record_.resize(stride_);
+    std::byte* rec = record_.data();
     std::memcpy(rec, xyz, 12);
-    if (color_ && rgb) std::memcpy(rec + 12, rgb, 3);
+    if (attribute_bytes_ > 0) std::memcpy(rec + 12, attributes, attribute_bytes_);
     if (storage_ == Storage::kMemory) {
         if ((size_ + 1) * stride_ > budget_bytes_) {
             spill();
@@ -147,7 +144,7 @@ const std::byte* VertexTable::cached_page(uint64_t page) {
     return data;
 }
 
-void VertexTable::get(uint64_t i, float* xyz, uint8_t* rgb) {
+void VertexTable::get(uint64_t i, float* xyz, std::byte* attributes) {
     const std::byte* rec = nullptr;  // the record, when it is in memory
     uint64_t at = 0;                 // else where it starts, from the start of cached page 0
     if (storage_ == Storage::kMemory) {
@@ -173,26 +170,24 @@ void VertexTable::get(uint64_t i, float* xyz, uint8_t* rgb) {
         }
     };
     for (int a = 0; a < 3; ++a) field(xyz_offsets_[a], 4, &xyz[a]);
-    if (rgb) {
-        if (color_)
-            for (int a = 0; a < 3; ++a) field(rgb_offsets_[a], 1, &rgb[a]);
-        else
-            rgb[0] = rgb[1] = rgb[2] = 0;
-    }
+    if (attributes && attribute_bytes_ > 0) field(12, attribute_bytes_, attributes);
 }
 
-bool emit_polygon(VertexTable& table, const std::vector<uint64_t>& polygon, PolygonScratch& scratch, size_t* next,
-                  TriangleChunk& chunk) {
+bool emit_polygon(VertexTable& table, const CornerLayout* layout, const std::vector<uint64_t>& polygon,
+                  PolygonScratch& scratch, size_t* next, TriangleChunk& chunk) {
     const size_t n = polygon.size();
     if (*next + 2 >= n) return true;  // done, or fewer than 3 corners
     if (chunk.full()) return false;
+    // The corner records are unpacked only when both the table has them and the chunk wants them.
+    const size_t rec = layout != nullptr ? layout->bytes() : 0;
+    if (scratch.record.size() < rec) scratch.record.resize(rec);
     if (n == 3) {  // most faces: straight into the chunk
         size_t i = chunk.size();
         float* xyz = chunk.push_slot();
-        uint8_t* rgb = chunk.rgb_at(i);
         uint64_t* ids = chunk.id_at(i);
         for (int k = 0; k < 3; ++k) {
-            table.get(polygon[k], xyz + 3 * k, rgb ? rgb + 3 * k : nullptr);
+            table.get(polygon[k], xyz + 3 * k, rec > 0 ? scratch.record.data() : nullptr);
+            if (rec > 0) layout->unpack(scratch.record.data(), chunk, i, k);
             if (ids) ids[k] = polygon[k];
         }
         *next = 1;
@@ -201,8 +196,9 @@ bool emit_polygon(VertexTable& table, const std::vector<uint64_t>& polygon, Poly
     if (*next == 0) {
         // Each corner is read once, then copied into its triangles.
         scratch.xyz.resize(3 * n);
-        scratch.rgb.resize(3 * n);
-        for (size_t k = 0; k < n; ++k) table.get(polygon[k], &scratch.xyz[3 * k], &scratch.rgb[3 * k]);
+        scratch.records.resize(rec * n);
+        for (size_t k = 0; k < n; ++k)
+            table.get(polygon[k], &scratch.xyz[3 * k], rec > 0 ? &scratch.records[rec * k] : nullptr);
         scratch.triangles.clear();
         triangulate_polygon(scratch.xyz, scratch.triangulate, scratch.triangles);
     }
@@ -210,12 +206,11 @@ bool emit_polygon(VertexTable& table, const std::vector<uint64_t>& polygon, Poly
         if (chunk.full()) return false;
         size_t i = chunk.size();
         float* xyz = chunk.push_slot();
-        uint8_t* rgb = chunk.rgb_at(i);
         uint64_t* ids = chunk.id_at(i);
         for (int k = 0; k < 3; ++k) {
             const uint32_t corner = scratch.triangles[3 * *next + k];
             std::memcpy(xyz + 3 * k, &scratch.xyz[3 * corner], 3 * sizeof(float));
-            if (rgb) std::memcpy(rgb + 3 * k, &scratch.rgb[3 * corner], 3);
+            if (rec > 0) layout->unpack(&scratch.records[rec * corner], chunk, i, k);
             if (ids) ids[k] = polygon[corner];
         }
     }

@@ -30,28 +30,27 @@ class VertexTable {
 public:
     enum class Storage { kMemory, kTempFile, kInputFile };
 
-    // An owned, growable table. `color`: records carry RGB8. Throws io::Error when a temp file
-    // cannot be created or written.
-    VertexTable(uint64_t budget_bytes, std::string tmpdir, bool color);
+    // An owned, growable table whose records are x, y, z and `attribute_bytes` more (a
+    // CornerLayout's record, or 0). Throws io::Error when a temp file cannot be created or written.
+    VertexTable(uint64_t budget_bytes, std::string tmpdir, size_t attribute_bytes);
     // A read-only view of `count` records of `stride` bytes starting at byte `offset` of the
-    // regular file `path`: float32 x, y, z (host byte order) at xyz_offsets, and when
-    // `rgb_offsets` is non-null uint8 red, green, blue there. Throws io::Error when the file
-    // cannot be opened.
+    // regular file `path`: float32 x, y, z (host byte order) at xyz_offsets, no attributes.
+    // Throws io::Error when the file cannot be opened.
     static std::unique_ptr<VertexTable> of_input_file(const std::string& path, uint64_t offset, uint64_t count,
                                                       size_t stride, const size_t (&xyz_offsets)[3],
-                                                      const size_t* rgb_offsets, uint64_t budget_bytes);
+                                                      uint64_t budget_bytes);
     ~VertexTable();
     VertexTable(const VertexTable&) = delete;
     VertexTable& operator=(const VertexTable&) = delete;
 
-    // Appends a vertex (owned tables only). `rgb` may be null (black).
-    void append(const float* xyz, const uint8_t* rgb);
+    // Appends a vertex (owned tables only): xyz[3] and attribute_bytes() of `attributes`.
+    void append(const float* xyz, const std::byte* attributes);
     uint64_t size() const { return size_; }
-    bool color() const { return color_; }
+    size_t attribute_bytes() const { return attribute_bytes_; }
     Storage storage() const { return storage_; }
-    // Copies vertex i (< size()) into xyz[3] and, when rgb is non-null, rgb[3] (zeros when the
-    // table has no colour). Not const: it accounts the pages it touches.
-    void get(uint64_t i, float* xyz, uint8_t* rgb);
+    // Copies vertex i (< size()) into xyz[3] and, when `attributes` is non-null, its
+    // attribute_bytes() there. Not const: it accounts the pages it touches.
+    void get(uint64_t i, float* xyz, std::byte* attributes);
 
 private:
     VertexTable() = default;
@@ -60,12 +59,12 @@ private:
 
     uint64_t budget_bytes_ = 0;
     std::string tmpdir_;
-    bool color_ = false;
+    size_t attribute_bytes_ = 0;
     Storage storage_ = Storage::kMemory;
     uint64_t size_ = 0;
     size_t stride_ = 12;
     size_t xyz_offsets_[3] = {0, 4, 8};
-    size_t rgb_offsets_[3] = {12, 13, 14};
+    std::vector<std::byte> record_;  // append's assembly buffer
 
     // kMemory: fixed-size blocks of records.
     static constexpr size_t kBlockRecordsLog2 = 16;
@@ -98,7 +97,8 @@ private:
 // about 80 bytes a corner of the largest polygon.
 struct PolygonScratch {
     std::vector<float> xyz;           // 3 per corner
-    std::vector<uint8_t> rgb;         // 3 per corner
+    std::vector<std::byte> records;   // one corner record per corner
+    std::vector<std::byte> record;    // one corner record, for triangles
     std::vector<uint32_t> triangles;  // 3 corner numbers per triangle
     TriangulateScratch triangulate;
 };
@@ -107,10 +107,13 @@ struct PolygonScratch {
 // convex, ear clipping otherwise; always size - 2 triangles) into `chunk`, from triangle
 // `*next` on, until the chunk is full or the polygon is done. The first call for a polygon
 // passes *next == 0 and reads its corners and triangulates it into `scratch`; later calls
-// for it must pass the same scratch. Sets the chunk's vertex ids (the polygon's indices) and
-// colours when the chunk has those channels. Returns true when the polygon is finished
-// (at once for fewer than 3 corners). Indices must be < table.size(); fewer than 2^32 corners.
-bool emit_polygon(VertexTable& table, const std::vector<uint64_t>& polygon, PolygonScratch& scratch, size_t* next,
-                  TriangleChunk& chunk);
+// for it must pass the same scratch. Sets the chunk's vertex ids (the polygon's indices) when
+// the chunk has them, and when `layout` is non-null (the table's records are its corner
+// records, and the chunk has its channels) the corners' attributes. Per-triangle channels are
+// the caller's: the triangles added are those from the chunk's size before the call on.
+// Returns true when the polygon is finished (at once for fewer than 3 corners). Indices must
+// be < table.size(); fewer than 2^32 corners.
+bool emit_polygon(VertexTable& table, const CornerLayout* layout, const std::vector<uint64_t>& polygon,
+                  PolygonScratch& scratch, size_t* next, TriangleChunk& chunk);
 
 }  // namespace meshstream::io

@@ -8,6 +8,8 @@
 #include "io/record_sort.hpp"
 
 #include <algorithm>
+#include <array>
+#include <cassert>
 #include <bit>
 #include <cstring>
 #include <optional>
@@ -16,49 +18,74 @@
 namespace meshstream::io {
 namespace {
 
+uint64_t hash_bytes(const std::byte* p, size_t n) {
+    uint64_t h = 0x9e3779b97f4a7c15ULL;
+    for (size_t i = 0; i < n; i += 8) {
+        uint64_t w = 0;
+        std::memcpy(&w, p + i, std::min<size_t>(8, n - i));
+        h = mix64(h ^ w);
+    }
+    return h;
+}
+
 uint32_t position_bits(float f) {
     uint32_t b = std::bit_cast<uint32_t>(f);
     return b == 0x80000000u ? 0u : b;  // -0.0 welds with +0.0
 }
 
-// Key = bit pattern of the position.
+// Key = bit pattern of the position, then the corner's attribute record (N bytes, zero padded
+// past the layout's size): corners of one position with different attributes (UV or normal
+// seams) stay different vertices.
+template <size_t N>
 struct PositionVertex {
     uint32_t pos[3];
-    uint8_t rgb[3];
     uint8_t used;
+    std::array<std::byte, N> attr;
     static constexpr bool kHasId = false;
+    static constexpr size_t kAttrBytes = N;
     void set_id(uint64_t) {}
     bool same_key(const PositionVertex& o) const {
-        return pos[0] == o.pos[0] && pos[1] == o.pos[1] && pos[2] == o.pos[2];
+        return pos[0] == o.pos[0] && pos[1] == o.pos[1] && pos[2] == o.pos[2] && attr == o.attr;
     }
     bool key_less(const PositionVertex& o) const {
         if (pos[0] != o.pos[0]) return pos[0] < o.pos[0];
         if (pos[1] != o.pos[1]) return pos[1] < o.pos[1];
-        return pos[2] < o.pos[2];
+        if (pos[2] != o.pos[2]) return pos[2] < o.pos[2];
+        return attr < o.attr;
     }
     uint64_t hash() const {
-        return mix64((uint64_t{pos[0]} << 32 | pos[1]) ^ mix64(pos[2] + 0x9e3779b97f4a7c15ULL));
+        uint64_t h = mix64((uint64_t{pos[0]} << 32 | pos[1]) ^ mix64(pos[2] + 0x9e3779b97f4a7c15ULL));
+        if constexpr (N > 0) h = mix64(h ^ hash_bytes(attr.data(), N));
+        return h;
     }
 };
 
-// Key = (vertex id, position bits): producers' ids, kept apart if they ever disagree on position.
+// Key = (vertex id, position bits, attributes): producers' ids, kept apart if they ever
+// disagree on position or attributes.
+template <size_t N>
 struct IdVertex {
     uint64_t id;
     uint32_t pos[3];
-    uint8_t rgb[3];
     uint8_t used;
+    std::array<std::byte, N> attr;
     static constexpr bool kHasId = true;
+    static constexpr size_t kAttrBytes = N;
     void set_id(uint64_t v) { id = v; }
     bool same_key(const IdVertex& o) const {
-        return id == o.id && pos[0] == o.pos[0] && pos[1] == o.pos[1] && pos[2] == o.pos[2];
+        return id == o.id && pos[0] == o.pos[0] && pos[1] == o.pos[1] && pos[2] == o.pos[2] && attr == o.attr;
     }
     bool key_less(const IdVertex& o) const {
         if (id != o.id) return id < o.id;
         if (pos[0] != o.pos[0]) return pos[0] < o.pos[0];
         if (pos[1] != o.pos[1]) return pos[1] < o.pos[1];
-        return pos[2] < o.pos[2];
+        if (pos[2] != o.pos[2]) return pos[2] < o.pos[2];
+        return attr < o.attr;
     }
-    uint64_t hash() const { return mix64(id ^ mix64((uint64_t{pos[0]} << 32 | pos[1]) + pos[2])); }
+    uint64_t hash() const {
+        uint64_t h = mix64(id ^ mix64((uint64_t{pos[0]} << 32 | pos[1]) + pos[2]));
+        if constexpr (N > 0) h = mix64(h ^ hash_bytes(attr.data(), N));
+        return h;
+    }
 };
 
 struct CornerId {  // second sort of the out-of-core path
@@ -78,10 +105,10 @@ struct Welder::Core {
     virtual ~Core() = default;
     virtual void add(const TriangleChunk& chunk) = 0;
     virtual void finish() = 0;
-    virtual size_t next_vertices(std::span<WeldedVertex> out) = 0;
+    virtual size_t next_vertices(std::span<float> xyz, std::span<std::byte> attributes) = 0;
     virtual size_t next_indices(std::span<uint32_t> out) = 0;
     uint64_t vertices = 0, triangles = 0;
-    bool color = false, out_of_core = false;
+    bool out_of_core = false;
 };
 
 namespace {
@@ -89,30 +116,29 @@ namespace {
 struct EmptyCore : Welder::Core {
     void add(const TriangleChunk&) override {}
     void finish() override {}
-    size_t next_vertices(std::span<WeldedVertex>) override { return 0; }
+    size_t next_vertices(std::span<float>, std::span<std::byte>) override { return 0; }
     size_t next_indices(std::span<uint32_t>) override { return 0; }
 };
 
 template <class V>
 class WeldCore : public Welder::Core {
 public:
-    WeldCore(uint64_t budget_bytes, std::string tmpdir, std::string name, bool with_color)
-        : budget_(budget_bytes), tmpdir_(std::move(tmpdir)), name_(std::move(name)) {
-        color = with_color;
+    WeldCore(uint64_t budget_bytes, std::string tmpdir, std::string name, const CornerLayout& layout)
+        : budget_(budget_bytes), tmpdir_(std::move(tmpdir)), name_(std::move(name)), layout_(layout) {
+        assert(layout_.bytes() <= V::kAttrBytes);
         spool_ = std::make_unique<TempFile>(tmpdir_, "meshstream-corners");
     }
 
     void add(const TriangleChunk& chunk) override {
         const size_t n = chunk.size();
         auto xyz = chunk.xyz();
-        auto rgb = chunk.rgb();
         auto ids = chunk.vertex_ids();
         corners_.resize(3 * n);
         for (size_t c = 0; c < 3 * n; ++c) {
             V& v = corners_[c];
             std::memset(&v, 0, sizeof v);
             for (int a = 0; a < 3; ++a) v.pos[a] = position_bits(xyz[3 * c + a]);
-            if (color && !rgb.empty()) std::memcpy(v.rgb, &rgb[3 * c], 3);
+            if constexpr (V::kAttrBytes > 0) layout_.pack(chunk, c / 3, int(c % 3), v.attr.data());
             if constexpr (V::kHasId) v.set_id(ids.empty() ? 0 : ids[c]);
             v.used = 1;
         }
@@ -151,8 +177,7 @@ public:
             if (!prev || !prev->same_key(r.v)) {
                 if (prev) ++id;
                 if (id > 0xffffffffULL) throw Error(name_, "more than 2^32 - 1 distinct vertices");
-                WeldedVertex w = to_welded(r.v);
-                vertex_file_->write(&w, sizeof w);
+                vertex_file_->write(&r.v, sizeof(V));
                 prev = r.v;
             }
             back_->push({r.corner, static_cast<uint32_t>(id), 0});
@@ -163,13 +188,20 @@ public:
         back_->finish_input(budget_ / 2);
     }
 
-    size_t next_vertices(std::span<WeldedVertex> out) override {
-        size_t n = static_cast<size_t>(std::min<uint64_t>(out.size(), vertices - vertices_read_));
+    size_t next_vertices(std::span<float> xyz, std::span<std::byte> attributes) override {
+        const size_t rec = layout_.bytes();
+        size_t fit = xyz.size() / 3;
+        if (rec > 0) fit = std::min(fit, attributes.size() / rec);
+        size_t n = static_cast<size_t>(std::min<uint64_t>(fit, vertices - vertices_read_));
         if (n == 0) return 0;
         if (out_of_core) {
-            vertex_file_->read_at(vertices_read_ * sizeof(WeldedVertex), out.data(), n * sizeof(WeldedVertex));
+            vertex_block_.resize(n);
+            vertex_file_->read_at(vertices_read_ * sizeof(V), vertex_block_.data(), n * sizeof(V));
+            for (size_t i = 0; i < n; ++i)
+                to_welded(vertex_block_[i], &xyz[3 * i], rec > 0 ? &attributes[rec * i] : nullptr);
         } else {
-            for (size_t i = 0; i < n; ++i) out[i] = to_welded(table_[order_[vertices_read_ + i]].v);
+            for (size_t i = 0; i < n; ++i)
+                to_welded(table_[order_[vertices_read_ + i]].v, &xyz[3 * i], rec > 0 ? &attributes[rec * i] : nullptr);
         }
         vertices_read_ += n;
         return n;
@@ -216,11 +248,10 @@ private:
         }
     };
 
-    static WeldedVertex to_welded(const V& v) {
-        WeldedVertex w;
-        for (int a = 0; a < 3; ++a) w.xyz[a] = std::bit_cast<float>(v.pos[a]);
-        std::memcpy(w.rgb, v.rgb, 3);
-        return w;
+    void to_welded(const V& v, float* xyz, std::byte* attributes) const {
+        for (int a = 0; a < 3; ++a) xyz[a] = std::bit_cast<float>(v.pos[a]);
+        if constexpr (V::kAttrBytes > 0)
+            if (attributes) std::memcpy(attributes, v.attr.data(), layout_.bytes());
     }
 
     // Inserts v's key if absent; false when the table would outgrow the budget.
@@ -276,6 +307,7 @@ private:
 
     uint64_t budget_;
     std::string tmpdir_, name_;
+    CornerLayout layout_;
     std::vector<V> corners_;  // the current chunk's corners
     // In-memory path.
     std::vector<Entry> table_;
@@ -291,23 +323,45 @@ private:
     uint64_t next_corner_ = 0;
     std::unique_ptr<RecordSorter<CornerId, CornerIdLess>> back_;
     std::unique_ptr<TempFile> vertex_file_;
+    std::vector<V> vertex_block_;
 };
 
 }  // namespace
 
-Welder::Welder(uint64_t budget_bytes, std::string tmpdir, std::string name)
-    : budget_bytes_(budget_bytes), tmpdir_(std::move(tmpdir)), name_(std::move(name)) {}
+namespace {
+
+// The core whose records hold `layout`'s corner record: the smallest of the sizes below.
+template <template <size_t> class V>
+std::unique_ptr<Welder::Core> make_core(uint64_t budget, const std::string& tmpdir, const std::string& name,
+                                        const CornerLayout& layout) {
+    const size_t n = layout.bytes();
+    if (n == 0) return std::make_unique<WeldCore<V<0>>>(budget, tmpdir, name, layout);
+    if (n <= 16) return std::make_unique<WeldCore<V<16>>>(budget, tmpdir, name, layout);
+    if (n <= 32) return std::make_unique<WeldCore<V<32>>>(budget, tmpdir, name, layout);
+    if (n <= 64) return std::make_unique<WeldCore<V<64>>>(budget, tmpdir, name, layout);
+    if (n <= 128) return std::make_unique<WeldCore<V<128>>>(budget, tmpdir, name, layout);
+    if (n <= Welder::kMaxAttributeBytes) return std::make_unique<WeldCore<V<256>>>(budget, tmpdir, name, layout);
+    throw Error(name, std::to_string(n) + " bytes of vertex attributes per corner, more than the " +
+                          std::to_string(Welder::kMaxAttributeBytes) +
+                          " an indexed writer keeps (drop some with --drop extra)");
+}
+
+}  // namespace
+
+Welder::Welder(uint64_t budget_bytes, std::string tmpdir, std::string name, const Channels& channels)
+    : budget_bytes_(budget_bytes), tmpdir_(std::move(tmpdir)), name_(std::move(name)), layout_(channels) {
+    if (layout_.bytes() > kMaxAttributeBytes) make_core<PositionVertex>(0, tmpdir_, name_, layout_);  // throws
+}
 
 Welder::~Welder() = default;
 
 void Welder::add(const TriangleChunk& chunk) {
     if (chunk.empty()) return;
     if (!core_) {
-        const Channels& ch = chunk.channels();
-        if (ch.vertex_id)
-            core_ = std::make_unique<WeldCore<IdVertex>>(budget_bytes_, tmpdir_, name_, ch.color);
+        if (chunk.channels().vertex_id)
+            core_ = make_core<IdVertex>(budget_bytes_, tmpdir_, name_, layout_);
         else
-            core_ = std::make_unique<WeldCore<PositionVertex>>(budget_bytes_, tmpdir_, name_, ch.color);
+            core_ = make_core<PositionVertex>(budget_bytes_, tmpdir_, name_, layout_);
     }
     core_->add(chunk);
 }
@@ -319,9 +373,10 @@ void Welder::finish() {
 
 uint64_t Welder::vertex_count() const { return core_->vertices; }
 uint64_t Welder::triangle_count() const { return core_->triangles; }
-bool Welder::color() const { return core_->color; }
 bool Welder::out_of_core() const { return core_->out_of_core; }
-size_t Welder::next_vertices(std::span<WeldedVertex> out) { return core_->next_vertices(out); }
+size_t Welder::next_vertices(std::span<float> xyz, std::span<std::byte> attributes) {
+    return core_->next_vertices(xyz, attributes);
+}
 size_t Welder::next_indices(std::span<uint32_t> out) { return core_->next_indices(out); }
 
 }  // namespace meshstream::io

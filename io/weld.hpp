@@ -1,7 +1,9 @@
 // Welding for the indexed writers (PLY, OBJ): turns a stream of triangle-soup chunks into a
 // vertex list and an index list, in bounded memory. Corners are the same vertex when their
-// positions are bit-identical (with -0.0 == +0.0; the welded vertex is written as +0.0), or,
-// when the chunks carry the vertex_id channel, when their ids (and positions) are equal.
+// positions are bit-identical (with -0.0 == +0.0; the welded vertex is written as +0.0) and
+// their per-corner attributes (io::CornerLayout's record) are equal, or, when the chunks carry
+// the vertex_id channel, when their ids, positions and attributes are equal: a UV or normal
+// seam stays two vertices.
 //
 // Output order does not depend on the path taken: vertices sorted by key (position bits, or
 // vertex id then position), so a PLY/OBJ input keeps its vertex order; triangles in input
@@ -26,23 +28,23 @@
 
 namespace meshstream::io {
 
-struct WeldedVertex {
-    float xyz[3];
-    uint8_t rgb[3];
-};
-
 class Welder {
 public:
+    // The largest corner record welded (CornerLayout::bytes()).
+    static constexpr size_t kMaxAttributeBytes = 256;
+
     // `budget_bytes` bounds the hash table or the sort buffers; temp files go to `tmpdir`
-    // (empty: $TMPDIR or /tmp). `name` names the output in error messages.
-    Welder(uint64_t budget_bytes, std::string tmpdir, std::string name);
+    // (empty: $TMPDIR or /tmp). `name` names the output in error messages. `channels`: those of
+    // the chunks to come, whose per-corner attributes are kept (vertex ids are decided by the
+    // first chunk). Throws io::Error when the corner record passes kMaxAttributeBytes.
+    Welder(uint64_t budget_bytes, std::string tmpdir, std::string name, const Channels& channels);
     ~Welder();
     Welder(const Welder&) = delete;
     Welder& operator=(const Welder&) = delete;
 
-    // Adds a chunk's triangles. The first non-empty chunk decides whether vertex ids are used
-    // and whether colour is kept. Throws io::Error (temp-file I/O, or more than 2^32 - 1
-    // vertices).
+    // Adds a chunk's triangles (with the channels given to the constructor). The first
+    // non-empty chunk decides whether vertex ids are used. Throws io::Error (temp-file I/O, or
+    // more than 2^32 - 1 vertices).
     void add(const TriangleChunk& chunk);
     // Ends input and assigns vertex ids. Throws io::Error.
     void finish();
@@ -50,10 +52,12 @@ public:
     // After finish():
     uint64_t vertex_count() const;
     uint64_t triangle_count() const;
-    bool color() const;
     bool out_of_core() const;  // true when the sort-based path was taken
-    // Fill `out` with the next vertices, in output order; 0 at the end.
-    size_t next_vertices(std::span<WeldedVertex> out);
+    // The corner records' layout (attribute bytes per vertex).
+    const CornerLayout& layout() const { return layout_; }
+    // Fills `xyz` (3 per vertex) and `attributes` (layout().bytes() per vertex) with the next
+    // vertices, in output order, as many as both hold; 0 at the end.
+    size_t next_vertices(std::span<float> xyz, std::span<std::byte> attributes);
     // Fill `out` with the next triangles' indices (3 each; out.size() >= 3); 0 at the end.
     size_t next_indices(std::span<uint32_t> out);
 
@@ -64,6 +68,7 @@ private:
     uint64_t budget_bytes_;
     std::string tmpdir_;
     std::string name_;
+    CornerLayout layout_;
 };
 
 }  // namespace meshstream::io

@@ -164,7 +164,7 @@ private:
 };
 
 size_t ExternalSorter::record_bytes_for(const io::Channels& channels) {
-    return 9 * sizeof(float) + (channels.color ? 9 : 0) + (channels.normal ? 9 * sizeof(float) : 0) +
+    return 9 * sizeof(float) + 3 * io::CornerLayout(channels).bytes() + io::FaceLayout(channels).bytes() +
            (channels.vertex_id ? 3 * sizeof(uint64_t) : 0);
 }
 
@@ -175,7 +175,8 @@ uint64_t ExternalSorter::run_capacity_for(uint64_t memory_budget_bytes, size_t r
 }
 
 ExternalSorter::ExternalSorter(SorterOptions options)
-    : options_(std::move(options)), record_bytes_(record_bytes_for(options_.channels)) {
+    : options_(std::move(options)), record_bytes_(record_bytes_for(options_.channels)),
+      corner_layout_(options_.channels), face_layout_(options_.channels) {
     assert(options_.axis >= 0 && options_.axis <= 2);
     stats_.record_bytes = record_bytes_;
     stats_.run_capacity = run_capacity_for(options_.memory_budget_bytes, record_bytes_);
@@ -186,14 +187,11 @@ ExternalSorter::~ExternalSorter() = default;
 void ExternalSorter::encode(const io::TriangleChunk& chunk, size_t i, std::byte* dst) const {
     std::memcpy(dst, &chunk.xyz()[9 * i], 9 * sizeof(float));
     dst += 9 * sizeof(float);
-    if (options_.channels.color) {
-        std::memcpy(dst, &chunk.rgb()[9 * i], 9);
-        dst += 9;
+    if (const size_t n = corner_layout_.bytes()) {
+        for (int k = 0; k < 3; ++k, dst += n) corner_layout_.pack(chunk, i, k, dst);
     }
-    if (options_.channels.normal) {
-        std::memcpy(dst, &chunk.normals()[9 * i], 9 * sizeof(float));
-        dst += 9 * sizeof(float);
-    }
+    face_layout_.pack(chunk, i, dst);
+    dst += face_layout_.bytes();
     if (options_.channels.vertex_id) std::memcpy(dst, &chunk.vertex_ids()[3 * i], 3 * sizeof(uint64_t));
 }
 
@@ -201,14 +199,11 @@ void ExternalSorter::decode(const std::byte* src, io::TriangleChunk& chunk) cons
     std::memcpy(chunk.push_slot(), src, 9 * sizeof(float));
     size_t i = chunk.size() - 1;
     src += 9 * sizeof(float);
-    if (options_.channels.color) {
-        std::memcpy(chunk.rgb_at(i), src, 9);
-        src += 9;
+    if (const size_t n = corner_layout_.bytes()) {
+        for (int k = 0; k < 3; ++k, src += n) corner_layout_.unpack(src, chunk, i, k);
     }
-    if (options_.channels.normal) {
-        std::memcpy(chunk.normal_at(i), src, 9 * sizeof(float));
-        src += 9 * sizeof(float);
-    }
+    face_layout_.unpack(src, chunk, i);
+    src += face_layout_.bytes();
     if (options_.channels.vertex_id) std::memcpy(chunk.id_at(i), src, 3 * sizeof(uint64_t));
 }
 

@@ -101,6 +101,8 @@ private:
     SorterOptions options_;
     SortStats stats_;
     size_t record_bytes_;
+    io::CornerLayout corner_layout_;  // per-corner attributes in a record
+    io::FaceLayout face_layout_;      // per-triangle attributes
     bool input_done_ = false;
 
     // Run generation.

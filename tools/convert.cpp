@@ -29,9 +29,14 @@ void run_convert(const ConvertOptions& opt) {
     if (opt.read.strict) wo.triangle_count = header.triangle_count;
     wo.expected_triangle_count = header.triangle_count;
     wo.sorted_axis = header.sorted_axis;
+    const io::Format& out_format = io::output_format(opt.output, opt.write.to);
+    wo.channels = io::writable_channels(out_format, header.channels, wo);
+    if (wo.channels.material) wo.materials = header.materials;
+    const std::string dropped = io::describe_missing(header.channels, wo.channels);
     io::Output out = io::open_output(opt.output, opt.write.to, wo, opt.write.gzip_level);
 
-    io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, header.channels);
+    // The chunk carries only what the output keeps: the reader fills no more.
+    io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, wo.channels);
     uint64_t done = 0;
     Progress progress("converting", header.triangle_count);
     TriangleFilter filter(in.source->name(), opt.read.strict);
@@ -53,9 +58,10 @@ void run_convert(const ConvertOptions& opt) {
     Warnings warnings;
     note_unused_write_flags(opt.write, *out.format, opt.output, warnings);
     for (const std::string& note : out.writer->notes()) warnings.note(note);
-    if (header.channels.color && !(out.format->traits & io::Format::kWritesColour))
-        warnings.note("the input's vertex colours are not written: " + std::string(out.format->name) +
-                      " output carries geometry only (PLY keeps them)");
+    if (!dropped.empty())
+        warnings.note(dropped + " dropped: " + std::string(out.format->name) + " output " +
+                      (wo.channels.has_attributes() ? "does not carry " + std::string(dropped.find(',') == std::string::npos ? "it" : "them")
+                                                    : std::string("carries positions only")));
     filter.report(warnings);
     note_input_changes(in.reader->header(), in.source->name(), warnings);
     warnings.print();

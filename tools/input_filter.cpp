@@ -31,12 +31,7 @@ size_t TriangleFilter::apply(io::TriangleChunk& chunk) {
             ++(finite ? degenerate_ : non_finite_);
             continue;
         }
-        if (kept != i) {
-            std::memmove(xyz + 9 * kept, t, 9 * sizeof(float));
-            if (uint8_t* rgb = chunk.rgb_at(kept)) std::memmove(rgb, chunk.rgb_at(i), 9);
-            if (float* nrm = chunk.normal_at(kept)) std::memmove(nrm, chunk.normal_at(i), 9 * sizeof(float));
-            if (uint64_t* id = chunk.id_at(kept)) std::memmove(id, chunk.id_at(i), 3 * sizeof(uint64_t));
-        }
+        if (kept != i) chunk.copy_triangle(kept, chunk, i);
         ++kept;
     }
     chunk.resize(kept);

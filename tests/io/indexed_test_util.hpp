@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -48,7 +49,8 @@ private:
 
 struct Soup {
     std::vector<float> xyz;       // 9 per triangle
-    std::vector<uint8_t> rgb;     // 9 per triangle when the reader gives colour
+    std::vector<uint8_t> rgb;     // 9 per triangle: rgba as 8 bits, without alpha
+    std::vector<float> rgba;      // 12 per triangle when the reader gives colour
     std::vector<uint64_t> ids;    // 3 per triangle when the reader gives vertex ids
     io::MeshHeader header;
     size_t triangles() const { return xyz.size() / 9; }
@@ -63,7 +65,10 @@ inline Soup read_soup(const std::string& path, size_t capacity = io::TriangleChu
     while (in.reader->next(chunk)) {
         EXPECT_FALSE(chunk.empty());
         s.xyz.insert(s.xyz.end(), chunk.xyz().begin(), chunk.xyz().end());
-        s.rgb.insert(s.rgb.end(), chunk.rgb().begin(), chunk.rgb().end());
+        s.rgba.insert(s.rgba.end(), chunk.colors().begin(), chunk.colors().end());
+        for (size_t c = 0; c < chunk.colors().size(); ++c)  // RGB as 8 bits, alpha left out
+            if (c % 4 != 3)
+                s.rgb.push_back(uint8_t(std::lround(std::clamp(chunk.colors()[c], 0.0f, 1.0f) * 255.0f)));
         s.ids.insert(s.ids.end(), chunk.vertex_ids().begin(), chunk.vertex_ids().end());
     }
     EXPECT_TRUE(chunk.empty());

@@ -330,6 +330,7 @@ TEST(PlyWriter, WritesHeaderCommentsAndColour) {
     io::WriteOptions wo;
     wo.sorted_axis = 2;
     wo.comment = "first\nsecond";
+    wo.channels = in.reader->header().channels;
     io::Output out = io::open_output(dir / "c.ply", "ply-ascii", wo);
     io::TriangleChunk chunk(100, in.reader->header().channels);
     while (in.reader->next(chunk)) out.write(chunk);

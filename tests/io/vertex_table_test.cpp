@@ -18,29 +18,32 @@ using namespace meshstream;
 
 namespace {
 
+// Vertex i: (i/2, -i, 3), and when the table has 3-byte records, (1, i mod 256, 2).
 void expect_vertex(io::VertexTable& t, uint64_t i) {
     float xyz[3];
-    uint8_t rgb[3];
-    t.get(i, xyz, rgb);
+    std::byte attributes[3] = {};
+    t.get(i, xyz, attributes);
     ASSERT_EQ(xyz[0], static_cast<float>(i) * 0.5f) << i;
     ASSERT_EQ(xyz[1], -static_cast<float>(i)) << i;
     ASSERT_EQ(xyz[2], 3.0f) << i;
-    if (t.color()) {
-        ASSERT_EQ(rgb[1], static_cast<uint8_t>(i)) << i;
+    if (t.attribute_bytes() > 0) {
+        ASSERT_EQ(attributes[0], std::byte{1}) << i;
+        ASSERT_EQ(attributes[1], static_cast<std::byte>(i)) << i;
+        ASSERT_EQ(attributes[2], std::byte{2}) << i;
     }
 }
 
 }  // namespace
 
 TEST(VertexTable, SpillsPastTheBudgetAndReadsWhileAppending) {
-    for (bool color : {false, true}) {
+    for (size_t attribute_bytes : {0, 3}) {
         test::TempDir dir;
-        io::VertexTable t(1 << 20, dir.path(), color);
+        io::VertexTable t(1 << 20, dir.path(), attribute_bytes);
         const uint64_t n = 150000;  // 1.8-2.4 MB: past the budget and the 1 MiB tail
         for (uint64_t i = 0; i < n; ++i) {
             const float xyz[3] = {static_cast<float>(i) * 0.5f, -static_cast<float>(i), 3.0f};
-            const uint8_t rgb[3] = {1, static_cast<uint8_t>(i), 2};
-            t.append(xyz, rgb);
+            const std::byte attributes[3] = {std::byte{1}, static_cast<std::byte>(i), std::byte{2}};
+            t.append(xyz, attributes);
             if (i % 9973 == 0) {  // OBJ reads earlier vertices between appends
                 expect_vertex(t, i);
                 expect_vertex(t, i / 2);
@@ -57,7 +60,7 @@ TEST(VertexTable, SpillsPastTheBudgetAndReadsWhileAppending) {
 // records appended later fill the rest of it, and must be read from the file again.
 TEST(VertexTable, APageCachedAtTheFilesEndIsReadAgainOnceItGrows) {
     test::TempDir dir;
-    io::VertexTable t(1 << 20, dir.path(), false);
+    io::VertexTable t(1 << 20, dir.path(), 0);
     auto add = [&](uint64_t i) {
         const float xyz[3] = {static_cast<float>(i) * 0.5f, -static_cast<float>(i), 3.0f};
         t.append(xyz, nullptr);
@@ -71,7 +74,7 @@ TEST(VertexTable, APageCachedAtTheFilesEndIsReadAgainOnceItGrows) {
 }
 
 TEST(VertexTable, StaysInMemoryWithinTheBudget) {
-    io::VertexTable t(1 << 20, {}, false);
+    io::VertexTable t(1 << 20, {}, 0);
     for (uint64_t i = 0; i < 1000; ++i) {
         const float xyz[3] = {static_cast<float>(i) * 0.5f, -static_cast<float>(i), 3.0f};
         t.append(xyz, nullptr);
@@ -82,20 +85,18 @@ TEST(VertexTable, StaysInMemoryWithinTheBudget) {
 
 TEST(VertexTable, ReadsRecordsOfAnInputFileInPlace) {
     test::TempDir dir;
-    // 5 junk bytes, then records of 20 bytes: pad(2) x y z pad(3) r g b ... (stride 20).
+    // 5 junk bytes, then records of 20 bytes: pad(2) x y z pad(8) (stride 20).
     std::string bytes(5, 'j');
     const uint64_t n = 5000;
     for (uint64_t i = 0; i < n; ++i) {
         char rec[20] = {};
         const float xyz[3] = {static_cast<float>(i) * 0.5f, -static_cast<float>(i), 3.0f};
         std::memcpy(rec + 2, xyz, 12);
-        rec[17] = static_cast<char>(i);
         bytes.append(rec, 20);
     }
     test::spit(dir / "v.bin", bytes);
     const size_t xyz_offsets[3] = {2, 6, 10};
-    const size_t rgb_offsets[3] = {16, 17, 18};
-    auto t = io::VertexTable::of_input_file(dir / "v.bin", 5, n, 20, xyz_offsets, rgb_offsets, 16 << 10);
+    auto t = io::VertexTable::of_input_file(dir / "v.bin", 5, n, 20, xyz_offsets, 16 << 10);
     EXPECT_EQ(t->storage(), io::VertexTable::Storage::kInputFile);
     for (uint64_t i = n; i-- > 0;) expect_vertex(*t, (i * 31) % n);
 }
@@ -116,7 +117,7 @@ uint64_t resident_bytes() {
 uint64_t resident_growth_of_sparse_reads(const std::string& path, uint64_t budget, uint64_t step_bytes) {
     const uint64_t n = uint64_t{4} << 20;  // 12-byte records: 48 MiB
     const size_t xyz_offsets[3] = {0, 4, 8};
-    auto t = io::VertexTable::of_input_file(path, 0, n, 12, xyz_offsets, nullptr, budget);
+    auto t = io::VertexTable::of_input_file(path, 0, n, 12, xyz_offsets, budget);
     const uint64_t before = resident_bytes();
     EXPECT_GT(before, 0u);
     uint64_t peak = before;

@@ -27,7 +27,7 @@ Welded weld(const std::vector<float>& soup, uint64_t budget, io::Channels channe
     test::TempDir dir;
     Welded out;
     {
-        io::Welder w(budget, dir.path(), "test");
+        io::Welder w(budget, dir.path(), "test", channels);
         io::TriangleChunk chunk(333, channels);
         for (size_t t = 0; t < soup.size() / 9; ++t) {
             if (chunk.full()) {
@@ -39,17 +39,19 @@ Welded weld(const std::vector<float>& soup, uint64_t budget, io::Channels channe
             std::copy(soup.begin() + 9 * t, soup.begin() + 9 * t + 9, p);
             if (channels.vertex_id)
                 for (int k = 0; k < 3; ++k) chunk.id_at(i)[k] = ids[3 * t + k];
-            if (channels.color)
-                for (int k = 0; k < 9; ++k) chunk.rgb_at(i)[k] = static_cast<uint8_t>(t + k);
+            if (channels.color)  // 8-bit RGB of the corner's position, alpha 1
+                for (int k = 0; k < 12; ++k)
+                    chunk.color_at(i)[k] = k % 4 == 3 ? 1.0f : float(static_cast<uint8_t>(7 * p[3 * (k / 4)] + 3 * p[3 * (k / 4) + 1] + k % 4)) / 255.0f;
         }
         w.add(chunk);
         w.finish();
         out.out_of_core = w.out_of_core();
-        std::vector<io::WeldedVertex> vs(100);
-        while (size_t n = w.next_vertices(vs))
+        std::vector<float> xyz(3 * 100);
+        std::vector<std::byte> records(100 * w.layout().bytes());
+        while (size_t n = w.next_vertices(xyz, records))
             for (size_t i = 0; i < n; ++i) {
-                out.xyz.insert(out.xyz.end(), vs[i].xyz, vs[i].xyz + 3);
-                out.rgb.insert(out.rgb.end(), vs[i].rgb, vs[i].rgb + 3);
+                out.xyz.insert(out.xyz.end(), &xyz[3 * i], &xyz[3 * i] + 3);
+                for (size_t b = 0; b < w.layout().bytes(); ++b) out.rgb.push_back(uint8_t(records[w.layout().bytes() * i + b]));
             }
         std::vector<uint32_t> idx(300);
         while (size_t n = w.next_indices(idx)) out.indices.insert(out.indices.end(), idx.begin(), idx.begin() + n);
@@ -66,7 +68,7 @@ TEST(Welder, HashAndExternalSortPathsAgree) {
     std::vector<float> grid = test::grid_soup(80);  // 12482 triangles, 6400 vertices
     for (bool color : {false, true}) {
         io::Channels ch;
-        ch.color = color;
+        if (color) ch.color = io::ColorFormat{};
         Welded memory = weld(grid, uint64_t{64} << 20, ch);
         Welded tiny = weld(grid, 32 << 10, ch);
         EXPECT_FALSE(memory.out_of_core);
@@ -137,4 +139,38 @@ TEST(RecordSorter, MergesInLevelsWhenRunsOutnumberTheMergeBudget) {
     while (sorter.next(v)) out.push_back(v);
     std::sort(values.begin(), values.end());
     EXPECT_EQ(out, values);
+}
+
+TEST(Welder, CornersOfOnePositionWithOtherAttributesStayApart) {
+    // Two triangles sharing an edge whose corners differ in colour on one side: a colour seam.
+    const std::vector<float> soup = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0};
+    io::Channels ch;
+    ch.color = io::ColorFormat{};
+    for (uint64_t budget : {uint64_t{1} << 20, uint64_t{0}}) {
+        test::TempDir dir;
+        io::Welder w(budget, dir.path(), "test", ch);
+        io::TriangleChunk chunk(2, ch);
+        for (int t = 0; t < 2; ++t) {
+            float* p = chunk.push_slot();
+            std::copy(soup.begin() + 9 * t, soup.begin() + 9 * t + 9, p);
+            for (int k = 0; k < 3; ++k) chunk.color_at(size_t(t))[4 * k] = t == 0 ? 1.0f : 0.0f;  // red, then black
+        }
+        w.add(chunk);
+        w.finish();
+        EXPECT_EQ(w.vertex_count(), 6u) << budget;  // the shared edge's two positions twice
+        EXPECT_EQ(w.layout().bytes(), 3u);
+    }
+}
+
+TEST(Welder, RefusesCornerRecordsPastItsLimit) {
+    io::Channels ch;
+    for (int c = 0; c < 40; ++c) ch.vertex_scalars.push_back({"s" + std::to_string(c), io::ScalarType::kFloat64});
+    test::TempDir dir;
+    try {
+        io::Welder w(1 << 20, dir.path(), "out.ply", ch);
+        FAIL() << "no error";
+    } catch (const io::Error& e) {
+        EXPECT_NE(std::string(e.what()).find("out.ply: 320 bytes of vertex attributes per corner"), std::string::npos)
+            << e.what();
+    }
 }

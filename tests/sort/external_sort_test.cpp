@@ -188,13 +188,16 @@ TEST(ExternalSorter, MultiPassMergeUnderTinyBudget) {
 }
 
 TEST(ExternalSorter, CarriesChannelsWithTheirTriangle) {
-    io::Channels ch{.color = true, .normal = true, .vertex_id = true};
+    io::Channels ch;
+    ch.normal = true;
+    ch.color = io::ColorFormat{};
+    ch.vertex_id = true;
     sort::SorterOptions o;
     o.channels = ch;
     o.memory_budget_bytes = 64 << 10;  // 1024-triangle runs
     TempDir dir;
     o.tmpdir = dir.path.string();
-    EXPECT_EQ(sort::ExternalSorter::record_bytes_for(ch), 36u + 9 + 36 + 24);
+    EXPECT_EQ(sort::ExternalSorter::record_bytes_for(ch), 36u + 9 + 36 + 24);  // colour as RGB8
     sort::ExternalSorter sorter(o);
     io::TriangleChunk chunk(300, ch);
     const int n = 5000;
@@ -209,7 +212,7 @@ TEST(ExternalSorter, CarriesChannelsWithTheirTriangle) {
         const float tri[9] = {float(i), 0, z, 1, 0, z, 0, 1, z};
         std::memcpy(p, tri, sizeof tri);
         size_t k = chunk.size() - 1;
-        for (int c = 0; c < 9; ++c) chunk.rgb_at(k)[c] = uint8_t(i + c);
+        for (int c = 0; c < 12; ++c) chunk.color_at(k)[c] = c % 4 == 3 ? 1.0f : float(uint8_t(i + c)) / 255.0f;
         for (int c = 0; c < 9; ++c) chunk.normal_at(k)[c] = float(i) + 0.5f * c;
         for (int c = 0; c < 3; ++c) chunk.id_at(k)[c] = uint64_t(i) * 3 + c;
     }
@@ -224,7 +227,8 @@ TEST(ExternalSorter, CarriesChannelsWithTheirTriangle) {
             int i = int(p[0]);
             ASSERT_GE(p[2], prev_z);
             prev_z = p[2];
-            for (int c = 0; c < 9; ++c) ASSERT_EQ(chunk.rgb()[9 * k + c], uint8_t(i + c));
+            for (int c = 0; c < 12; ++c)
+                ASSERT_EQ(chunk.colors()[12 * k + c], c % 4 == 3 ? 1.0f : float(uint8_t(i + c)) / 255.0f);
             for (int c = 0; c < 9; ++c) ASSERT_EQ(chunk.normals()[9 * k + c], float(i) + 0.5f * c);
             for (int c = 0; c < 3; ++c) ASSERT_EQ(chunk.vertex_ids()[3 * k + c], uint64_t(i) * 3 + c);
         }
