@@ -51,6 +51,13 @@ CLI::Validator format_name(bool for_writing) {
 
 }  // namespace
 
+std::string dropped_channels_text(const std::string& dropped, const io::Format& output, const io::Channels& kept) {
+    const bool one = dropped.find(',') == std::string::npos;
+    return dropped + " dropped: " + std::string(output.name) + " output " +
+           (kept.has_attributes() ? std::string(one ? "does not carry it" : "does not carry them")
+                                  : std::string("carries positions only"));
+}
+
 void note_input_changes(const io::MeshHeader& header, const std::string& input_name, Warnings& warnings) {
     for (const auto& [key, text] : header.notes)
         if (key == io::kLastLineNote)

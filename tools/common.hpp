@@ -60,6 +60,9 @@ class Warnings;
 // output not named *.gz (they do nothing there).
 void note_unused_write_flags(const WriteFlags& flags, const io::Format& output, const std::string& output_path,
                              Warnings& warnings);
+// The warning for channels an output cannot hold: "`dropped` dropped: <format> output carries
+// positions only" (or "does not carry them" when it keeps some others, `kept`).
+std::string dropped_channels_text(const std::string& dropped, const io::Format& output, const io::Channels& kept);
 // Repeats as warnings what the reader noted that changes the data (double coordinates rounded).
 void note_input_changes(const io::MeshHeader& header, const std::string& input_name, Warnings& warnings);
 

@@ -58,10 +58,7 @@ void run_convert(const ConvertOptions& opt) {
     Warnings warnings;
     note_unused_write_flags(opt.write, *out.format, opt.output, warnings);
     for (const std::string& note : out.writer->notes()) warnings.note(note);
-    if (!dropped.empty())
-        warnings.note(dropped + " dropped: " + std::string(out.format->name) + " output " +
-                      (wo.channels.has_attributes() ? "does not carry " + std::string(dropped.find(',') == std::string::npos ? "it" : "them")
-                                                    : std::string("carries positions only")));
+    if (!dropped.empty()) warnings.note(dropped_channels_text(dropped, *out.format, wo.channels));
     filter.report(warnings);
     note_input_changes(in.reader->header(), in.source->name(), warnings);
     warnings.print();

@@ -139,7 +139,8 @@ void run_decimate(const DecimateOptions& opt) {
     io::Output out = io::open_output(opt.output, opt.write.to, wo, opt.write.gzip_level);
 
     const decimate::Emit emit = [&out](const io::TriangleChunk& chunk) { out.write(chunk); };
-    io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, header.channels);
+    // The decimator rates and writes positions only: no other channel is read.
+    io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, io::Channels{});
     uint64_t done = 0;
     Progress progress("decimating", header.triangle_count);
     TriangleFilter filter(in.source->name(), opt.read.strict);
@@ -181,6 +182,8 @@ void run_decimate(const DecimateOptions& opt) {
     decimate::print_phase_report(stderr);  // only in builds with MESHSTREAM_PHASE_TIMERS
 
     Warnings warnings;
+    if (const std::string dropped = io::describe_missing(header.channels, io::Channels{}); !dropped.empty())
+        warnings.note(dropped + " dropped: decimate keeps positions only");
     char ratio_text[32];
     std::snprintf(ratio_text, sizeof ratio_text, "%.6g", decimator.ratio());
     // The command that judges this run's buffer (info assumes the default one).

@@ -195,7 +195,10 @@ void run_sort(const SortOptions& opt) {
     sort::SorterOptions so;
     so.axis = axis;
     so.tmpdir = tmpdir;
-    so.channels = header.channels;
+    // Only the channels the output keeps are carried through the runs.
+    const io::Format& out_format = io::output_format(opt.output, opt.write.to);
+    so.channels = io::writable_channels(out_format, header.channels, opt.write.options(opt.read));
+    const std::string dropped = io::describe_missing(header.channels, so.channels);
     const size_t record_bytes = sort::ExternalSorter::record_bytes_for(so.channels);
     // The pipe's chunks are part of the sorter's share: each at most 1/64 of the budget.
     const size_t chunk_capacity =
@@ -227,7 +230,7 @@ void run_sort(const SortOptions& opt) {
     {
         // Input thread: reads, parses and filters chunks; this thread adds them to the runs
         // (and sorts and spills each full run).
-        ChunkPipe pipe(chunk_capacity, header.channels);
+        ChunkPipe pipe(chunk_capacity, so.channels);
         std::atomic<uint64_t> read{0};
         PipeWorker reader(pipe, [&] {
             try {
@@ -266,12 +269,14 @@ void run_sort(const SortOptions& opt) {
     wo.tmpdir = tmpdir;
     wo.triangle_count = total;
     wo.sorted_axis = axis;
+    wo.channels = so.channels;
+    if (wo.channels.material) wo.materials = header.materials;
     io::Output out = io::open_output(opt.output, opt.write.to, wo, opt.write.gzip_level);
     const int passes = sorter.stats().merge_passes;
     progress.phase(passes == 0 ? "writing" : "merge " + std::to_string(passes) + "/" + std::to_string(passes), total);
     {
         // Output thread: formats and writes chunks; this thread merges (or gathers) them.
-        ChunkPipe pipe(chunk_capacity, header.channels);
+        ChunkPipe pipe(chunk_capacity, so.channels);
         PipeWorker writer(pipe, [&] {
             try {
                 while (io::TriangleChunk* chunk = pipe.get_full()) {
@@ -297,6 +302,7 @@ void run_sort(const SortOptions& opt) {
     progress.done();
     Warnings warnings;
     note_unused_write_flags(opt.write, *out.format, opt.output, warnings);
+    if (!dropped.empty()) warnings.note(dropped_channels_text(dropped, *out.format, so.channels));
     // Only STL, PLY and OBJ have a place for the axis (a header or a comment).
     if (out.format->traits & io::Format::kDracoUnlessOff)
         warnings.note(std::string(opt.output == "-" ? "<stdout>" : opt.output) +

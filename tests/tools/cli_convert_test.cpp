@@ -134,6 +134,20 @@ TEST(CliConvert, DroppedVertexColoursAreSaid) {
     cli_test::CliRun ply = run("convert " + coloured + " " + dir / "c.ply");
     EXPECT_EQ(ply.code, 0) << ply.err;
     EXPECT_EQ(ply.err.find("colours"), std::string::npos) << ply.err;
+    // sort carries the channels the output keeps, and names the others; decimate keeps
+    // positions only and says so.
+    cli_test::CliRun sorted = run("sort " + coloured + " " + dir / "s.ply");
+    EXPECT_EQ(sorted.code, 0) << sorted.err;
+    EXPECT_EQ(sorted.err.find("colours"), std::string::npos) << sorted.err;
+    EXPECT_NE(cli_test::slurp(dir / "s.ply").find("property uchar red\nproperty uchar green\nproperty uchar blue\n"),
+              std::string::npos);
+    cli_test::CliRun sorted_stl = run("sort " + coloured + " " + dir / "s.stl");
+    EXPECT_NE(sorted_stl.err.find("warning: colours dropped: stl output carries positions only"), std::string::npos)
+        << sorted_stl.err;
+    cli_test::CliRun decimated = run("decimate " + coloured + " " + dir / "d.ply -r 0.5");
+    EXPECT_EQ(decimated.code, 0) << decimated.err;
+    EXPECT_NE(decimated.err.find("warning: colours dropped: decimate keeps positions only"), std::string::npos)
+        << decimated.err;
 }
 
 TEST(CliConvert, AsciiStlNormalsHaveNoNegativeZeros) {
