@@ -128,6 +128,9 @@ struct WriteOptions {
     std::optional<uint64_t> expected_triangle_count;
     std::optional<int> sorted_axis;          // recorded in the header when the format has room
     std::string comment;                     // free text for formats with comments
+    // --strict: a writer that cannot hold something it is given (a degenerate triangle Draco
+    // drops, a NaN no quantization holds) throws io::Error instead of a counted note.
+    bool strict = false;
     // The stream's channels: every chunk written has exactly these (the command chooses them
     // with Format::keep_channels), and the material table their material channel indexes.
     Channels channels;

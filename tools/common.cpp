@@ -144,6 +144,7 @@ io::WriteOptions WriteFlags::options(const ReadFlags& read) const {
     io::WriteOptions o;
     o.memory_budget_bytes = parse_bytes(read.memory);
     o.tmpdir = read.tmpdir;
+    o.strict = read.strict;
     o.draco = draco;
     o.normals = normals;
     o.draco_position_bits = draco_qp;
