@@ -8,7 +8,7 @@
 namespace meshstream::decimate {
 
 TriangleOutput::TriangleOutput(size_t chunk_triangles)
-    : chunk_(chunk_triangles, io::Channels{.vertex_id = true}) {}
+    : chunk_(chunk_triangles, io::Channels::ids_only()) {}
 
 void TriangleOutput::emit(const float xyz[9], const uint64_t ids[3], const Emit& out) {
     float* slot = chunk_.push_slot();

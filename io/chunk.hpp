@@ -60,6 +60,12 @@ struct Channels {
     std::vector<ScalarChannel> face_scalars;  // 1 × double each
 
     bool operator==(const Channels&) const = default;
+    // Positions and vertex ids (what the decimator emits).
+    static Channels ids_only() {
+        Channels c;
+        c.vertex_id = true;
+        return c;
+    }
     // True when any channel but vertex ids is present (what a positions-only consumer drops).
     bool has_attributes() const {
         return normal || color || uv_sets > 0 || !vertex_scalars.empty() || material || !face_scalars.empty();

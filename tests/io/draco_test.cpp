@@ -157,7 +157,7 @@ TEST(DracoWriter, UsesVertexIdsInsteadOfWelding) {
     for (bool ids : {false, true}) {
         io::WriteOptions o;
         io::Output out = io::open_output(dir / "q.drc", {}, o);
-        io::TriangleChunk chunk(4, io::Channels{.vertex_id = ids});
+        io::TriangleChunk chunk(4, ids ? io::Channels::ids_only() : io::Channels{});
         for (int t = 0; t < 2; ++t) {
             chunk.push(quad[t]);
             if (ids)

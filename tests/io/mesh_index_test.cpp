@@ -33,7 +33,7 @@ TEST(MeshIndexer, WeldsExactPositionsTreatingMinusZeroAsZero) {
 
 TEST(MeshIndexer, UsesVertexIdsWhenPresent) {
     io::MeshIndexer ix("out.glb");
-    io::TriangleChunk c = chunk_of({{0, 0, 0, 1, 0, 0, 1, 1, 0}, {0, 0, 0, 1, 1, 0, 0, 1, 0}}, {.vertex_id = true});
+    io::TriangleChunk c = chunk_of({{0, 0, 0, 1, 0, 0, 1, 1, 0}, {0, 0, 0, 1, 1, 0, 0, 1, 0}}, io::Channels::ids_only());
     const uint64_t ids[6] = {7, 8, 9, 17, 9, 18};  // corner 1 of triangle 1 shares id 9
     for (int t = 0; t < 2; ++t)
         for (int k = 0; k < 3; ++k) c.id_at(t)[k] = ids[3 * t + k];

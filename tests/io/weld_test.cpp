@@ -164,7 +164,11 @@ TEST(Welder, CornersOfOnePositionWithOtherAttributesStayApart) {
 
 TEST(Welder, RefusesCornerRecordsPastItsLimit) {
     io::Channels ch;
-    for (int c = 0; c < 40; ++c) ch.vertex_scalars.push_back({"s" + std::to_string(c), io::ScalarType::kFloat64});
+    for (int c = 0; c < 40; ++c) {
+        std::string name = "s";
+        name += std::to_string(c);
+        ch.vertex_scalars.push_back({name, io::ScalarType::kFloat64});
+    }
     test::TempDir dir;
     try {
         io::Welder w(1 << 20, dir.path(), "out.ply", ch);
