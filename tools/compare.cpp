@@ -5,7 +5,7 @@
 #include "tools/commands.hpp"
 #include "tools/common.hpp"
 #include "tools/input_filter.hpp"
-#include "tools/metro.hpp"
+#include "compare/metro.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -16,6 +16,14 @@
 
 namespace meshstream::tools {
 namespace {
+
+using compare::CompareOptions;
+using compare::CompareResult;
+using compare::DistanceStats;
+using compare::MeshSource;
+using compare::MeshSummary;
+using compare::compare_meshes;
+using compare::file_source;
 
 struct CompareCliOptions {
     std::string a, b;

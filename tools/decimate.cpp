@@ -8,7 +8,7 @@
 #include "tools/commands.hpp"
 #include "tools/common.hpp"
 #include "tools/input_filter.hpp"
-#include "tools/metro.hpp"
+#include "compare/metro.hpp"
 
 #include <chrono>
 #include <cmath>
@@ -21,6 +21,11 @@
 
 namespace meshstream::tools {
 namespace {
+
+using compare::CompareOptions;
+using compare::CompareResult;
+using compare::compare_meshes;
+using compare::file_source;
 
 struct DecimateOptions {
     std::string input, output;

@@ -5,8 +5,9 @@
 #include "tools/commands.hpp"
 #include "tools/common.hpp"
 #include "tools/input_filter.hpp"
-#include "tools/topology.hpp"
-#include "tools/order.hpp"
+#include "compare/topology.hpp"
+#include "compare/order.hpp"
+#include "tools/order_text.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -20,11 +21,17 @@
 namespace meshstream::tools {
 namespace {
 
+using compare::BufferVerdict;
+using compare::OrderMeter;
+using compare::OrderReport;
+using compare::TopologyCounter;
+using compare::TopologyReport;
+
 struct InfoOptions {
     std::string input;
     bool json = false;
     bool topology = false;  // --topology: vertex and edge counts (tools/topology.hpp)
-    bool order = false;        // --order: measure the stream's width (tools/order.hpp)
+    bool order = false;        // --order: measure the stream's width (compare/order.hpp)
     uint64_t buffer = 400000;  // --buffer: decimation buffer to judge against the width
     double ratio = 0.1;        // --ratio: the decimation ratio it is judged for
     ReadFlags read;

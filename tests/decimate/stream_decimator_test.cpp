@@ -4,7 +4,7 @@
 #include "decimate/stream_decimator.hpp"
 
 #include "mesh_util.hpp"
-#include "tools/metro.hpp"
+#include "compare/metro.hpp"
 
 #include <gtest/gtest.h>
 
@@ -96,12 +96,12 @@ TEST(StreamDecimator, BunnyAtTenPercentIsWithinAQuarterOfGarlandHeckbert) {
     options.seed = 1;
     const Decimated d = run_decimator(bunny(), options);
     ASSERT_EQ(d.triangle_count(), 6945u);
-    meshstream::tools::CompareOptions compare;
-    compare.samples = 200000;  // fast; the figure moves by under 1 % against 10⁶ samples
-    compare.seed = 1;
-    const meshstream::tools::CompareResult r = meshstream::tools::compare_meshes(
-        meshstream::tools::memory_source("bunny", bunny()), meshstream::tools::memory_source("decimated", d.xyz),
-        compare);
+    meshstream::compare::CompareOptions co;
+    co.samples = 200000;  // fast; the figure moves by under 1 % against 10⁶ samples
+    co.seed = 1;
+    const meshstream::compare::CompareResult r = meshstream::compare::compare_meshes(
+        meshstream::compare::memory_source("bunny", bunny()), meshstream::compare::memory_source("decimated", d.xyz),
+        co);
     const double rms_percent = 100.0 * r.rms() / r.diagonal;
     EXPECT_GT(rms_percent, 0.0);
     EXPECT_LE(rms_percent, 1.25 * kCgalRmsPercent);

@@ -3,7 +3,7 @@
 // fixtures, such as the topology kept through small buffers.
 #include "io/format.hpp"
 #include "tools/cli_util.hpp"
-#include "tools/metro.hpp"
+#include "compare/metro.hpp"
 
 #include <gtest/gtest.h>
 
@@ -20,10 +20,10 @@ using cli_test::run;
 using cli_test::TempDir;
 using namespace meshstream;
 
-tools::EdgeCounts edges_of(const std::string& path) {
+compare::EdgeCounts edges_of(const std::string& path) {
     io::Input in = io::open_input(path);
     io::TriangleChunk chunk;
-    tools::EdgeCounter counter;
+    compare::EdgeCounter counter;
     while (in.reader->next(chunk))
         for (size_t t = 0; t < chunk.size(); ++t) counter.add_triangle(&chunk.xyz()[9 * t]);
     return counter.finish();
@@ -72,11 +72,11 @@ TEST(CliDecimate, SmallBuffersAddNoNonManifoldEdges) {
     TempDir dir;
     const std::string mesh = dir / "g.stl";
     ASSERT_EQ(std::system((std::string(MESHSTREAM_GEN_BINARY) + " -q -n 100000 " + mesh).c_str()), 0);
-    const tools::EdgeCounts in = edges_of(mesh);
+    const compare::EdgeCounts in = edges_of(mesh);
     for (const char* options : {"-r 0.01 --buffer 2000", "-r 0.1 --buffer 3000", "-r 0.01 --buffer 1000"}) {
         CliRun r = run("decimate " + std::string(options) + " " + mesh + " " + dir / "out.stl");
         ASSERT_EQ(r.code, 0) << options << ": " << r.err;
-        const tools::EdgeCounts out = edges_of(dir / "out.stl");
+        const compare::EdgeCounts out = edges_of(dir / "out.stl");
         EXPECT_LE(out.non_manifold_edges, in.non_manifold_edges) << options;
         // Closed input stays closed, except for the cracks evictions leave (said in the
         // warning; the 1 000-triangle buffer is too small for this mesh at 1 %).
@@ -229,7 +229,7 @@ TEST(CliDecimate, ForcedWritesDegradeGracefully) {
     EXPECT_NE(r.err.find("force-written"), std::string::npos) << r.err;  // still short of room
     const uint64_t out = *io::open_input(dir / "out.stl").reader->triangle_count();
     EXPECT_LT(out, 2 * 695u) << r.err;
-    const tools::EdgeCounts e = edges_of(dir / "out.stl");
+    const compare::EdgeCounts e = edges_of(dir / "out.stl");
     EXPECT_EQ(e.non_manifold_edges, 0u);
     EXPECT_LE(e.boundary_edges, 223u);  // the input's own holes, no cracks
 }

@@ -4,7 +4,7 @@
 // exact welding (the derived case table is consistent across cells), holes that open it,
 // a shuffle that keeps the same triangles in another order, same seed same bytes, and exit codes.
 #include "io/format.hpp"
-#include "tools/metro.hpp"
+#include "compare/metro.hpp"
 
 #include <gtest/gtest.h>
 
@@ -85,8 +85,8 @@ std::pair<double, double> disorder(const std::vector<std::array<float, 9>>& tris
     return {worst, tris.empty() ? 0.0 : double(drops) / double(tris.size())};
 }
 
-tools::EdgeCounts edges_of(const std::vector<std::array<float, 9>>& tris) {
-    tools::EdgeCounter counter;
+compare::EdgeCounts edges_of(const std::vector<std::array<float, 9>>& tris) {
+    compare::EdgeCounter counter;
     for (const auto& t : tris) counter.add_triangle(t.data());
     return counter.finish();
 }
@@ -110,7 +110,7 @@ TEST(GenMesh, CountWithinFivePercentAndSortedAlongZ) {
         auto [worst, drops] = disorder(tris);
         EXPECT_LE(worst, 2.0 / n + 1e-6);
         EXPECT_GT(worst, 0.0);  // approximately, not exactly sorted, like a scanner's output
-        tools::EdgeCounts e = edges_of(tris);
+        compare::EdgeCounts e = edges_of(tris);
         EXPECT_EQ(e.boundary_edges, 0u);
         EXPECT_EQ(e.non_manifold_edges, 0u);
         EXPECT_EQ(2 * e.edges, 3 * tris.size());
@@ -122,7 +122,7 @@ TEST(GenMesh, HolesOpenTheSurface) {
     GenRun r = gen(dir, "-q --holes -n 40000 " + (dir.path / "h.stl").string());
     ASSERT_EQ(r.exit_code, 0) << r.err;
     auto tris = read_all(dir.path / "h.stl");
-    tools::EdgeCounts e = edges_of(tris);
+    compare::EdgeCounts e = edges_of(tris);
     EXPECT_GT(e.boundary_edges, 50u);
     EXPECT_EQ(e.non_manifold_edges, 0u);
     EXPECT_NEAR(double(tris.size()), 40000.0, 2000.0);

@@ -2,7 +2,7 @@
 // larger one. See metro.hpp for the method and its memory bound. Spatial indices are BVHs
 // built by median split on the longest centroid axis (leaf 4 triangles / 8 samples); distances
 // use Ericson's closest point on a triangle (Real-Time Collision Detection, §5.1.5) in double.
-#include "tools/metro.hpp"
+#include "compare/metro.hpp"
 
 #include "io/byte_stream.hpp"
 #include "io/error.hpp"
@@ -14,7 +14,7 @@
 #include <cstring>
 #include <limits>
 
-namespace meshstream::tools {
+namespace meshstream::compare {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
@@ -471,109 +471,6 @@ private:
 
 }  // namespace
 
-// ---- EdgeCounter -------------------------------------------------------------------------
-
-struct EdgeCounter::Impl {
-    using Key = std::array<uint32_t, 6>;  // both endpoints' float bits, smaller endpoint first
-    static constexpr size_t kPartitions = 32;
-
-    uint64_t budget_bytes;
-    std::string tmpdir;
-    std::vector<Key> buffer;
-    size_t buffer_capacity;
-    std::vector<std::unique_ptr<io::TempFile>> parts;
-    bool spilled = false;
-
-    static uint32_t bits(float f) {
-        uint32_t u;
-        std::memcpy(&u, &f, 4);
-        return u == 0x80000000u ? 0u : u;  // -0 welds with +0
-    }
-    static size_t partition_of(const Key& k) {
-        uint64_t h = 0x9E3779B97F4A7C15ull;
-        for (uint32_t w : k) h = (h ^ w) * 0xBF58476D1CE4E5B9ull, h ^= h >> 29;
-        return static_cast<size_t>(h % kPartitions);
-    }
-    void spill() {
-        spilled = true;
-        if (parts.empty())
-            for (size_t i = 0; i < kPartitions; ++i) parts.push_back(std::make_unique<io::TempFile>(tmpdir, "meshstream-edges"));
-        for (const Key& k : buffer) parts[partition_of(k)]->write(k.data(), sizeof k);
-        buffer.clear();
-    }
-    static void count_sorted(std::vector<Key>& keys, EdgeCounts& c) {
-        std::sort(keys.begin(), keys.end());
-        for (size_t i = 0; i < keys.size();) {
-            size_t j = i + 1;
-            while (j < keys.size() && keys[j] == keys[i]) ++j;
-            ++c.edges;
-            if (j - i == 1) ++c.boundary_edges;
-            if (j - i >= 3) ++c.non_manifold_edges;
-            i = j;
-        }
-    }
-};
-
-EdgeCounter::EdgeCounter(uint64_t budget_bytes, std::string tmpdir) : impl_(std::make_unique<Impl>()) {
-    impl_->budget_bytes = budget_bytes;
-    impl_->tmpdir = std::move(tmpdir);
-    // The spill partitions' write buffers (1 MiB each) come out of the same budget.
-    uint64_t overhead = std::min(budget_bytes / 2, uint64_t{Impl::kPartitions} << 20);
-    impl_->buffer_capacity = static_cast<size_t>(std::max<uint64_t>((budget_bytes - overhead) / sizeof(Impl::Key), 1024));
-    // Reserved once: growth by doubling would briefly hold twice the budget. Untouched pages
-    // of the reservation are not resident, so small meshes do not pay for it.
-    impl_->buffer.reserve(impl_->buffer_capacity);
-}
-
-EdgeCounter::~EdgeCounter() = default;
-
-void EdgeCounter::add_triangle(const float* tri) {
-    Impl& m = *impl_;
-    uint32_t v[3][3];
-    for (int i = 0; i < 3; ++i)
-        for (int a = 0; a < 3; ++a) v[i][a] = Impl::bits(tri[3 * i + a]);
-    // A triangle with a repeated corner (a, b, b) is no surface element: its edge a–b, met both
-    // ways, would otherwise count as two uses and make a manifold edge non-manifold.
-    for (int e = 0; e < 3; ++e)
-        if (std::equal(v[e], v[e] + 3, v[(e + 1) % 3])) return;
-    for (int e = 0; e < 3; ++e) {
-        const uint32_t* p = v[e];
-        const uint32_t* q = v[(e + 1) % 3];
-        if (!std::lexicographical_compare(p, p + 3, q, q + 3)) std::swap(p, q);
-        m.buffer.push_back({p[0], p[1], p[2], q[0], q[1], q[2]});
-        if (m.buffer.size() >= m.buffer_capacity) m.spill();
-    }
-}
-
-bool EdgeCounter::spilled() const { return impl_->spilled; }
-
-EdgeCounts EdgeCounter::finish() {
-    Impl& m = *impl_;
-    EdgeCounts counts;
-    if (m.parts.empty()) {
-        Impl::count_sorted(m.buffer, counts);
-        m.buffer = std::vector<Impl::Key>();  // frees it (`= {}` would keep the capacity)
-        return counts;
-    }
-    m.spill();
-    m.buffer = std::vector<Impl::Key>();  // the partitions below reuse this memory
-    // Equal keys share a partition, so each partition is counted on its own. A partition is
-    // about 1/32 of the edges: past 32 × budget it exceeds the budget (stated in docs). One
-    // allocation of the largest, so that growing never holds two copies.
-    uint64_t largest = 0;
-    for (const auto& part : m.parts) largest = std::max<uint64_t>(largest, part->size());
-    std::vector<Impl::Key> keys;
-    keys.reserve(static_cast<size_t>(largest / sizeof(Impl::Key)));
-    for (auto& part : m.parts) {
-        keys.resize(part->size() / sizeof(Impl::Key));
-        if (!keys.empty()) part->read_at(0, keys.data(), keys.size() * sizeof(Impl::Key));
-        Impl::count_sorted(keys, counts);
-        part.reset();
-    }
-    m.parts.clear();
-    return counts;
-}
-
 // ---- Sources -----------------------------------------------------------------------------
 
 MeshSource file_source(const std::string& path, std::string_view from, const io::ReadOptions& options) {
@@ -791,4 +688,4 @@ CompareResult compare_meshes(const MeshSource& a, const MeshSource& b, const Com
     return r;
 }
 
-}  // namespace meshstream::tools
+}  // namespace meshstream::compare

@@ -9,11 +9,12 @@
 // samples. The other mesh is streamed twice: pass 1 counts it (area, bounds, edges, a
 // fixed-size reservoir of surface points) and pass 2 generates its samples per triangle on the
 // fly (not stored) and keeps a running minimum distance for each stored sample of the
-// in-memory mesh. Edge counting of the streamed mesh spills to hash-partitioned temporary
-// files past the memory budget. So memory is O(smaller mesh + sample count), independent of
-// the streamed mesh's size.
+// in-memory mesh. Edge counting (compare/topology.hpp) sorts within the memory budget and
+// spills sorted runs past it. So memory is O(smaller mesh + sample count) plus that budget,
+// independent of the streamed mesh's size.
 #pragma once
 
+#include "compare/topology.hpp"
 #include "io/format.hpp"
 
 #include <cstdint>
@@ -24,7 +25,7 @@
 #include <string_view>
 #include <vector>
 
-namespace meshstream::tools {
+namespace meshstream::compare {
 
 // A mesh that can be read more than once: each open() starts a fresh pass from the first
 // triangle. Throws io::Error.
@@ -52,13 +53,6 @@ struct CompareOptions {
 
 // clamp(10 · triangles, 1 000 000, 10 000 000).
 uint64_t default_sample_count(uint64_t triangle_count);
-
-struct EdgeCounts {
-    uint64_t edges = 0;               // distinct edges after exact welding (triangles with a
-                                      // repeated corner add none)
-    uint64_t boundary_edges = 0;      // used by exactly one triangle
-    uint64_t non_manifold_edges = 0;  // used by three or more triangles
-};
 
 struct MeshSummary {
     std::string name;
@@ -91,25 +85,4 @@ struct CompareResult {
 // inputs. Throws io::Error when a mesh cannot be read, is empty, or changes between passes.
 CompareResult compare_meshes(const MeshSource& a, const MeshSource& b, const CompareOptions& options = {});
 
-// Counts distinct edges of a triangle stream after exact welding (-0 equals +0), keeping at
-// most about `budget_bytes` in memory and spilling 24-byte edge records to hash-partitioned
-// temporary files in `tmpdir` beyond that.
-class EdgeCounter {
-public:
-    explicit EdgeCounter(uint64_t budget_bytes = uint64_t{256} << 20, std::string tmpdir = {});
-    ~EdgeCounter();
-    EdgeCounter(const EdgeCounter&) = delete;
-    EdgeCounter& operator=(const EdgeCounter&) = delete;
-    // Adds the three edges of one triangle (9 floats).
-    void add_triangle(const float* tri);
-    // Finishes counting. Call once.
-    EdgeCounts finish();
-    // True when edge records were spilled to temporary files.
-    bool spilled() const;
-
-private:
-    struct Impl;
-    std::unique_ptr<Impl> impl_;
-};
-
-}  // namespace meshstream::tools
+}  // namespace meshstream::compare

@@ -1,6 +1,6 @@
 // tools/topology: vertex, boundary and non-manifold edge counts against the corpus MANIFEST,
 // identical with a budget small enough to spill, and through `meshstream info --topology`.
-#include "tools/topology.hpp"
+#include "compare/topology.hpp"
 
 #include "io/format.hpp"
 
@@ -14,9 +14,9 @@ using namespace meshstream;
 
 namespace {
 
-tools::TopologyReport count(const std::string& name, uint64_t budget = uint64_t{64} << 20) {
+compare::TopologyReport count(const std::string& name, uint64_t budget = uint64_t{64} << 20) {
     io::Input in = io::open_input(std::string(MESHSTREAM_FIXTURES_DIR) + "/" + name);
-    tools::TopologyCounter counter(budget, {});
+    compare::TopologyCounter counter(budget, {});
     io::TriangleChunk chunk(1000, in.reader->header().channels);
     while (in.reader->next(chunk)) counter.add(chunk);
     return counter.finish();
@@ -44,20 +44,20 @@ TEST(Topology, MatchesTheCorpusManifest) {
     };
     for (const Case& c : cases) {
         SCOPED_TRACE(c.file);
-        tools::TopologyReport r = count(c.file);
+        compare::TopologyReport r = count(c.file);
         EXPECT_EQ(r.by_vertex_id, c.by_id);
         EXPECT_EQ(r.vertices, c.vertices);
         EXPECT_EQ(r.boundary_edges, c.boundary);
         EXPECT_EQ(r.non_manifold_edges, c.non_manifold);
     }
     // Euler: a closed genus-0 bunny would have V - E + F = 2; the elephant is closed.
-    tools::TopologyReport e = count("ply/elephant_normals.binary_be.ply");
+    compare::TopologyReport e = count("ply/elephant_normals.binary_be.ply");
     EXPECT_EQ(e.edges * 2, 5558u * 3);
 }
 
 TEST(Topology, SpillingGivesTheSameCounts) {
-    tools::TopologyReport memory = count("bunny_from_draco.bin.stl");
-    tools::TopologyReport spilled = count("bunny_from_draco.bin.stl", 256 << 10);
+    compare::TopologyReport memory = count("bunny_from_draco.bin.stl");
+    compare::TopologyReport spilled = count("bunny_from_draco.bin.stl", 256 << 10);
     EXPECT_EQ(spilled.vertices, memory.vertices);
     EXPECT_EQ(spilled.edges, memory.edges);
     EXPECT_EQ(spilled.boundary_edges, memory.boundary_edges);

@@ -38,7 +38,7 @@
 #include <string_view>
 #include <vector>
 
-namespace meshstream::tools {
+namespace meshstream::compare {
 
 struct OrderReport {
     uint64_t triangles = 0;
@@ -107,11 +107,4 @@ private:
 std::optional<OrderReport> measure_file_order(const std::string& path, std::string_view from,
                                               const io::ReadOptions& options);
 
-// The text lines `info --order` prints ("width:", "buffer:", "key descents:"), judging
-// `buffer_triangles` for decimation at `ratio`. `flagged_axis`: the axis the file says it is
-// sorted along, if any (without one, a "suffices" warns that hole rims stay open to the end,
-// which the width cannot tell; with one whose keys descend, the claim is called false).
-std::string format_order_text(const OrderReport& report, uint64_t buffer_triangles, double ratio,
-                              std::optional<int> flagged_axis = std::nullopt);
-
-}  // namespace meshstream::tools
+}  // namespace meshstream::compare

@@ -4,7 +4,7 @@
 // is held in memory, and the CLI's exit codes and messages.
 #include "io/error.hpp"
 #include "io/format.hpp"
-#include "tools/metro.hpp"
+#include "compare/metro.hpp"
 
 #include <gtest/gtest.h>
 
@@ -21,7 +21,7 @@
 
 namespace fs = std::filesystem;
 using namespace meshstream;
-using namespace meshstream::tools;
+using namespace meshstream::compare;
 
 namespace {
 
