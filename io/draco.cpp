@@ -1,5 +1,5 @@
-// Draco .drc reader and writer on Draco's own library (draco::Encoder / draco::Decoder),
-// plus the encode/decode helpers io/gltf.cpp uses for KHR_draco_mesh_compression.
+// Draco .drc reader and writer on Draco's own library (draco::Encoder / draco::Decoder), plus
+// the encode/decode helpers the glTF reader and writer use for KHR_draco_mesh_compression.
 // Settings mirror Debian's draco_encoder (speed = 10 - level for both encoder and decoder
 // speed, quantization per attribute) so the output matches it byte for byte on the same mesh.
 #include "io/draco.hpp"

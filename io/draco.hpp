@@ -11,7 +11,7 @@
 // the connectivity method (edgebreaker/sequential), the position quantization bits and the
 // attributes present. Draco point clouds (no faces) are refused with a clear io::Error rather
 // than read as zero triangles, so a point cloud never turns silently into an empty mesh.
-// The encode/decode helpers are shared with io/gltf.cpp (KHR_draco_mesh_compression).
+// The encode/decode helpers are shared with the glTF reader and writer (KHR_draco_mesh_compression).
 #pragma once
 
 #include "io/format.hpp"

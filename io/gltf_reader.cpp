@@ -1,0 +1,762 @@
+// glTF 2.0 reader on tinygltf (JSON parsing and the document model) and Draco
+// (KHR_draco_mesh_compression). tinygltf parses the whole document from memory; the reader
+// walks the default scene, decodes each primitive once and hands out world-space triangles.
+// See gltf.hpp for the contract.
+#include "io/gltf.hpp"
+#include "io/gltf_internal.hpp"
+
+#include "io/byte_stream.hpp"
+#include "io/error.hpp"
+#include "io/text_number.hpp"
+#if MESHSTREAM_WITH_DRACO
+#include "io/draco.hpp"
+#endif
+
+#include <nlohmann/json.hpp>
+#include <tiny_gltf.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstring>
+#include <map>
+#include <memory>
+#include <string_view>
+#include <sys/stat.h>
+
+namespace meshstream::io::gltf_detail {
+namespace {
+
+bool skip_image(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int, void*) {
+    return true;  // geometry only: images are never decoded
+}
+
+// Required extensions that do not change geometry, or that this reader implements.
+bool extension_supported(const std::string& ext) {
+#if MESHSTREAM_WITH_DRACO
+    if (ext == kDracoExtension) return true;
+#endif
+    if (ext == kQuantizationExtension) return true;
+    return ext.starts_with("KHR_materials_") || ext.starts_with("KHR_texture_") || ext.starts_with("EXT_texture_") ||
+           ext == "KHR_lights_punctual";
+}
+
+size_t component_size(int type) {
+    switch (type) {
+        case TINYGLTF_COMPONENT_TYPE_BYTE:
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return 1;
+        case TINYGLTF_COMPONENT_TYPE_SHORT:
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return 2;
+        case TINYGLTF_COMPONENT_TYPE_INT:
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
+        case TINYGLTF_COMPONENT_TYPE_FLOAT: return 4;
+        default: return 0;
+    }
+}
+
+int component_count(int type) {
+    switch (type) {
+        case TINYGLTF_TYPE_SCALAR: return 1;
+        case TINYGLTF_TYPE_VEC2: return 2;
+        case TINYGLTF_TYPE_VEC3: return 3;
+        case TINYGLTF_TYPE_VEC4: return 4;
+        default: return 0;
+    }
+}
+
+// a + b for a message, where the two numbers come from a file and their sum may pass 2^64.
+std::string sum_text(uint64_t a, uint64_t b) {
+    uint64_t sum;
+    return __builtin_add_overflow(a, b, &sum) ? std::to_string(a) + " + " + std::to_string(b) : std::to_string(sum);
+}
+
+// A bounds-checked window onto one accessor's elements.
+struct AccessorView {
+    const unsigned char* base = nullptr;  // null: no bufferView, all zeros (glTF 2.0 §3.6.2.4)
+    size_t stride = 0, count = 0;
+    int component_type = 0, components = 0;
+    bool normalized = false;
+
+    double get(size_t i, int c) const {
+        if (!base) return 0.0;
+        const unsigned char* p = base + i * stride + c * component_size(component_type);
+        switch (component_type) {
+            case TINYGLTF_COMPONENT_TYPE_FLOAT: {
+                float f;
+                std::memcpy(&f, p, 4);
+                return f;
+            }
+            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: return get_u32(p);
+            case TINYGLTF_COMPONENT_TYPE_INT: return static_cast<int32_t>(get_u32(p));
+            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+                double v = uint16_t(p[0] | p[1] << 8);
+                return normalized ? v / 65535.0 : v;
+            }
+            case TINYGLTF_COMPONENT_TYPE_SHORT: {
+                double v = int16_t(uint16_t(p[0] | p[1] << 8));
+                return normalized ? std::max(v / 32767.0, -1.0) : v;
+            }
+            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return normalized ? p[0] / 255.0 : p[0];
+            case TINYGLTF_COMPONENT_TYPE_BYTE: {
+                double v = static_cast<int8_t>(p[0]);
+                return normalized ? std::max(v / 127.0, -1.0) : v;
+            }
+            default: return 0.0;
+        }
+    }
+};
+
+// A primitive in its local space: positions and triangles (strips and fans already unrolled).
+struct PrimitiveGeometry {
+    std::vector<float> positions;
+    std::vector<uint32_t> triangles;
+};
+
+struct Instance {
+    double matrix[16];  // column-major world transform
+    int mesh;
+    const std::vector<double>* weights;  // morph target weights: the node's, else the mesh's
+};
+
+void mat_mul(const double* a, const double* b, double* out) {
+    double r[16];
+    for (int c = 0; c < 4; ++c)
+        for (int row = 0; row < 4; ++row) {
+            double s = 0;
+            for (int k = 0; k < 4; ++k) s += a[k * 4 + row] * b[c * 4 + k];
+            r[c * 4 + row] = s;
+        }
+    std::memcpy(out, r, sizeof r);
+}
+
+void local_matrix(const tinygltf::Node& node, double* m) {
+    if (node.matrix.size() == 16) {
+        for (int i = 0; i < 16; ++i) m[i] = node.matrix[i];
+        return;
+    }
+    double t[3] = {0, 0, 0}, q[4] = {0, 0, 0, 1}, s[3] = {1, 1, 1};
+    if (node.translation.size() == 3)
+        for (int i = 0; i < 3; ++i) t[i] = node.translation[i];
+    if (node.rotation.size() == 4)
+        for (int i = 0; i < 4; ++i) q[i] = node.rotation[i];
+    if (node.scale.size() == 3)
+        for (int i = 0; i < 3; ++i) s[i] = node.scale[i];
+    const double x = q[0], y = q[1], z = q[2], w = q[3];
+    // Rotation matrix of the unit quaternion (x, y, z, w), columns scaled: M = T · R · S.
+    const double r[9] = {1 - 2 * (y * y + z * z), 2 * (x * y + z * w), 2 * (x * z - y * w),
+                         2 * (x * y - z * w), 1 - 2 * (x * x + z * z), 2 * (y * z + x * w),
+                         2 * (x * z + y * w), 2 * (y * z - x * w), 1 - 2 * (x * x + y * y)};
+    for (int c = 0; c < 3; ++c) {
+        for (int row = 0; row < 3; ++row) m[c * 4 + row] = r[c * 3 + row] * s[c];
+        m[c * 4 + 3] = 0;
+    }
+    m[12] = t[0];
+    m[13] = t[1];
+    m[14] = t[2];
+    m[15] = 1;
+}
+
+double det3(const double* m) {
+    return m[0] * (m[5] * m[10] - m[9] * m[6]) - m[4] * (m[1] * m[10] - m[9] * m[2]) + m[8] * (m[1] * m[6] - m[5] * m[2]);
+}
+
+// Required extensions listed in the raw JSON, for a clear refusal when tinygltf itself fails
+// on data only the extension explains (EXT_meshopt_compression's fallback buffers).
+std::vector<std::string> required_extensions_in(std::string_view json) {
+    std::vector<std::string> out;
+    auto doc = nlohmann::json::parse(json, nullptr, false);
+    if (doc.is_discarded() || !doc.is_object() || !doc.contains("extensionsRequired")) return out;
+    for (const auto& e : doc["extensionsRequired"])
+        if (e.is_string()) out.push_back(e.get<std::string>());
+    return out;
+}
+
+// The JSON of a glTF document: the file itself, or a GLB's first chunk (empty when cut short).
+std::string_view json_text(const std::vector<unsigned char>& bytes, bool glb) {
+    const char* text = reinterpret_cast<const char*>(bytes.data());
+    if (!glb) return {text, bytes.size()};
+    if (bytes.size() < 20) return {};
+    return {text + 20, std::min<size_t>(get_u32(&bytes[12]), bytes.size() - 20)};
+}
+
+// Deepest nesting of JSON arrays and objects read. tinygltf (and nlohmann::json under it)
+// recurse once per level when turning the parsed JSON into values, so a document of 15 000
+// '[' overflowed the stack (SIGSEGV); a glTF document needs about 10 levels, extras a few more.
+constexpr size_t kMaxJsonDepth = 512;
+
+// Throws at the first array or object nested deeper than kMaxJsonDepth, before any JSON
+// parser sees `json`, which starts at byte `offset` of the file, and at its end when it ends
+// inside a string or an open array or object (a cut file: tinygltf said only "JSON string
+// too short"). `container` names what ends there: "file" or "JSON chunk". Brackets inside
+// strings (with their escapes) do not count; everything else is left to the parser.
+void check_json_nesting(std::string_view json, uint64_t offset, const std::string& file, const char* container) {
+    size_t depth = 0;
+    bool in_string = false;
+    for (size_t i = 0; i < json.size(); ++i) {
+        const char c = json[i];
+        if (in_string) {
+            if (c == '\\') ++i;  // the escaped character, which may be a quote
+            else if (c == '"') in_string = false;
+        } else if (c == '"') {
+            in_string = true;
+        } else if (c == '[' || c == '{') {
+            if (++depth > kMaxJsonDepth)
+                throw Error(file, offset + i, 0, "JSON nested deeper than " + std::to_string(kMaxJsonDepth) +
+                                                     " arrays and objects (a glTF document needs about 10)");
+        } else if ((c == ']' || c == '}') && depth > 0) {
+            --depth;
+        }
+    }
+    if (in_string || depth > 0)
+        throw Error(file, offset + json.size(), 0, std::string(container) + " ends inside the JSON document (" +
+                                                       (in_string ? "in a string, " : "") + std::to_string(depth) +
+                                                       (depth == 1 ? " array or object" : " arrays or objects") +
+                                                       " still open)");
+}
+
+// Whether some "uri" of the document names something other than a data: URI (a file).
+bool names_files(std::string_view json) {
+    for (size_t at = json.find("\"uri\""); at != std::string_view::npos; at = json.find("\"uri\"", at + 5)) {
+        size_t v = at + 5;
+        while (v < json.size() && (json[v] == ' ' || json[v] == '\t' || json[v] == '\r' || json[v] == '\n' || json[v] == ':'))
+            ++v;
+        if (json.substr(v, 6) != "\"data:") return true;
+    }
+    return false;
+}
+
+// The bytes the document's buffers in other files declare (byteLength of each buffer whose URI
+// is not a data: URI): tinygltf reads them whole, past the budget the document itself is held to.
+// (Parsed only when some URI names a file: a document with embedded buffers, hundreds of MB of
+// base64, is not parsed an extra time.)
+uint64_t external_buffer_bytes(std::string_view json) {
+    if (!names_files(json)) return 0;
+    const auto doc = nlohmann::json::parse(json, nullptr, false);
+    uint64_t total = 0;
+    if (doc.is_discarded() || !doc.is_object() || !doc.contains("buffers") || !doc["buffers"].is_array()) return 0;
+    for (const auto& b : doc["buffers"]) {
+        if (!b.is_object() || !b.contains("uri") || !b["uri"].is_string() || !b.contains("byteLength") ||
+            !b["byteLength"].is_number_unsigned())
+            continue;
+        if (b["uri"].get<std::string>().rfind("data:", 0) == 0) continue;
+        total += b["byteLength"].get<uint64_t>();
+    }
+    return total;
+}
+
+// tinygltf looks each buffer (and image) file up in the directory it is given and then in the
+// current one ("." is always its second search path), so a .gltf whose sub/a.bin was missing
+// quietly read ./a.bin. These file callbacks let through only paths in the document's own
+// directory, as glTF's relative URIs mean, and remember the ones missing there for the error.
+struct DocumentDir {
+    std::string prefix;                // the directory as tinygltf joins it to a URI: "sub/", "./", "/"
+    std::vector<std::string> missing;  // paths asked for in it that do not exist
+};
+
+bool document_file_exists(const std::string& path, void* user) {
+    auto* dir = static_cast<DocumentDir*>(user);
+    if (!path.starts_with(dir->prefix)) return false;
+    struct stat st;
+    if (::stat(path.c_str(), &st) == 0) return true;
+    dir->missing.push_back(path);
+    return false;
+}
+
+// URIs name files as they are: no "~" or "$VAR" expansion (older tinygltf ran wordexp on them).
+std::string unexpanded_path(const std::string& path, void*) { return path; }
+
+bool read_document_file(std::vector<unsigned char>* out, std::string* err, const std::string& path, void* user) {
+    if (!path.starts_with(static_cast<DocumentDir*>(user)->prefix)) return false;
+    return tinygltf::ReadWholeFile(out, err, path, nullptr);
+}
+
+class GltfReader final : public Reader {
+public:
+    GltfReader(ByteSource& source, const ReadOptions& options)
+        : name_(source.name()), budget_bytes_(options.memory_budget_bytes) {
+        std::vector<unsigned char> bytes;
+        unsigned char buf[1 << 16];
+        while (size_t n = source.read(buf, sizeof buf)) {
+            bytes.insert(bytes.end(), buf, buf + n);
+            if (bytes.size() > options.memory_budget_bytes)
+                throw Error(name_, "glTF documents are read whole into memory and this one is over the memory budget of " +
+                                       binary_size(options.memory_budget_bytes) + "; raise --memory");
+        }
+        // A cut inside the magic ("g" of "glTF") is a GLB cut short too: no JSON starts so.
+        const bool glb = !bytes.empty() && std::memcmp(bytes.data(), kGlbMagic, std::min<size_t>(bytes.size(), 4)) == 0;
+        if (glb) {
+            // tinygltf tolerates a GLB shorter than its header says when the cut falls in
+            // padding; a file that disagrees with its own length is truncated or corrupt.
+            if (bytes.size() < 12) throw Error(name_, bytes.size(), 0, "file ends inside the 12-byte GLB header");
+            uint32_t stated = get_u32(&bytes[8]);
+            if (stated != bytes.size())
+                throw Error(name_, 8, 0, "GLB header states " + std::to_string(stated) + " bytes, the file holds " +
+                                             std::to_string(bytes.size()));
+        } else {
+            size_t first = 0;
+            while (first < bytes.size() && std::isspace(bytes[first])) ++first;
+            if (first == bytes.size() || bytes[first] != '{')
+                throw Error(name_, first, 0, "not glTF: expected the GLB magic 'glTF' or a JSON object");
+        }
+        if (!glb && bytes.size() > 0xFFFFFFFFull) throw Error(name_, "glTF JSON over 4 GiB is not supported");
+        // Before any JSON parser runs: ours below (Draco indices, buffer sizes) and tinygltf's.
+        check_json_nesting(json_text(bytes, glb), glb ? 20 : 0, name_, glb ? "JSON chunk" : "file");
+        header_.variant = glb ? "binary (GLB)" : "JSON";
+
+        hide_draco_indices(bytes, glb);
+        if (const uint64_t external = external_buffer_bytes(json_text(bytes, glb));
+            bytes.size() + external > options.memory_budget_bytes)
+            throw Error(name_, "glTF documents are read whole into memory with their buffers: this one and its buffer "
+                               "files take " + binary_size(bytes.size() + external) + ", over the memory budget of " +
+                               binary_size(options.memory_budget_bytes) + "; raise --memory");
+
+        tinygltf::TinyGLTF gltf;
+        gltf.SetImageLoader(&skip_image, nullptr);
+        std::string err, warn;
+        const std::string base_dir = parent_dir(source.name());  // "." for stdin: the current directory
+        DocumentDir files{base_dir.ends_with('/') ? base_dir : base_dir + "/", {}};
+        gltf.SetFsCallbacks({&document_file_exists, &unexpanded_path, &read_document_file, nullptr, &files});
+        bool ok = glb ? gltf.LoadBinaryFromMemory(&model_, &err, &warn, bytes.data(), static_cast<unsigned>(bytes.size()), base_dir)
+                      : gltf.LoadASCIIFromString(&model_, &err, &warn, reinterpret_cast<const char*>(bytes.data()),
+                                                 static_cast<unsigned>(bytes.size()), base_dir);
+        if (!ok) {
+            for (const std::string& ext : required_extensions_in(json_text(bytes, glb)))
+                if (!extension_supported(ext)) throw_unsupported_extension(ext);
+            for (const std::string& path : files.missing)
+                if (err.find("File not found : " + path.substr(files.prefix.size())) != std::string::npos)
+                    throw Error(name_, "buffer file " + path + " does not exist (buffer files are read from the " +
+                                           (name_ == "<stdin>" ? "current directory for a document on stdin)"
+                                                               : "document's directory only)"));
+            while (!err.empty() && (err.back() == '\n' || err.back() == ' ')) err.pop_back();
+            // tinygltf quotes the document: a bad data URI came back whole (1.1 MB for the
+            // bunny's buffer), with whatever bytes the file held.
+            throw Error(name_, "invalid glTF: " +
+                                   (err.empty() ? std::string("tinygltf failed to parse it") : printable(err, 400)));
+        }
+        bytes = std::vector<unsigned char>();  // the file is parsed: free it (`= {}` keeps the capacity)
+        for (const std::string& ext : model_.extensionsRequired)
+            if (!extension_supported(ext)) throw_unsupported_extension(ext);
+
+        collect_instances();
+        uint64_t triangles = 0;
+        for (const Instance& inst : instances_)
+            for (size_t p = 0; p < model_.meshes[inst.mesh].primitives.size(); ++p)
+                triangles += primitive_triangle_count(inst.mesh, static_cast<int>(p));
+        header_.triangle_count = triangles;
+        header_.notes.emplace_back("instances", std::to_string(instances_.size()) + " mesh instance(s) of " +
+                                                    std::to_string(model_.meshes.size()) + " mesh(es)");
+        if (!model_.asset.generator.empty()) header_.notes.emplace_back("generator", model_.asset.generator);
+        // Draco settings, from the first Draco primitive of the scene (decoded now, then cached).
+        for (const Instance& inst : instances_) {
+            const auto& prims = model_.meshes[inst.mesh].primitives;
+            auto it = std::find_if(prims.begin(), prims.end(), [this](const tinygltf::Primitive& p) { return is_draco(p); });
+            if (it == prims.end()) continue;
+            geometry(inst.mesh, static_cast<int>(it - prims.begin()));
+            header_.notes.emplace_back("draco", draco_settings_);
+            break;
+        }
+        std::string used;
+        for (const std::string& e : model_.extensionsUsed) used += (used.empty() ? "" : ", ") + e;
+        if (!used.empty()) header_.notes.emplace_back("extensions", used);
+    }
+
+    bool next(TriangleChunk& chunk) override;
+
+private:
+    void hide_draco_indices(std::vector<unsigned char>& bytes, bool glb);
+    [[noreturn]] void throw_unsupported_extension(const std::string& ext) const {
+#if !MESHSTREAM_WITH_DRACO
+        if (ext == kDracoExtension)
+            throw Error(name_, "requires extension KHR_draco_mesh_compression, but this meshstream was built without Draco");
+#endif
+        throw Error(name_, "requires extension " + ext + ", which meshstream does not support");
+    }
+    std::string where(int mesh, int prim) const {
+        std::string s = "mesh " + std::to_string(mesh);
+        if (!model_.meshes[mesh].name.empty()) s += " '" + model_.meshes[mesh].name + "'";
+        return s + " primitive " + std::to_string(prim);
+    }
+    void collect_instances();
+    void visit(int node, const double* parent, int depth);
+    bool is_draco(const tinygltf::Primitive& p) const {
+#if MESHSTREAM_WITH_DRACO
+        return p.extensions.count(kDracoExtension) > 0;
+#else
+        (void)p;
+        return false;
+#endif
+    }
+    int mode_of(int mesh, int prim) const;
+    uint64_t primitive_triangle_count(int mesh, int prim) const;
+    AccessorView view(int accessor, const std::string& what) const;
+    std::shared_ptr<const PrimitiveGeometry> geometry(int mesh, int prim);
+    void load_current();
+
+    std::string name_;
+    uint64_t budget_bytes_;  // --memory
+    tinygltf::Model model_;
+    std::vector<Instance> instances_;
+    std::map<std::pair<int, int>, std::shared_ptr<const PrimitiveGeometry>> draco_cache_;
+    std::map<std::pair<int, int>, int> draco_indices_;
+    std::string draco_settings_;  // of the first Draco primitive decoded, for `info`  // (mesh, primitive) -> hidden indices accessor
+    // Streaming position: instance, primitive, triangle; world-space positions of the current one.
+    size_t inst_ = 0, prim_ = 0, tri_ = 0;
+    bool loaded_ = false;
+    bool flip_ = false;
+    std::shared_ptr<const PrimitiveGeometry> current_;
+    std::vector<float> world_;
+};
+
+// tinygltf 2.7 rejects an index accessor without a bufferView ("accessor[0] invalid
+// bufferView"), which is exactly what KHR_draco_mesh_compression primitives have: the indices
+// live in the Draco blob. So the "indices" of Draco primitives are taken out of the JSON before
+// tinygltf parses it and remembered here (they only state the triangle count).
+void GltfReader::hide_draco_indices(std::vector<unsigned char>& bytes, bool glb) {
+    size_t json_begin = 0, json_size = bytes.size();
+    if (glb) {
+        if (bytes.size() < 20 || get_u32(&bytes[16]) != kChunkJson) return;  // tinygltf reports it
+        json_begin = 20;
+        json_size = get_u32(&bytes[12]);
+        if (json_size > bytes.size() - 20) return;
+    }
+    std::string_view json(reinterpret_cast<const char*>(bytes.data()) + json_begin, json_size);
+    if (json.find(kDracoExtension) == std::string_view::npos) return;
+    auto doc = nlohmann::ordered_json::parse(json, nullptr, false);
+    if (doc.is_discarded() || !doc.is_object() || !doc.contains("meshes") || !doc["meshes"].is_array()) return;
+    bool changed = false;
+    for (size_t m = 0; m < doc["meshes"].size(); ++m) {
+        auto& mesh = doc["meshes"][m];
+        if (!mesh.is_object() || !mesh.contains("primitives") || !mesh["primitives"].is_array()) continue;
+        for (size_t p = 0; p < mesh["primitives"].size(); ++p) {
+            auto& prim = mesh["primitives"][p];
+            if (!prim.is_object() || !prim.contains("extensions") || !prim["extensions"].is_object() ||
+                !prim["extensions"].contains(kDracoExtension) || !prim.contains("indices") ||
+                !prim["indices"].is_number_integer())
+                continue;
+            draco_indices_[{int(m), int(p)}] = prim["indices"].get<int>();
+            prim.erase("indices");
+            changed = true;
+        }
+    }
+    if (!changed) return;
+    std::string text = doc.dump();
+    if (!glb) {
+        bytes.assign(text.begin(), text.end());
+        return;
+    }
+    while (text.size() % 4) text.push_back(' ');
+    std::string head;
+    head.append(kGlbMagic, 4);
+    put_u32(head, 2);
+    const size_t rest = bytes.size() - 20 - json_size;  // the BIN chunk and anything after
+    put_u32(head, static_cast<uint32_t>(20 + text.size() + rest));
+    put_u32(head, static_cast<uint32_t>(text.size()));
+    put_u32(head, kChunkJson);
+    std::vector<unsigned char> out;
+    out.reserve(head.size() + text.size() + rest);
+    out.insert(out.end(), head.begin(), head.end());
+    out.insert(out.end(), text.begin(), text.end());
+    out.insert(out.end(), bytes.begin() + 20 + json_size, bytes.end());
+    bytes.swap(out);
+}
+
+void GltfReader::collect_instances() {
+    const double identity[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+    if (model_.scenes.empty()) {
+        // No scene: nothing says how meshes are placed; take each mesh once, untransformed.
+        for (size_t m = 0; m < model_.meshes.size(); ++m) {
+            Instance inst;
+            std::memcpy(inst.matrix, identity, sizeof identity);
+            inst.mesh = static_cast<int>(m);
+            inst.weights = &model_.meshes[m].weights;
+            instances_.push_back(inst);
+        }
+        return;
+    }
+    int scene = model_.defaultScene >= 0 ? model_.defaultScene : 0;
+    if (scene >= static_cast<int>(model_.scenes.size()))
+        throw Error(name_, "default scene " + std::to_string(scene) + " does not exist");
+    for (int node : model_.scenes[scene].nodes) visit(node, identity, 0);
+}
+
+void GltfReader::visit(int node, const double* parent, int depth) {
+    if (node < 0 || node >= static_cast<int>(model_.nodes.size()))
+        throw Error(name_, "scene refers to node " + std::to_string(node) + ", which does not exist");
+    if (depth > static_cast<int>(model_.nodes.size())) throw Error(name_, "node hierarchy has a cycle at node " + std::to_string(node));
+    const tinygltf::Node& n = model_.nodes[node];
+    double local[16], world[16];
+    local_matrix(n, local);
+    mat_mul(parent, local, world);
+    if (n.mesh >= 0) {
+        if (n.mesh >= static_cast<int>(model_.meshes.size()))
+            throw Error(name_, "node " + std::to_string(node) + " refers to mesh " + std::to_string(n.mesh) + ", which does not exist");
+        Instance inst;
+        // glTF 2.0 §3.7.3.3: a skinned mesh ignores its node's transform (only joints move it).
+        // Joint transforms are not applied: the mesh is read in its bind pose, as stored.
+        static constexpr double kIdentity[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+        std::memcpy(inst.matrix, n.skin >= 0 ? kIdentity : world, sizeof world);
+        inst.mesh = n.mesh;
+        inst.weights = n.weights.empty() ? &model_.meshes[n.mesh].weights : &n.weights;
+        instances_.push_back(inst);
+    }
+    for (int child : n.children) visit(child, world, depth + 1);
+}
+
+int GltfReader::mode_of(int mesh, int prim) const {
+    int mode = model_.meshes[mesh].primitives[prim].mode;
+    if (mode == -1) mode = TINYGLTF_MODE_TRIANGLES;  // the default when absent
+    static const char* kNames[] = {"POINTS", "LINES", "LINE_LOOP", "LINE_STRIP"};
+    if (mode >= 0 && mode <= 3)
+        throw Error(name_, where(mesh, prim) + " has mode " + kNames[mode] + " (" + std::to_string(mode) +
+                               "); only TRIANGLES, TRIANGLE_STRIP and TRIANGLE_FAN are supported");
+    if (mode > 6) throw Error(name_, where(mesh, prim) + " has unknown mode " + std::to_string(mode));
+    if (is_draco(model_.meshes[mesh].primitives[prim]) && mode != TINYGLTF_MODE_TRIANGLES)
+        throw Error(name_, where(mesh, prim) + ": KHR_draco_mesh_compression with mode " + std::to_string(mode) +
+                               " is not supported (only TRIANGLES)");
+    return mode;
+}
+
+uint64_t GltfReader::primitive_triangle_count(int mesh, int prim) const {
+    const tinygltf::Primitive& p = model_.meshes[mesh].primitives[prim];
+    int mode = mode_of(mesh, prim);
+    auto pos = p.attributes.find("POSITION");
+    if (pos == p.attributes.end()) throw Error(name_, where(mesh, prim) + " has no POSITION attribute");
+    int acc = p.indices >= 0 ? p.indices : pos->second;
+    if (auto hidden = draco_indices_.find({mesh, prim}); hidden != draco_indices_.end()) acc = hidden->second;
+    if (acc < 0 || acc >= static_cast<int>(model_.accessors.size()))
+        throw Error(name_, where(mesh, prim) + " refers to accessor " + std::to_string(acc) + ", which does not exist");
+    uint64_t n = model_.accessors[acc].count;
+    if (mode == TINYGLTF_MODE_TRIANGLES) {
+        if (n % 3) throw Error(name_, where(mesh, prim) + ": TRIANGLES with " + std::to_string(n) + " vertices, not a multiple of 3");
+        return n / 3;
+    }
+    return n >= 3 ? n - 2 : 0;
+}
+
+AccessorView GltfReader::view(int accessor, const std::string& what) const {
+    if (accessor < 0 || accessor >= static_cast<int>(model_.accessors.size()))
+        throw Error(name_, what + " refers to accessor " + std::to_string(accessor) + ", which does not exist");
+    const tinygltf::Accessor& a = model_.accessors[accessor];
+    std::string where_acc = what + " (accessor " + std::to_string(accessor) + ")";
+    if (a.sparse.isSparse) throw Error(name_, where_acc + " is sparse; sparse accessors are not supported");
+    AccessorView v;
+    v.count = a.count;
+    v.component_type = a.componentType;
+    v.components = component_count(a.type);
+    v.normalized = a.normalized;
+    size_t csize = component_size(a.componentType);
+    if (csize == 0 || v.components == 0)
+        throw Error(name_, where_acc + " has unsupported component type " + std::to_string(a.componentType) + " / type " +
+                               std::to_string(a.type));
+    if (a.bufferView < 0) {
+        // All zeros: nothing is stored, so only the count bounds what is decoded (4 bytes a
+        // component), and a 200-byte file could ask for 8 GB, or for 2^64 / 3 + 1 vertices,
+        // whose float count wrapped to 2 and was written past. Held to --memory, as files are.
+        if (a.count > budget_bytes_ / (4 * uint64_t(v.components)))
+            throw Error(name_, where_acc + " has no bufferView (all zeros) and count " + std::to_string(a.count) +
+                                   ", over the memory budget of " + binary_size(budget_bytes_) +
+                                   " once decoded; raise --memory");
+        return v;
+    }
+    if (a.bufferView >= static_cast<int>(model_.bufferViews.size()))
+        throw Error(name_, where_acc + " refers to bufferView " + std::to_string(a.bufferView) + ", which does not exist");
+    const tinygltf::BufferView& bv = model_.bufferViews[a.bufferView];
+    if (bv.buffer < 0 || bv.buffer >= static_cast<int>(model_.buffers.size()))
+        throw Error(name_, where_acc + ": bufferView refers to a missing buffer");
+    const std::vector<unsigned char>& data = model_.buffers[bv.buffer].data;
+    const size_t elem = csize * v.components;
+    // glTF 2.0 §3.6.2.4: a stride spaces elements apart, it never overlaps them (the validator's
+    // ACCESSOR_SMALL_BYTESTRIDE); byteStride 4 under VEC3 floats read each from the last one's y.
+    if (bv.byteStride != 0 && bv.byteStride < elem)
+        throw Error(name_, where_acc + ": bufferView " + std::to_string(a.bufferView) + " has byteStride " +
+                               std::to_string(bv.byteStride) + ", less than the accessor's " + std::to_string(elem) +
+                               "-byte elements");
+    v.stride = bv.byteStride ? bv.byteStride : elem;
+    // Offsets, lengths and the count are 64-bit numbers from the JSON, so no sum or product of
+    // them may wrap: a byteOffset near 2^64 made the view start before its buffer.
+    const uint64_t view_offset = bv.byteOffset, view_length = bv.byteLength;
+    if (view_offset > data.size() || view_length > data.size() - view_offset)
+        throw Error(name_, where_acc + ": bufferView " + std::to_string(a.bufferView) + " ends at byte " +
+                               sum_text(view_offset, view_length) + ", past the end of buffer " + std::to_string(bv.buffer) +
+                               " (" + std::to_string(data.size()) + " bytes)");
+    uint64_t end = a.byteOffset, span = 0;  // the end of the last element, from the view's start
+    const bool wraps = a.count > 0 && (__builtin_mul_overflow(uint64_t{a.count - 1}, uint64_t{v.stride}, &span) ||
+                                       __builtin_add_overflow(span, uint64_t{elem}, &span) ||
+                                       __builtin_add_overflow(end, span, &end));
+    if (wraps || end > view_length)
+        throw Error(name_, where_acc + " reaches byte " + (wraps ? std::string("2^64 or more") : sum_text(view_offset, end)) +
+                               " of a buffer view ending at " + std::to_string(view_offset + view_length));
+    v.base = data.data() + bv.byteOffset + a.byteOffset;
+    return v;
+}
+
+std::shared_ptr<const PrimitiveGeometry> GltfReader::geometry(int mesh, int prim) {
+    const tinygltf::Primitive& p = model_.meshes[mesh].primitives[prim];
+    const int mode = mode_of(mesh, prim);
+    const std::string at = where(mesh, prim);
+    auto geo = std::make_shared<PrimitiveGeometry>();
+#if MESHSTREAM_WITH_DRACO
+    if (is_draco(p)) {
+        auto cached = draco_cache_.find({mesh, prim});
+        if (cached != draco_cache_.end()) return cached->second;
+        const tinygltf::Value& ext = p.extensions.at(kDracoExtension);
+        const tinygltf::Value& bvv = ext.Get("bufferView");
+        const tinygltf::Value& attrs = ext.Get("attributes");
+        if (!bvv.IsInt() || !attrs.IsObject() || !attrs.Get("POSITION").IsInt())
+            throw Error(name_, at + ": KHR_draco_mesh_compression needs an integer bufferView and attributes.POSITION");
+        int bvi = bvv.Get<int>();
+        if (bvi < 0 || bvi >= static_cast<int>(model_.bufferViews.size()))
+            throw Error(name_, at + ": KHR_draco_mesh_compression refers to bufferView " + std::to_string(bvi) + ", which does not exist");
+        const tinygltf::BufferView& bv = model_.bufferViews[bvi];
+        if (bv.buffer < 0 || bv.buffer >= static_cast<int>(model_.buffers.size()) ||
+            bv.byteOffset > model_.buffers[bv.buffer].data.size() ||
+            bv.byteLength > model_.buffers[bv.buffer].data.size() - bv.byteOffset)  // no sum to wrap
+            throw Error(name_, at + ": KHR_draco_mesh_compression bufferView " + std::to_string(bvi) + " lies outside its buffer");
+        const auto* start = reinterpret_cast<const std::byte*>(model_.buffers[bv.buffer].data.data() + bv.byteOffset);
+        DracoDecoded d;
+        try {
+            d = decode_draco({start, bv.byteLength}, name_, 0, attrs.Get("POSITION").Get<int>());
+        } catch (const Error& e) {
+            throw Error(name_, at + " (KHR_draco_mesh_compression): " + e.message());
+        }
+        uint64_t stated = primitive_triangle_count(mesh, prim);
+        if (d.indices.size() / 3 != stated)
+            throw Error(name_, at + ": accessors state " + std::to_string(stated) + " triangles, the Draco data holds " +
+                                   std::to_string(d.indices.size() / 3));
+        if (draco_settings_.empty())
+            draco_settings_ = "bitstream " + std::to_string(d.version_major) + "." + std::to_string(d.version_minor) + ", " +
+                              (d.edgebreaker ? "edgebreaker" : "sequential") + " connectivity, positions " +
+                              (d.position_bits ? std::to_string(d.position_bits) + " bits" : std::string("not quantized")) +
+                              " (" + at + ")";
+        geo->positions = std::move(d.positions);
+        geo->triangles = std::move(d.indices);
+        draco_cache_[{mesh, prim}] = geo;
+        return geo;
+    }
+#endif
+    AccessorView pos = view(p.attributes.at("POSITION"), at + " POSITION");
+    if (pos.components != 3) throw Error(name_, at + " POSITION is not VEC3");
+    if (pos.component_type != TINYGLTF_COMPONENT_TYPE_FLOAT) {
+        bool quantized = std::find(model_.extensionsUsed.begin(), model_.extensionsUsed.end(), kQuantizationExtension) !=
+                         model_.extensionsUsed.end();
+        bool integer = pos.component_type != TINYGLTF_COMPONENT_TYPE_INT && pos.component_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
+        if (!quantized || !integer)
+            throw Error(name_, at + " POSITION has component type " + std::to_string(pos.component_type) +
+                                   " (allowed: FLOAT, or 8/16-bit integers with KHR_mesh_quantization)");
+    }
+    geo->positions.resize(pos.count * 3);
+    for (size_t i = 0; i < pos.count; ++i)
+        for (int c = 0; c < 3; ++c) geo->positions[3 * i + c] = static_cast<float>(pos.get(i, c));
+
+    std::vector<uint32_t> order;  // the vertex sequence the mode walks
+    if (p.indices >= 0) {
+        AccessorView idx = view(p.indices, at + " indices");
+        if (idx.components != 1 || (idx.component_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
+                                    idx.component_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+                                    idx.component_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT))
+            throw Error(name_, at + " indices must be unsigned byte/short/int scalars");
+        order.resize(idx.count);
+        for (size_t i = 0; i < idx.count; ++i) {
+            double v = idx.get(i, 0);
+            if (v >= static_cast<double>(pos.count))
+                throw Error(name_, at + " index " + std::to_string(i) + " is " + std::to_string(uint64_t(v)) + ", but POSITION has " +
+                                       std::to_string(pos.count) + " vertices");
+            order[i] = static_cast<uint32_t>(v);
+        }
+    } else {
+        order.resize(pos.count);
+        for (size_t i = 0; i < pos.count; ++i) order[i] = static_cast<uint32_t>(i);
+    }
+    const size_t n = order.size();
+    if (mode == TINYGLTF_MODE_TRIANGLES) {
+        geo->triangles = std::move(order);
+    } else if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
+        // glTF 2.0 §3.7.2.1: triangle i is (v_i, v_{i+1+i%2}, v_{i+2-i%2}), keeping one winding.
+        for (size_t i = 0; i + 2 < n; ++i) {
+            uint32_t t[3] = {order[i], order[i + 1 + i % 2], order[i + 2 - i % 2]};
+            geo->triangles.insert(geo->triangles.end(), t, t + 3);
+        }
+    } else {  // TRIANGLE_FAN: (v_{i+1}, v_{i+2}, v_0)
+        for (size_t i = 0; i + 2 < n; ++i) {
+            uint32_t t[3] = {order[i + 1], order[i + 2], order[0]};
+            geo->triangles.insert(geo->triangles.end(), t, t + 3);
+        }
+    }
+    return geo;
+}
+
+void GltfReader::load_current() {
+    const Instance& inst = instances_[inst_];
+    current_ = geometry(inst.mesh, static_cast<int>(prim_));
+    const double* m = inst.matrix;
+    // A mirroring transform reverses the winding (glTF 2.0 §3.7.4); swap two corners back.
+    flip_ = det3(m) < 0;
+    const auto& src = current_->positions;
+    // Morph targets at the default weights (glTF 2.0 §3.7.2.2): the pose a viewer shows.
+    std::vector<double> morphed;
+    const tinygltf::Primitive& p = model_.meshes[inst.mesh].primitives[prim_];
+    for (size_t t = 0; t < p.targets.size() && t < inst.weights->size(); ++t) {
+        const double w = (*inst.weights)[t];
+        auto target = p.targets[t].find("POSITION");
+        if (w == 0 || target == p.targets[t].end()) continue;
+        const std::string at = where(inst.mesh, static_cast<int>(prim_)) + " morph target " + std::to_string(t);
+        if (is_draco(p)) {  // Draco reorders the vertices the target's displacements refer to
+            std::string weight;
+            append_number(weight, w);
+            throw Error(name_, at + " has weight " + weight +
+                                   ": morph targets of KHR_draco_mesh_compression primitives are not supported");
+        }
+        const AccessorView d = view(target->second, at + " POSITION");
+        if (d.components != 3 || d.count != src.size() / 3)
+            throw Error(name_, at + " POSITION must be VEC3 with as many elements as POSITION (" +
+                                   std::to_string(src.size() / 3) + ")");
+        if (morphed.empty()) morphed.assign(src.begin(), src.end());
+        for (size_t i = 0; i < d.count; ++i)
+            for (int c = 0; c < 3; ++c) morphed[3 * i + c] += w * d.get(i, c);
+    }
+    world_.resize(src.size());
+    for (size_t i = 0; i < src.size(); i += 3) {
+        double x = src[i], y = src[i + 1], z = src[i + 2];
+        if (!morphed.empty()) x = morphed[i], y = morphed[i + 1], z = morphed[i + 2];
+        for (int r = 0; r < 3; ++r) world_[i + r] = static_cast<float>(m[r] * x + m[4 + r] * y + m[8 + r] * z + m[12 + r]);
+    }
+    tri_ = 0;
+    loaded_ = true;
+}
+
+bool GltfReader::next(TriangleChunk& chunk) {
+    chunk.clear();
+    while (!chunk.full() && inst_ < instances_.size()) {
+        const tinygltf::Mesh& mesh = model_.meshes[instances_[inst_].mesh];
+        if (prim_ >= mesh.primitives.size()) {
+            ++inst_;
+            prim_ = 0;
+            loaded_ = false;
+            continue;
+        }
+        if (!loaded_) load_current();
+        const std::vector<uint32_t>& t = current_->triangles;
+        const size_t count = t.size() / 3;
+        while (tri_ < count && !chunk.full()) {
+            float* dst = chunk.push_slot();
+            uint32_t v[3] = {t[3 * tri_], t[3 * tri_ + 1], t[3 * tri_ + 2]};
+            if (flip_) std::swap(v[1], v[2]);
+            for (int k = 0; k < 3; ++k) std::memcpy(dst + 3 * k, &world_[3 * size_t{v[k]}], 3 * sizeof(float));
+            ++tri_;
+        }
+        if (tri_ == count) {
+            ++prim_;
+            loaded_ = false;
+        }
+    }
+    return !chunk.empty();
+}
+
+
+}  // namespace
+
+std::unique_ptr<Reader> open_gltf_reader(ByteSource& source, const ReadOptions& options) {
+    return std::make_unique<GltfReader>(source, options);
+}
+
+}  // namespace meshstream::io::gltf_detail
