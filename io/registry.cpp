@@ -5,6 +5,7 @@
 #include "io/obj.hpp"
 #include "io/ply.hpp"
 #include "io/stl.hpp"
+#include "io/triangle_stream.hpp"
 #if MESHSTREAM_WITH_DRACO
 #include "io/draco.hpp"
 #endif
@@ -29,6 +30,7 @@ constexpr const Format* kFormats[] = {
     &kPlyFormat,
     &kPlyAsciiFormat,
     &kObjFormat,
+    &kTriangleStreamFormat,
     &kStlFormat,
     &kStlAsciiFormat,
 };
