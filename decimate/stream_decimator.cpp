@@ -49,9 +49,16 @@ double choose_ratio(const Options& options, std::optional<uint64_t> input_count)
 }  // namespace
 
 StreamDecimator::StreamDecimator(const Options& options, std::optional<uint64_t> input_triangle_count)
-    : options_(checked(options, input_triangle_count)),
-      input_count_(input_triangle_count),
-      ratio_(choose_ratio(options, input_triangle_count)),
+    : StreamDecimator(options, io::InputCount{input_triangle_count}, nullptr) {}
+
+StreamDecimator::StreamDecimator(const Options& options, const io::InputCount& input)
+    : StreamDecimator(options, io::InputCount{input.promised}, &input) {}
+
+StreamDecimator::StreamDecimator(const Options& options, io::InputCount own, const io::InputCount* input)
+    : options_(checked(options, own.promised)),
+      own_count_(own),
+      input_(input != nullptr ? input : &own_count_),
+      ratio_(choose_ratio(options, own.promised)),
       buffer_(options.buffer_triangles, options.weld_eps),
       rng_(options.seed),
       output_(options.output_chunk_triangles) {
@@ -231,16 +238,16 @@ void StreamDecimator::write_one(const Emit& out, bool allow_forced) {
     stats_.vertices_moved += write_face(buffer_, f, next_id_, output_, out);
 }
 
-void StreamDecimator::follow_skipped() {
-    if (!options_.target || skipped_ == 0 || *input_count_ == 0) return;
+void StreamDecimator::follow_dropped() {
+    if (!options_.target || input_->dropped == 0 || *input_->promised == 0) return;
     // The most the input can still hold: never below the triangles already read, so the
     // writes this ratio allows never pass the target.
-    const uint64_t usable = *input_count_ - std::min(*input_count_, skipped_);
+    const uint64_t usable = *input_->usable();
     ratio_ = usable > 0 ? std::min(1.0, double(*options_.target) / double(usable)) : 1.0;
 }
 
 void StreamDecimator::make_room(const Emit& out) {
-    follow_skipped();
+    follow_dropped();
     if (options_.sorted_axis) sweep();
     const RoomPlan plan = plan_full_buffer(buffer_.face_capacity(), ratio_, stats_.triangles_in,
                                            output_.triangle_count());

@@ -15,6 +15,7 @@
 #include "decimate/random.hpp"
 #include "decimate/writing.hpp"
 #include "io/chunk.hpp"
+#include "io/input_count.hpp"
 
 #include <cmath>
 #include <cstddef>
@@ -68,17 +69,19 @@ public:
     // Options outside their ranges throw std::invalid_argument. Allocates every buffer once;
     // see halfedge_buffer.hpp for the bound (about 470 bytes reserved per buffer triangle).
     StreamDecimator(const Options& options, std::optional<uint64_t> input_triangle_count);
+    // The same for input that passes a read loop (io::TriangleInput) which may drop triangles
+    // on the way: `input` (observed, must outlive this) says what its header promised and how
+    // many were dropped so far. With Options::target the ratio becomes target / (promised −
+    // dropped so far), so the output lands on the target when the dropped ones come early or
+    // spread through the input; ones that all come late leave it short (the mesh before them
+    // was decimated for more input).
+    StreamDecimator(const Options& options, const io::InputCount& input);
 
     // Reads every triangle of `in` (positions only; other channels are ignored), decimating
     // and writing to `out` as the schedule demands. Every coordinate must be finite, else it
     // throws std::invalid_argument before reading any: NaN/inf corners can be neither welded
     // nor finalized (the commands drop them first with tools::TriangleFilter).
     void push(const io::TriangleChunk& in, const Emit& out);
-    // Input triangles the caller dropped instead of pushing (non-finite, degenerate). With
-    // Options::target the ratio becomes target / (input count − skipped so far), so the output
-    // lands on the target when the dropped ones come early or spread through the input; ones
-    // that all come late leave it short (the mesh before them was decimated for more input).
-    void skipped(uint64_t count) { skipped_ += count; }
     // End of input: decimates to the target (as close as the mesh allows: see Stats), writes
     // the rest, flushes `out`.
     // Call once; push() or finish() after it throw std::logic_error.
@@ -87,20 +90,21 @@ public:
     const Stats& stats() const { return stats_; }
     // round(ratio · input_triangle_count): the output size finish() lands on.
     static uint64_t expected_output(double ratio, uint64_t input_triangle_count);
-    // The ratio in use (target / input count with Options::target, less what was skipped()).
+    // The ratio in use (target / input count with Options::target, less what was dropped).
     double ratio() const { return ratio_; }
 
 private:
+    StreamDecimator(const Options& options, io::InputCount own, const io::InputCount* input);
     void read_triangle(const float tri[9], const size_t slots[3], const Emit& out);
     void make_room(const Emit& out);
     void write_one(const Emit& out, bool allow_forced);
     void sweep();
     void track_sweep(const float tri[9]);
-    void follow_skipped();
+    void follow_dropped();
 
     Options options_;
-    std::optional<uint64_t> input_count_;
-    uint64_t skipped_ = 0;
+    io::InputCount own_count_;         // the count given to the first constructor
+    const io::InputCount* input_;      // own_count_ or the caller's read loop's
     double ratio_;
     HalfEdgeBuffer buffer_;
     Rng rng_;

@@ -55,6 +55,9 @@ struct MeshHeader {
     std::vector<Material> materials;         // the table the material channel indexes
     std::string variant;                     // e.g. "binary", "ascii", "binary_big_endian"
     std::vector<std::pair<std::string, std::string>> notes;  // extra facts for `info`
+    // Files besides the input that the reader read (a .gltf's buffer files, an OBJ's .mtl and
+    // textures), so the commands can refuse an output that would overwrite one of them.
+    std::vector<std::string> side_files;
     // Set by readers of double coordinates (PLY) once they are read: the largest change that
     // rounding them to float made (0: none). The commands warn when it is above 0.
     std::optional<double> coordinate_rounding;
@@ -166,6 +169,9 @@ struct Format {
     // Of the channels `in`, those the writer keeps (with the options it will be given: glTF
     // with Draco keeps fewer). Null: positions only (vertex ids are a hint, never "kept").
     Channels (*keep_channels)(const Channels& in, const WriteOptions& options) = nullptr;
+    // The files the writer creates or replaces beside an output at `path` (a .gltf's .bin),
+    // so the commands can refuse an output that would overwrite an input. Null: none.
+    std::vector<std::string> (*side_files)(const std::string& path, const WriteOptions& options) = nullptr;
 };
 
 // All registered formats, in probe priority order.

@@ -17,7 +17,7 @@ const Format kGlbFormat = {
 
 const Format kGltfFormat = {
     "gltf", "gltf", "glTF 2.0 JSON + .bin (Draco by default; whole mesh in memory)", &probe_gltf_json, &gltf_detail::open_gltf_reader,
-    &gltf_detail::open_gltf_writer, Format::kDracoUnlessOff,
+    &gltf_detail::open_gltf_writer, Format::kDracoUnlessOff, nullptr, nullptr, &gltf_detail::gltf_side_files,
 };
 
 bool probe_glb(std::span<const std::byte> head, std::optional<uint64_t>) {

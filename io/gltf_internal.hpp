@@ -30,5 +30,7 @@ std::unique_ptr<Reader> open_gltf_reader(ByteSource& source, const ReadOptions& 
 // io/gltf_writer.cpp.
 std::unique_ptr<Writer> open_glb_writer(ByteSink& sink, const WriteOptions& options);
 std::unique_ptr<Writer> open_gltf_writer(ByteSink& sink, const WriteOptions& options);
+// The .bin a .gltf output at `path` writes beside it (none when written in place).
+std::vector<std::string> gltf_side_files(const std::string& path, const WriteOptions& options);
 
 }  // namespace meshstream::io::gltf_detail

@@ -251,6 +251,7 @@ uint64_t external_buffer_bytes(std::string_view json) {
 struct DocumentDir {
     std::string prefix;                // the directory as tinygltf joins it to a URI: "sub/", "./", "/"
     std::vector<std::string> missing;  // paths asked for in it that do not exist
+    std::vector<std::string> read;     // paths read (MeshHeader::side_files)
 };
 
 bool document_file_exists(const std::string& path, void* user) {
@@ -266,7 +267,9 @@ bool document_file_exists(const std::string& path, void* user) {
 std::string unexpanded_path(const std::string& path, void*) { return path; }
 
 bool read_document_file(std::vector<unsigned char>* out, std::string* err, const std::string& path, void* user) {
-    if (!path.starts_with(static_cast<DocumentDir*>(user)->prefix)) return false;
+    auto* dir = static_cast<DocumentDir*>(user);
+    if (!path.starts_with(dir->prefix)) return false;
+    dir->read.push_back(path);
     return tinygltf::ReadWholeFile(out, err, path, nullptr);
 }
 
@@ -314,7 +317,7 @@ public:
         gltf.SetImageLoader(&skip_image, nullptr);
         std::string err, warn;
         const std::string base_dir = parent_dir(source.name());  // "." for stdin: the current directory
-        DocumentDir files{base_dir.ends_with('/') ? base_dir : base_dir + "/", {}};
+        DocumentDir files{base_dir.ends_with('/') ? base_dir : base_dir + "/", {}, {}};
         gltf.SetFsCallbacks({&document_file_exists, &unexpanded_path, &read_document_file, nullptr, &files});
         bool ok = glb ? gltf.LoadBinaryFromMemory(&model_, &err, &warn, bytes.data(), static_cast<unsigned>(bytes.size()), base_dir)
                       : gltf.LoadASCIIFromString(&model_, &err, &warn, reinterpret_cast<const char*>(bytes.data()),
@@ -333,6 +336,7 @@ public:
             throw Error(name_, "invalid glTF: " +
                                    (err.empty() ? std::string("tinygltf failed to parse it") : printable(err, 400)));
         }
+        header_.side_files = files.read;
         bytes = std::vector<unsigned char>();  // the file is parsed: free it (`= {}` keeps the capacity)
         for (const std::string& ext : model_.extensionsRequired)
             if (!extension_supported(ext)) throw_unsupported_extension(ext);

@@ -388,6 +388,11 @@ std::unique_ptr<Writer> open_glb_writer(ByteSink& sink, const WriteOptions& opti
     return std::make_unique<GltfWriter>(sink, options, true);
 }
 
+std::vector<std::string> gltf_side_files(const std::string& path, const WriteOptions&) {
+    // Written in place (stdout, a pipe, a device), the buffer goes inside, as a data URI.
+    return is_stream(path) ? std::vector<std::string>{} : std::vector<std::string>{bin_path_for(path)};
+}
+
 std::unique_ptr<Writer> open_gltf_writer(ByteSink& sink, const WriteOptions& options) {
     return std::make_unique<GltfWriter>(sink, options, false);
 }

@@ -1,6 +1,8 @@
 // Shared CLI helpers: option groups, sizes, progress bar, warnings.
 #include "tools/common.hpp"
 
+#include "io/triangle_stream.hpp"
+
 #include <charconv>
 #include <cstdlib>
 #include <cmath>
@@ -96,13 +98,75 @@ void note_unused_write_flags(const WriteFlags& flags, const io::Format& output, 
                       " to Draco and glTF outputs only: ignored for " + std::string(output.name));
 }
 
-void require_output_format(const std::string& output, const WriteFlags& flags) {
-    if (output.empty()) throw UsageError("the output name is empty");
-    if (!flags.to.empty()) return;  // checked by its validator
-    if (output == "-") throw UsageError("<stdout>: writing to stdout needs --to (one of: " + format_names(true) + ")");
-    if (io::format_for_extension(output, true) == nullptr)
-        throw UsageError(output + ": cannot tell the output format from the name (use --to, one of: " + format_names(true) + ")");
+bool names_a_pipe(const std::string& output) {
+    struct stat st;
+    const int rc = output == "-" ? ::fstat(1, &st) : ::stat(output.c_str(), &st);
+    return rc == 0 && (S_ISFIFO(st.st_mode) || S_ISSOCK(st.st_mode));
 }
+
+const io::Format& resolve_output_format(const std::string& output, const WriteFlags& flags) {
+    if (output.empty()) throw UsageError("the output name is empty");
+    if (!flags.to.empty()) return *io::find_format(flags.to);  // checked by its validator
+    if (const io::Format* f = io::format_for_extension(output, true)) return *f;
+    // Between two commands nothing needs a count first: the triangle stream flows at once.
+    if (names_a_pipe(output)) return io::kTriangleStreamFormat;
+    if (output == "-")
+        throw UsageError("<stdout>: writing to stdout needs --to unless it is a pipe (one of: " + format_names(true) + ")");
+    throw UsageError(output + ": cannot tell the output format from the name (use --to, one of: " + format_names(true) + ")");
+}
+
+namespace {
+
+// The file a path names, by device and inode, when it is an existing regular file ("-" is
+// the descriptor: stdin for an input, stdout for an output). Symbolic links are followed.
+std::optional<std::pair<dev_t, ino_t>> regular_file_id(const std::string& path, bool output) {
+    struct stat st;
+    const int rc = path == "-" ? ::fstat(output ? 1 : 0, &st) : ::stat(path.c_str(), &st);
+    if (rc != 0 || !S_ISREG(st.st_mode)) return std::nullopt;
+    return std::pair{st.st_dev, st.st_ino};
+}
+
+std::string shown(const std::string& path, bool output) {
+    return path != "-" ? path : output ? "<stdout>" : "<stdin>";
+}
+
+}  // namespace
+
+void refuse_output_over_inputs(const std::string& output, const std::vector<std::string>& output_side_files,
+                               const std::vector<InputFiles>& inputs) {
+    struct Target {
+        std::string path;
+        bool side;
+    };
+    std::vector<Target> targets{{output, false}};
+    for (const std::string& side : output_side_files) targets.push_back({side, true});
+    for (const Target& target : targets) {
+        const auto id = regular_file_id(target.path, true);
+        if (!id) continue;
+        for (const InputFiles& in : inputs) {
+            std::string why;
+            if (regular_file_id(in.path, false) == id) why = "the input " + shown(in.path, false);
+            for (const std::string& side : in.side_files)
+                if (why.empty() && regular_file_id(side, false) == id)
+                    why = side + ", which the input " + shown(in.path, false) + " reads";
+            if (why.empty()) continue;
+            const bool same_name = !target.side && target.path == in.path;
+            throw UsageError(shown(output, true) + ": " +
+                             (target.side ? "its side file " + target.path + " would overwrite " + why
+                                          : std::string("would overwrite ") + why +
+                                                (same_name ? "" : " (the same file, through a link)")) +
+                             "; write the output to another file");
+        }
+    }
+}
+
+void refuse_output_over_inputs(const std::string& output, const io::Format& format, const io::WriteOptions& options,
+                               const std::vector<InputFiles>& inputs) {
+    refuse_output_over_inputs(output, format.side_files ? format.side_files(output, options) : std::vector<std::string>{},
+                              inputs);
+}
+
+InputFiles input_files(const std::string& path, const io::MeshHeader& header) { return {path, header.side_files}; }
 
 double physical_memory_bytes() {
     const long pages = ::sysconf(_SC_PHYS_PAGES), page_bytes = ::sysconf(_SC_PAGESIZE);
@@ -130,8 +194,16 @@ void add_read_flags(CLI::App* cmd, ReadFlags& flags) {
     cmd->add_option("--memory", flags.memory,
                     "Memory budget for tables, spills and sort runs, e.g. 64M, 1G (default 256M)");
     cmd->add_option("--tmpdir", flags.tmpdir, "Directory for temporary files (default: $TMPDIR or /tmp)");
-    cmd->add_flag("--strict", flags.strict, "Triangles with a NaN/inf coordinate or two corners at the same position are skipped with a "
-                   "counted warning; --strict makes them (and faces of fewer than 3 vertices) errors");
+    cmd->add_flag("--strict", flags.strict,
+                  "Make a counted recovery an error: input a reader repairs (faces of fewer than 3 vertices), and what "
+                  "the output format cannot hold (e.g. triangles Draco drops)");
+}
+
+void strict_refuses_dropped_triangles(CLI::App* cmd) {
+    cmd->get_option("--strict")
+        ->description("Triangles with a NaN/inf coordinate or two corners at the same position are skipped with a "
+                      "counted warning (decimate cannot use them); --strict makes them, and faces of fewer than 3 "
+                      "vertices and what the output format cannot hold, errors");
 }
 
 void strict_reports_bad_triangles(CLI::App* cmd) {
@@ -154,7 +226,10 @@ io::WriteOptions WriteFlags::options(const ReadFlags& read) const {
 }
 
 void add_write_flags(CLI::App* cmd, WriteFlags& flags) {
-    cmd->add_option("--to", flags.to, "Output format, overriding the extension (e.g. stl, stl-ascii)")
+    cmd->add_option("--to", flags.to,
+                    "Output format, overriding the extension (e.g. stl, stl-ascii). Without it, '-' on a pipe gets "
+                    "meshstream's triangle stream, which the next command reads as it comes; --to stl or ply to a "
+                    "pipe spools the body to --tmpdir first (their count goes before it)")
         ->check(format_name(true));
     cmd->add_option("--gzip-level", flags.gzip_level, "zlib level 0-9 for outputs ending in .gz (default 6)")
         ->check(CLI::Range(0, 9));

@@ -13,6 +13,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace meshstream::tools {
 
@@ -38,6 +39,8 @@ void add_read_flags(CLI::App* cmd, ReadFlags& flags);
 // For commands that measure the input as it is (info, compare): --strict's help says that it
 // makes bad triangles errors, without the skipping that convert, sort and decimate do.
 void strict_reports_bad_triangles(CLI::App* cmd);
+// For decimate, which drops the triangles it cannot use: --strict's help says it makes them errors.
+void strict_refuses_dropped_triangles(CLI::App* cmd);
 
 // Options every command that writes a mesh accepts.
 struct WriteFlags {
@@ -50,9 +53,31 @@ struct WriteFlags {
 };
 // `with_memory`: false when add_read_flags already added --memory/--tmpdir to `cmd`.
 void add_write_flags(CLI::App* cmd, WriteFlags& flags);
-// Throws UsageError when no --to is given and `output` is stdout ("-") or a name whose
-// extension is no writable format.
-void require_output_format(const std::string& output, const WriteFlags& flags);
+// The format an output is written in: --to's, else its extension's, else, for stdout or a
+// FIFO that is a pipe or socket, meshstream's triangle stream (io/triangle_stream.hpp). Throws
+// UsageError (exit 2) when none applies ("-" on a terminal or a file without --to, a name
+// whose extension is no writable format).
+const io::Format& resolve_output_format(const std::string& output, const WriteFlags& flags);
+// True when `output` ("-" = stdout) is a pipe or a socket.
+bool names_a_pipe(const std::string& output);
+
+// An input for refuse_output_over_inputs: its path ("-" = stdin) and the other files its
+// reader read (MeshHeader::side_files).
+struct InputFiles {
+    std::string path;
+    std::vector<std::string> side_files;
+};
+// Refuses with UsageError (exit 2), before anything is written, an output that would overwrite
+// an input: the same regular file by device and inode (so also a symbolic or hard link to it,
+// and stdout redirected into it), or a side file of either: one the output's format writes
+// beside it (`output_side_files`, from Format::side_files) or one an input's reader read.
+void refuse_output_over_inputs(const std::string& output, const std::vector<std::string>& output_side_files,
+                               const std::vector<InputFiles>& inputs);
+// The same with the side files `format` names for `output`.
+void refuse_output_over_inputs(const std::string& output, const io::Format& format, const io::WriteOptions& options,
+                               const std::vector<InputFiles>& inputs);
+// The InputFiles of an opened input.
+InputFiles input_files(const std::string& path, const io::MeshHeader& header);
 // This machine's memory (0 when the system does not say).
 double physical_memory_bytes();
 class Warnings;

@@ -66,21 +66,18 @@ nlohmann::ordered_json stats_json(const DistanceStats& s, double diagonal) {
 }
 
 // compare measures each file as it is; with --strict a NaN/inf or degenerate triangle is an
-// error instead, as in the other commands.
+// error instead, as in the other commands (the read loop refuses it), and so is a header
+// whose promised count the file breaks.
 class StrictReader final : public io::Reader {
 public:
-    StrictReader(std::unique_ptr<io::Reader> in, const std::string& name) : in_(std::move(in)), filter_(name, true) {
-        header_ = in_->header();
+    StrictReader(std::unique_ptr<io::Reader> in, const std::string& name)
+        : in_(std::move(in), name, io::BadTriangles::kRefuse) {
+        header_ = in_.header();
     }
-    bool next(io::TriangleChunk& chunk) override {
-        if (!in_->next(chunk)) return false;
-        filter_.apply(chunk);  // strict: throws at the first bad triangle, removes none
-        return true;
-    }
+    bool next(io::TriangleChunk& chunk) override { return in_.next(chunk); }
 
 private:
-    std::unique_ptr<io::Reader> in_;
-    TriangleFilter filter_;
+    io::TriangleInput in_;
 };
 
 MeshSource source(const std::string& path, const ReadFlags& flags) {
@@ -92,6 +89,8 @@ MeshSource source(const std::string& path, const ReadFlags& flags) {
 void run_compare(const CompareCliOptions& opt) {
     if (is_stream(opt.a) && is_stream(opt.b))
         throw UsageError("compare cannot read both A and B from stdin or pipes: one of them is read twice");
+    // What compare prints must not land in a file it reads (`compare a.stl b.stl >> a.stl`).
+    refuse_output_over_inputs("-", {}, {{opt.a, {}}, {opt.b, {}}});
     // The held mesh keeps every sample (about 60 bytes each at the peak, while its BVH is built:
     // 626 MB for 10 M samples against a 10 k-triangle mesh): a count past memory would only
     // fail after minutes of work, as a bare "out of memory".

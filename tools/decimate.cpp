@@ -76,7 +76,7 @@ double weld_epsilon(const DecimateOptions& opt, const std::string& input_name) {
 void run_decimate(const DecimateOptions& opt) {
     const auto start = std::chrono::steady_clock::now();
     // Checked before any work: the comparison re-reads both files once the output is done.
-    require_output_format(opt.output, opt.write);
+    const io::Format& out_format = resolve_output_format(opt.output, opt.write);
     if (opt.report) {
         const bool input_stream = is_stream(opt.input);
         if (input_stream || is_stream(opt.output)) {
@@ -84,28 +84,18 @@ void run_decimate(const DecimateOptions& opt) {
                                                   : (opt.output == "-" ? "<stdout>" : opt.output);
             throw UsageError(name + ": --report needs to re-read both files; it does not work with '-' or a pipe");
         }
-        // Replaced in place, the input is gone when the comparison reads it: the output would be
-        // compared with itself (an error of 0).
-        // (By resolved name, not by file: a hard link to the input keeps the old file when the
-        // output replaces its name.)
-        std::error_code ec_in, ec_out;
-        const auto input = std::filesystem::weakly_canonical(opt.input, ec_in);
-        const auto output = std::filesystem::weakly_canonical(opt.output, ec_out);
-        if (!ec_in && !ec_out && input == output)
-            throw UsageError(opt.output + ": --report compares the output against the input, which this output "
-                             "replaces: write the output to another file");
     }
-    io::Input in = io::open_input(opt.input, opt.read.from, opt.read.options());
-    const io::MeshHeader& header = in.reader->header();
+    io::TriangleInput in = open_triangle_input(opt.input, opt.read, Command::kDecimate);
+    const io::MeshHeader& header = in.header();
 
     decimate::Options options;
     if (opt.target) {
         // Options that cannot work with this input: exit 2, like the command line's own errors.
         if (!header.triangle_count)
-            throw UsageError(in.source->name() + ": --target needs the input triangle count, which this format does "
+            throw UsageError(in.name() + ": --target needs the input triangle count, which this format does "
                                                  "not state up front (binary STL, Draco and glTF do); use --ratio");
         if (*opt.target > *header.triangle_count)
-            throw UsageError(in.source->name() + ": --target " + std::to_string(*opt.target) + " is more than the " +
+            throw UsageError(in.name() + ": --target " + std::to_string(*opt.target) + " is more than the " +
                              std::to_string(*header.triangle_count) +
                              " triangles of the input (decimation only removes triangles)");
         options.target = *opt.target;
@@ -115,14 +105,14 @@ void run_decimate(const DecimateOptions& opt) {
     options.buffer_triangles = opt.buffer;
     options.candidates = opt.candidates;
     options.seed = opt.seed;
-    options.weld_eps = weld_epsilon(opt, in.source->name());
+    options.weld_eps = weld_epsilon(opt, in.name());
     options.sorted_axis = opt.sorted_axis ? opt.sorted_axis : header.sorted_axis;
     // The file's flag comes from `meshstream sort` (or a convert that kept its order): ascending
     // by triangle minimum. A --sorted-axis of the user's own says less: the key is not known.
     options.sorted_by_minimum = header.sorted_axis && options.sorted_axis == header.sorted_axis;
     std::unique_ptr<decimate::StreamDecimator> made;  // on the heap only to catch a refused reservation here
     try {
-        made = std::make_unique<decimate::StreamDecimator>(options, header.triangle_count);
+        made = std::make_unique<decimate::StreamDecimator>(options, in.count());
     } catch (const std::bad_alloc&) {
         throw std::runtime_error(
             "--buffer " + std::to_string(opt.buffer) + " reserves " +
@@ -141,23 +131,17 @@ void run_decimate(const DecimateOptions& opt) {
     // when the in-core rest is closed and one triangle too many is left (collapses remove two
     // faces; it then ends one over, with a warning), and skipped input triangles change N_in.
     // Writers patch their header counts at finish() (or spool when the output cannot seek).
-    io::Output out = io::open_output(opt.output, opt.write.to, wo, opt.write.gzip_level);
+    refuse_output_over_inputs(opt.output, out_format, wo, {input_files(opt.input, header)});
+    io::Output out = io::open_output(opt.output, out_format.name, wo, opt.write.gzip_level);
 
     const decimate::Emit emit = [&out](const io::TriangleChunk& chunk) { out.write(chunk); };
     // The decimator rates and writes positions only: no other channel is read.
     io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, io::Channels{});
-    uint64_t done = 0;
     Progress progress("decimating", header.triangle_count);
-    TriangleFilter filter(in.source->name(), opt.read.strict);
-    while (in.reader->next(chunk)) {
-        done += chunk.size();
-        decimator.skipped(filter.apply(chunk));
+    while (in.next(chunk)) {
         decimator.push(chunk, emit);
-        progress.update(done);
+        progress.update(in.count().read);
     }
-    if (header.triangle_count && done != *header.triangle_count)
-        throw io::Error(in.source->name(), "header promises " + std::to_string(*header.triangle_count) +
-                                               " triangles, read " + std::to_string(done));
     progress.phase("finishing", std::nullopt);
     decimator.finish(emit);
     progress.done();
@@ -165,7 +149,7 @@ void run_decimate(const DecimateOptions& opt) {
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
     const decimate::Stats& s = decimator.stats();
-    std::fprintf(stderr, "decimated %s -> %s\n", in.source->name().c_str(), opt.output.c_str());
+    std::fprintf(stderr, "decimated %s -> %s\n", in.name().c_str(), opt.output.c_str());
     std::fprintf(stderr, "  triangles in %llu, out %llu (target %llu, ratio %.6g)\n",
                  (unsigned long long)s.triangles_in, (unsigned long long)s.triangles_out,
                  (unsigned long long)s.target_triangles, decimator.ratio());
@@ -196,11 +180,12 @@ void run_decimate(const DecimateOptions& opt) {
                                       (opt.buffer != DecimateOptions{}.buffer ? " --buffer " + std::to_string(opt.buffer) : "") + "`";
     note_unused_write_flags(opt.write, *out.format, opt.output, warnings);
     for (const std::string& note : out.writer->notes()) warnings.note(note);
-    filter.report(warnings);
-    note_input_changes(in.reader->header(), in.source->name(), warnings);
+    const uint64_t skipped = in.count().dropped;
+    note_dropped_triangles(dropped_triangles(in), "skipped", warnings);
+    note_input_changes(in.header(), in.name(), warnings);
     const bool axis_conflict = opt.sorted_axis && header.sorted_axis && *opt.sorted_axis != *header.sorted_axis;
     if (axis_conflict)
-        warnings.note(std::string("--sorted-axis ") + "xyz"[*opt.sorted_axis] + " was given, but " + in.source->name() +
+        warnings.note(std::string("--sorted-axis ") + "xyz"[*opt.sorted_axis] + " was given, but " + in.name() +
                       " says it is sorted along " + "xyz"[*header.sorted_axis] + ": the sweep used " +
                       "xyz"[*opt.sorted_axis] + ", as given");
     if (s.forced_writes > 0)
@@ -260,15 +245,15 @@ void run_decimate(const DecimateOptions& opt) {
                                std::to_string(s.target_triangles);
     // Skipped triangles that come late leave --target short: the part read before them was
     // decimated for the larger input the header promised.
-    const std::string skipped_late = std::to_string(filter.skipped()) +
+    const std::string skipped_late = std::to_string(skipped) +
                                      " input triangles were skipped (above), most of them after the part before "
                                      "them had been decimated for the larger input the header promised; `meshstream "
-                                     "convert` drops them into a copy that lands on the target";
+                                     "convert --clean` drops them into a copy that lands on the target";
     if (s.triangles_in > 0 && s.target_triangles > s.triangles_in)
         warnings.note("the target " + std::to_string(s.target_triangles) + " is more than the " +
                       std::to_string(s.triangles_in) + " usable input triangles: " +
                       (s.collapses == 0 ? std::string("nothing was decimated") : missed + "; " + skipped_late));
-    else if (options.target && s.triangles_in > 0 && s.triangles_out < s.target_triangles && filter.skipped() > 0)
+    else if (options.target && s.triangles_in > 0 && s.triangles_out < s.target_triangles && skipped > 0)
         warnings.note(missed + " (" + skipped_late + ")");
     else if (s.triangles_in > 0 && s.triangles_out == s.target_triangles + 1)
         warnings.note(missed + " (a collapse removes two triangles, and no boundary edge could be collapsed to remove the odd one)");
@@ -321,7 +306,7 @@ void add_decimate(CLI::App& app) {
                     "(one more when an odd number is left to remove at the end and no boundary edge can be\n"
                     "collapsed to remove a single triangle; a warning says so).");
     cmd->add_option("input", opt->input, "Input mesh ('-' = stdin)")->required();
-    cmd->add_option("output", opt->output, "Output mesh ('-' = stdout, needs --to)")->required();
+    cmd->add_option("output", opt->output, "Output mesh ('-' = stdout: a pipe gets meshstream's triangle stream, anything else needs --to)")->required();
     auto* ratio = cmd->add_option("-r,--ratio", opt->ratio, "Fraction of input triangles to keep, in (0, 1] (default 0.1)")
                       ->check(open_unit_interval());
     cmd->add_option("--target", opt->target, "Exact output triangle count (needs a format that states the input count)")
@@ -349,6 +334,7 @@ void add_decimate(CLI::App& app) {
             "x|y|z"));
     cmd->add_flag("--report", opt->report, "Compare the output against the input (Hausdorff, mean, RMS) at the end");
     add_read_flags(cmd, opt->read);
+    strict_refuses_dropped_triangles(cmd);
     add_write_flags(cmd, opt->write);
     cmd->callback([opt] { run_decimate(*opt); });
 }

@@ -75,8 +75,11 @@ void accumulate(const io::TriangleChunk& chunk, InfoStats& s) {
 }
 
 void run_info(const InfoOptions& opt) {
-    io::Input in = io::open_input(opt.input, opt.read.from, opt.read.options());
-    const io::MeshHeader& header = in.reader->header();
+    // info reports bad triangles; --strict makes the first one an error instead.
+    io::TriangleInput in = open_triangle_input(opt.input, opt.read, Command::kMeasure);
+    const io::MeshHeader& header = in.header();
+    // What info prints must not land in the file it reads (`info scan.stl >> scan.stl`).
+    refuse_output_over_inputs("-", {}, {input_files(opt.input, header)});
     InfoStats stats;
     io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, header.channels);
     std::unique_ptr<TopologyCounter> topology;
@@ -85,11 +88,7 @@ void run_info(const InfoOptions& opt) {
     if (opt.order) meter.emplace(opt.read.options().memory_budget_bytes);
     {
         Progress progress("reading", header.triangle_count);
-        // info reports bad triangles; --strict makes the first one an error instead.
-        std::optional<TriangleFilter> strict;
-        if (opt.read.strict) strict.emplace(in.source->name(), true);
-        while (in.reader->next(chunk)) {
-            if (strict) strict->apply(chunk);  // throws, removes nothing
+        while (in.next(chunk)) {
             accumulate(chunk, stats);
             if (topology) topology->add(chunk);
             if (meter) meter->add(chunk);
@@ -100,18 +99,18 @@ void run_info(const InfoOptions& opt) {
     std::error_code size_error;
     const uint64_t file_size = opt.input == "-" ? 0 : std::filesystem::file_size(opt.input, size_error);
     const bool has_file_size = opt.input != "-" && !size_error;
-    uint64_t decoded_bytes = in.source->offset();
+    uint64_t decoded_bytes = in.source().offset();
     bool has_box = stats.triangles > stats.non_finite;
     static const char* kAxes[] = {"x", "y", "z"};
 
     if (opt.json) {
         nlohmann::ordered_json j;
         j["file"] = opt.input;
-        j["format"] = std::string(in.format->name);
+        j["format"] = std::string(in.format().name);
         if (!header.variant.empty()) j["variant"] = header.variant;
-        j["gzip"] = in.source->gzip();
+        j["gzip"] = in.source().gzip();
         if (has_file_size) j["file_bytes"] = file_size;
-        if (in.source->gzip()) j["decoded_bytes"] = decoded_bytes;
+        if (in.source().gzip()) j["decoded_bytes"] = decoded_bytes;
         j["triangles"] = stats.triangles;
         if (header.vertex_count) j["vertices"] = *header.vertex_count;
         j["degenerate_triangles"] = stats.degenerate;
@@ -153,9 +152,9 @@ void run_info(const InfoOptions& opt) {
         return;
     }
     std::printf("file:        %s\n", opt.input.c_str());
-    std::printf("format:      %s%s%s%s\n", std::string(in.format->name).c_str(),
+    std::printf("format:      %s%s%s%s\n", std::string(in.format().name).c_str(),
                 header.variant.empty() ? "" : " (", header.variant.c_str(), header.variant.empty() ? "" : ")");
-    if (in.source->gzip()) std::printf("compression: gzip (%llu bytes decoded)\n", (unsigned long long)decoded_bytes);
+    if (in.source().gzip()) std::printf("compression: gzip (%llu bytes decoded)\n", (unsigned long long)decoded_bytes);
     if (has_file_size) std::printf("file size:   %llu bytes\n", (unsigned long long)file_size);
     std::printf("triangles:   %llu\n", (unsigned long long)stats.triangles);
     if (header.vertex_count) std::printf("vertices:    %llu\n", (unsigned long long)*header.vertex_count);

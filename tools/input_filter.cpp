@@ -1,47 +1,46 @@
-// TriangleFilter: see input_filter.hpp for the policy.
+// The commands' triangle policies and their warnings: see input_filter.hpp.
 #include "tools/input_filter.hpp"
 
-#include "io/error.hpp"
-
-#include <cmath>
-#include <cstring>
-
 namespace meshstream::tools {
-namespace {
 
-bool same_point(const float* a, const float* b) { return a[0] == b[0] && a[1] == b[1] && a[2] == b[2]; }
-
-}  // namespace
-
-size_t TriangleFilter::apply(io::TriangleChunk& chunk) {
-    const size_t n = chunk.size();
-    float* xyz = chunk.xyz_storage();
-    size_t kept = 0;
-    for (size_t i = 0; i < n; ++i, ++seen_) {
-        const float* t = xyz + 9 * i;
-        bool finite = true;
-        for (int k = 0; k < 9; ++k) finite &= std::isfinite(t[k]);
-        const bool degenerate = finite && (same_point(t, t + 3) || same_point(t + 3, t + 6) || same_point(t, t + 6));
-        if (!finite || degenerate) {
-            if (strict_)
-                throw io::Error(file_, "triangle " + std::to_string(seen_ + 1) +
-                                           (finite ? " is degenerate (two corners at the same position)"
-                                                   : " has a NaN or infinite coordinate") +
-                                           " (--strict)");
-            ++(finite ? degenerate_ : non_finite_);
-            continue;
-        }
-        if (kept != i) chunk.copy_triangle(kept, chunk, i);
-        ++kept;
+io::BadTriangles bad_triangle_policy(Command command, bool clean, bool strict) {
+    switch (command) {
+        case Command::kConvert:
+        case Command::kSort:
+            // --strict is about what an output cannot hold; triangles asked to be dropped are
+            // no such loss.
+            return clean ? io::BadTriangles::kDrop : io::BadTriangles::kKeep;
+        case Command::kDecimate: return strict ? io::BadTriangles::kRefuse : io::BadTriangles::kDrop;
+        case Command::kMeasure: return strict ? io::BadTriangles::kRefuse : io::BadTriangles::kKeep;
     }
-    chunk.resize(kept);
-    return n - kept;
+    return io::BadTriangles::kKeep;
 }
 
-void TriangleFilter::report(Warnings& warnings) const {
-    if (seen_ == 0) warnings.note("the input holds no triangles");
-    if (non_finite_ > 0) warnings.add("triangles with a NaN or infinite coordinate skipped", non_finite_);
-    if (degenerate_ > 0) warnings.add("degenerate triangles (two corners at the same position) skipped", degenerate_);
+io::TriangleInput open_triangle_input(const std::string& path, const ReadFlags& read, const io::ReadOptions& options,
+                                      Command command, bool clean) {
+    return io::TriangleInput(io::open_input(path, read.from, options),
+                             bad_triangle_policy(command, clean, read.strict));
+}
+
+io::TriangleInput open_triangle_input(const std::string& path, const ReadFlags& read, Command command, bool clean) {
+    return open_triangle_input(path, read, read.options(), command, clean);
+}
+
+DroppedTriangles dropped_triangles(const io::TriangleInput& in) {
+    return {in.count().read, in.non_finite(), in.degenerate()};
+}
+
+void note_dropped_triangles(const DroppedTriangles& dropped, const std::string& verb, Warnings& warnings) {
+    if (dropped.read == 0) warnings.note("the input holds no triangles");
+    if (dropped.non_finite > 0) warnings.add("triangles with a NaN or infinite coordinate " + verb, dropped.non_finite);
+    if (dropped.degenerate > 0)
+        warnings.add("degenerate triangles (two corners at the same position) " + verb, dropped.degenerate);
+}
+
+void add_clean_flag(CLI::App* cmd, bool& clean) {
+    cmd->add_flag("--clean", clean,
+                  "Drop triangles with a NaN or infinite coordinate and degenerate ones (two corners at the same "
+                  "position), counting them; without it every input triangle is kept");
 }
 
 }  // namespace meshstream::tools

@@ -1,42 +1,39 @@
-// The one place where meshstream's commands skip triangles that no consumer can use, so
-// convert, sort and decimate apply the same policy (docs/robustness.md):
-//   - a NaN or infinite coordinate (possible in binary STL/PLY/Draco and as "nan"/"inf" text);
-//   - a degenerate face: two corners at exactly the same position (-0 == +0).
-// Each is dropped and counted into a tools::Warnings line; with --strict the first one is an
-// io::Error naming the file and the triangle's ordinal instead. Zero-area faces with three
-// distinct corners (slivers) are kept: they are valid geometry that the decimator removes.
-// Readers still reject what is malformed (indices out of range, truncation) themselves.
+// How the commands use the read loop's triangle policy (io/triangle_input.hpp): which policy
+// each command takes from its flags, and the counted warnings for what it dropped.
+//   - convert, sort: every triangle is kept (lossless); --clean drops non-finite and
+//     degenerate ones and counts them;
+//   - decimate: drops them (it cannot use them) and counts them; --strict makes the first
+//     one an error;
+//   - info, compare: measure the file as it is; --strict makes the first one an error.
 #pragma once
 
-#include "io/chunk.hpp"
+#include "io/triangle_input.hpp"
 #include "tools/common.hpp"
-
-#include <cstdint>
-#include <string>
 
 namespace meshstream::tools {
 
-class TriangleFilter {
-public:
-    // `file` names the input in errors; `strict`: throw instead of skipping.
-    TriangleFilter(std::string file, bool strict) : file_(std::move(file)), strict_(strict) {}
+enum class Command : uint8_t { kConvert, kSort, kDecimate, kMeasure };
 
-    // Removes the skipped triangles from `chunk` in place, keeping its channels aligned;
-    // returns how many were removed. Throws io::Error under --strict. Call once per chunk,
-    // in input order (the ordinal in errors counts every triangle seen).
-    size_t apply(io::TriangleChunk& chunk);
+// The policy for a command: `clean` is --clean (convert, sort), `strict` is --strict.
+io::BadTriangles bad_triangle_policy(Command command, bool clean, bool strict);
 
-    uint64_t non_finite() const { return non_finite_; }
-    uint64_t degenerate() const { return degenerate_; }
-    uint64_t skipped() const { return non_finite_ + degenerate_; }
-    // Adds one counted line per kind that occurred.
-    void report(Warnings& warnings) const;
+// Opens `path` as ReadFlags say and wraps it in the read loop with the command's policy.
+io::TriangleInput open_triangle_input(const std::string& path, const ReadFlags& read, Command command,
+                                      bool clean = false);
+// The same with the reader's options given (a command that splits --memory).
+io::TriangleInput open_triangle_input(const std::string& path, const ReadFlags& read, const io::ReadOptions& options,
+                                      Command command, bool clean = false);
 
-private:
-    std::string file_;
-    bool strict_;
-    uint64_t seen_ = 0;
-    uint64_t non_finite_ = 0, degenerate_ = 0;
+// The warnings about the triangles a finished read loop dropped, one counted line per kind
+// (`verb`: "skipped" for decimate, "removed (--clean)" for --clean), and a note when the
+// input held no triangles at all.
+struct DroppedTriangles {
+    uint64_t read = 0, non_finite = 0, degenerate = 0;
 };
+DroppedTriangles dropped_triangles(const io::TriangleInput& in);
+void note_dropped_triangles(const DroppedTriangles& dropped, const std::string& verb, Warnings& warnings);
+
+// --clean for convert and sort.
+void add_clean_flag(CLI::App* cmd, bool& clean);
 
 }  // namespace meshstream::tools

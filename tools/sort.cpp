@@ -32,6 +32,7 @@ struct SortOptions {
     std::string input, output;
     std::string axis = "auto";
     bool stats = false;
+    bool clean = false;
     ReadFlags read;
     WriteFlags write;
 };
@@ -151,11 +152,10 @@ int longest_axis(const SortOptions& opt, const io::ReadOptions& ro) {
 
 void run_sort(const SortOptions& opt) {
     const auto t0 = std::chrono::steady_clock::now();
-    require_output_format(opt.output, opt.write);
+    const io::Format& out_format = resolve_output_format(opt.output, opt.write);
     // Draco's connectivity coder reorders the triangles: the sorted order would be lost.
-    const io::Format* to = opt.write.to.empty() ? io::format_for_extension(opt.output, true) : io::find_format(opt.write.to);
-    if (to != nullptr && ((to->traits & io::Format::kAlwaysDraco) ||
-                          ((to->traits & io::Format::kDracoUnlessOff) && opt.write.draco)))
+    if ((out_format.traits & io::Format::kAlwaysDraco) ||
+        ((out_format.traits & io::Format::kDracoUnlessOff) && opt.write.draco))
         throw UsageError((opt.output == "-" ? std::string("<stdout>") : opt.output) +
                          ": Draco compression reorders triangles, so the sorted order would be lost: write STL, PLY "
                          "or OBJ (or glTF with --no-draco)");
@@ -178,25 +178,21 @@ void run_sort(const SortOptions& opt) {
                                                        : std::string();
     ro.tmpdir = tmpdir;
 
-    int axis;
-    if (opt.axis == "auto") {
-        if (!is_regular_file(opt.input))
-            throw UsageError((opt.input == "-" ? std::string("<stdin>") : opt.input) +
-                             ": --axis auto reads the input twice (bounding box first), which needs a regular file; "
-                             "give --axis x, y or z to sort a stream");
-        axis = longest_axis(opt, ro);
-    } else {
-        axis = static_cast<int>(std::find(std::begin(kAxisNames), std::end(kAxisNames), opt.axis) - std::begin(kAxisNames));
-    }
-
-    io::Input in = io::open_input(opt.input, opt.read.from, ro);
-    const io::MeshHeader header = in.reader->header();
-    const std::string input_name = in.source->name();  // `in` is released before the merge
+    if (opt.axis == "auto" && !is_regular_file(opt.input))
+        throw UsageError((opt.input == "-" ? std::string("<stdin>") : opt.input) +
+                         ": --axis auto reads the input twice (bounding box first), which needs a regular file; "
+                         "give --axis x, y or z to sort a stream");
+    io::TriangleInput in = open_triangle_input(opt.input, opt.read, ro, Command::kSort, opt.clean);
+    const io::MeshHeader header = in.header();
+    const std::string input_name = in.name();  // the reader is released before the merge
+    refuse_output_over_inputs(opt.output, out_format, opt.write.options(opt.read), {input_files(opt.input, header)});
+    const int axis = opt.axis == "auto" ? longest_axis(opt, ro)
+                                        : static_cast<int>(std::find(std::begin(kAxisNames), std::end(kAxisNames), opt.axis) -
+                                                           std::begin(kAxisNames));
     sort::SorterOptions so;
     so.axis = axis;
     so.tmpdir = tmpdir;
     // Only the channels the output keeps are carried through the runs.
-    const io::Format& out_format = io::output_format(opt.output, opt.write.to);
     so.channels = io::writable_channels(out_format, header.channels, opt.write.options(opt.read));
     const std::string dropped = io::describe_missing(header.channels, so.channels);
     const size_t record_bytes = sort::ExternalSorter::record_bytes_for(so.channels);
@@ -210,7 +206,7 @@ void run_sort(const SortOptions& opt) {
         uint64_t least = pipe_bytes * 4 / 3;
         while (least - least / 4 <= pipe_bytes) ++least;
         const uint64_t least_kib = (least + 1023) / 1024;
-        throw UsageError(in.source->name() + ": --memory " + opt.read.memory + " is too small to sort: give at least " +
+        throw UsageError(input_name + ": --memory " + opt.read.memory + " is too small to sort: give at least " +
                          std::to_string(least_kib) + "K");
     }
     so.memory_budget_bytes = budget - budget / 4 - pipe_bytes;
@@ -226,7 +222,6 @@ void run_sort(const SortOptions& opt) {
         progress.update(merged);
     };
     sort::ExternalSorter sorter(so);
-    TriangleFilter filter(in.source->name(), opt.read.strict);
     {
         // Input thread: reads, parses and filters chunks; this thread adds them to the runs
         // (and sorts and spills each full run).
@@ -234,16 +229,11 @@ void run_sort(const SortOptions& opt) {
         std::atomic<uint64_t> read{0};
         PipeWorker reader(pipe, [&] {
             try {
-                uint64_t done = 0;
                 while (io::TriangleChunk* chunk = pipe.get_free()) {
-                    if (!in.reader->next(*chunk)) break;
-                    read.store(done += chunk->size(), std::memory_order_relaxed);
-                    filter.apply(*chunk);
+                    if (!in.next(*chunk)) break;
+                    read.store(in.count().read, std::memory_order_relaxed);
                     pipe.put_full(chunk);
                 }
-                if (header.triangle_count && done != *header.triangle_count)
-                    throw io::Error(in.source->name(), "header promises " + std::to_string(*header.triangle_count) +
-                                                           " triangles, read " + std::to_string(done));
                 pipe.close();
             } catch (...) {
                 pipe.fail(std::current_exception());
@@ -257,8 +247,8 @@ void run_sort(const SortOptions& opt) {
     }
     // What the reader noted by the end of the input (a last line without a line end), before
     // it goes.
-    const io::MeshHeader end_header = in.reader->header();
-    in = {};  // the reader's buffers and tables are not needed while merging
+    const io::MeshHeader end_header = in.header();
+    in.close();  // the reader's buffers and tables are not needed while merging
     const double input_seconds = seconds_since(t0);
     sorter.finish_input();
     const double sort_seconds = seconds_since(t0) - input_seconds;
@@ -271,7 +261,7 @@ void run_sort(const SortOptions& opt) {
     wo.sorted_axis = axis;
     wo.channels = so.channels;
     if (wo.channels.material) wo.materials = header.materials;
-    io::Output out = io::open_output(opt.output, opt.write.to, wo, opt.write.gzip_level);
+    io::Output out = io::open_output(opt.output, out_format.name, wo, opt.write.gzip_level);
     const int passes = sorter.stats().merge_passes;
     progress.phase(passes == 0 ? "writing" : "merge " + std::to_string(passes) + "/" + std::to_string(passes), total);
     {
@@ -308,7 +298,7 @@ void run_sort(const SortOptions& opt) {
         warnings.note(std::string(opt.output == "-" ? "<stdout>" : opt.output) +
                       ": glTF has no place for the sorted axis: decimate it with --sorted-axis " + "xyz"[axis] +
                       ", or sort to STL, PLY or OBJ, which record it");
-    filter.report(warnings);
+    note_dropped_triangles(dropped_triangles(in), "removed (--clean)", warnings);
     note_input_changes(end_header, input_name, warnings);
     warnings.print();
 
@@ -339,10 +329,11 @@ void add_sort(CLI::App& app) {
         "sort", "Sort triangles by their minimum coordinate along an axis (out of core, stable), so that\n"
                 "decimate can stream them; the output records the axis (see docs/sorting.md)");
     cmd->add_option("input", opt->input, "Input mesh ('-' = stdin, needs --axis x|y|z)")->required();
-    cmd->add_option("output", opt->output, "Output mesh ('-' = stdout, needs --to)")->required();
+    cmd->add_option("output", opt->output, "Output mesh ('-' = stdout: a pipe gets meshstream's triangle stream, anything else needs --to)")->required();
     cmd->add_option("--axis", opt->axis, "x, y, z, or auto: the longest bounding-box axis (default; needs a file)")
         ->check(CLI::IsMember({"x", "y", "z", "auto"}));
     cmd->add_flag("--stats", opt->stats, "Print runs, merge passes, temporary disk, time and peak RSS on stderr");
+    add_clean_flag(cmd, opt->clean);
     add_read_flags(cmd, opt->read);
     cmd->get_option("--tmpdir")->description("Directory for sort runs and spills (default: the output's directory; $TMPDIR "
                                              "or /tmp when writing to stdout, a pipe or a device)");

@@ -56,7 +56,7 @@ TEST(FuzzRegression, Issue7_WeldHugeCoordinate) {
 // A NaN or infinite corner can be neither welded (NaN != NaN) nor finalized, so finish() found
 // no writable face (assert `allow_forced`). Minimized finding: one triangle, all three corners
 // (nan, 9e-40, 1.8e-30), --weld 1, sorted along y. The commands drop such triangles first
-// (TriangleFilter; tested in tests/tools/cli_bad_input_test.cpp), and push() refuses them with
+// (io::TriangleInput; tested in tests/tools/cli_bad_input_test.cpp), and push() refuses them with
 // std::invalid_argument (it was an assert, compiled out of release builds).
 TEST(FuzzRegression, Issue7_NonFiniteCoordinatesAreRefused) {
     Options options;

@@ -461,3 +461,33 @@ TEST(StreamDecimator, BadOptionsAndCallOrderThrow) {
     EXPECT_THROW(decimator.finish(out), std::logic_error);
     EXPECT_EQ(written, 1u);
 }
+
+// With Options::target the decimator follows the read loop's count (io::InputCount): triangles
+// dropped before it (here 20 000 of a promised 89 451, all first) leave the ratio at target /
+// what the input can still hold, so the output lands on the target as for the clean input.
+TEST(StreamDecimator, TargetFollowsTheTrianglesTheReadLoopDropped) {
+    Options options;
+    options.target = 6945;
+    options.buffer_triangles = 10000;
+    const std::vector<float>& soup = bunny();
+    const size_t n = soup.size() / 9;
+    meshstream::io::InputCount count{n + 20000};
+    StreamDecimator decimator(options, count);
+    count.read = count.dropped = 20000;  // what the loop dropped before handing anything on
+    uint64_t out = 0;
+    const Emit emit = [&](const meshstream::io::TriangleChunk& chunk) { out += chunk.size(); };
+    meshstream::io::TriangleChunk chunk(4096);
+    for (size_t i = 0; i < n; ++i) {
+        float tri[9];
+        std::copy(&soup[9 * i], &soup[9 * i] + 9, tri);
+        chunk.push(tri);
+        ++count.read;
+        if (chunk.full() || i + 1 == n) {
+            decimator.push(chunk, emit);
+            chunk.clear();
+        }
+    }
+    decimator.finish(emit);
+    EXPECT_NEAR(double(out), 6945.0, 1.0);
+    EXPECT_NEAR(decimator.ratio(), 6945.0 / double(n), 1e-12);
+}

@@ -7,7 +7,7 @@
 //                                                   bits 1..: input chunk capacity 1 + (b >> 1)
 //   byte 6: palette size P = 1 + b % 64, then P × 12 bytes of float xyz,
 //   then triangles as 3 palette index bytes each (mod P).
-// Triangles with a NaN/inf corner are dropped before push(), as tools::TriangleFilter does in
+// Triangles with a NaN/inf corner are dropped before push(), as io::TriangleInput does in
 // the commands: finite coordinates are push()'s asserted precondition (the first fuzz run
 // found the decimator's finish() asserting on them). Huge, tiny, denormal and repeated
 // coordinates all go in. Checked: asserts and sanitizers inside, the emitted count equals

@@ -420,8 +420,8 @@ TEST(BadInput, IndicesOutOfRangeNameTheItem) {
     }
 }
 
-// NaN and inf are numbers to the readers: they pass through and the commands' TriangleFilter
-// skips or rejects them (tests/tools/cli_bad_input_test.cpp).
+// NaN and inf are numbers to the readers: they pass through, and the commands' read loop
+// (io::TriangleInput) keeps, drops or refuses them (tests/tools/cli_bad_input_test.cpp).
 TEST(BadInput, NanAndInfCoordinatesAreReadAsNumbers) {
     const io::Format& ply = *io::find_format("ply");
     EXPECT_EQ(read_with(ply, kPlyTriangleHeader + std::string("nan 0 0\n1 inf 0\n0 1 -inf\n3 0 1 2\n"), "n.ply"), 1u);

@@ -1,6 +1,7 @@
 // The bad-input suite of issue 7 through the `meshstream` binary (MESHSTREAM_BINARY): bad files
 // give exit 1, a `meshstream: error: <file>...` line and no output file; NaN and degenerate
-// triangles are skipped with counted warnings (errors with --strict); Ctrl-C during convert,
+// triangles are kept by convert and sort and dropped with counted warnings by --clean and
+// decimate (errors for decimate with --strict); Ctrl-C during convert,
 // sort and decimate leaves no temporary or partial file; a file-size limit (a full disk for
 // the process) gives a clear error instead of death by SIGXFSZ.
 #include "tools/cli_util.hpp"
@@ -127,23 +128,71 @@ TEST(CliBadInput, DecimateReportWithAPipeIsRefusedBeforeAnyOutput) {
     CliRun w = run("decimate --report -r 0.5 --to stl " + dir / "in.stl" + " -");
     EXPECT_EQ(w.code, 2) << w.err;
     EXPECT_EQ(w.err.rfind("meshstream: error: <stdout>: --report", 0), 0u) << w.err;
-    // An output that replaces the input, by name or through a link: the comparison would read
-    // the output twice and report an error of 0.
+}
+
+// issue 21 §4: an output that is an input (the same path, a symbolic link to it, a hard link:
+// one device and inode) is refused with exit 2 before anything is written, by every command
+// that writes; so is stdout redirected into an input, for info and compare too.
+TEST(CliBadInput, AnOutputThatIsAnInputIsRefusedBeforeAnythingIsWritten) {
+    TempDir dir;
+    write_file(dir / "in.stl", binary_stl(grid(4)));
     const std::string before = slurp(dir / "in.stl");
     fs::create_symlink(dir / "in.stl", dir / "link.stl");
-    for (const std::string out : {"in.stl", "link.stl"}) {
-        CliRun same = run("decimate --report -r 0.5 " + dir / "in.stl" + " " + dir / out);
-        EXPECT_EQ(same.code, 2) << same.err;
-        EXPECT_NE(same.err.find(": --report compares the output against the input, which this output replaces"),
-                  std::string::npos) << same.err;
-        EXPECT_EQ(slurp(dir / "in.stl"), before);
-    }
-    // A hard link is another name: the output replaces that name, the input keeps its file.
     fs::create_hard_link(dir / "in.stl", dir / "hard.stl");
-    CliRun hard = run("decimate --report -r 0.5 " + dir / "in.stl" + " " + dir / "hard.stl");
-    EXPECT_EQ(hard.code, 0) << hard.err;
+    const std::vector<std::string> entries = listing(dir.path);
+    for (const std::string cmd : {"convert", "sort --axis x", "decimate -r 0.5", "decimate --report -r 0.5",
+                                  "convert --to stream"}) {
+        for (const std::string out : {"in.stl", "link.stl", "hard.stl"}) {
+            CliRun r = run(cmd + " " + dir / "in.stl" + " " + dir / out);
+            EXPECT_EQ(r.code, 2) << cmd << " > " << out << ": " << r.err;
+            EXPECT_EQ(r.err.rfind("meshstream: error: " + dir / out + ": would overwrite the input " + dir / "in.stl", 0),
+                      0u) << r.err;
+            EXPECT_EQ(r.err.find("through a link") != std::string::npos, out != "in.stl") << r.err;
+            EXPECT_EQ(slurp(dir / "in.stl"), before) << cmd;
+            EXPECT_EQ(listing(dir.path), entries) << cmd;
+        }
+        if (cmd.find("--report") != std::string::npos || cmd.find("--to") != std::string::npos) continue;
+        // stdout appended to the input: `meshstream ... - >> in.stl`.
+        CliRun piped = run(cmd + " --to stl " + dir / "in.stl" + " - >> " + dir / "in.stl");
+        EXPECT_EQ(piped.code, 2) << cmd << ": " << piped.err;
+        EXPECT_NE(piped.err.find("<stdout>: would overwrite the input " + dir / "in.stl"), std::string::npos) << piped.err;
+        EXPECT_EQ(slurp(dir / "in.stl"), before) << cmd;
+    }
+    for (const std::string& cmd : {"info " + dir / "in.stl", "compare " + dir / "in.stl" + " " + dir / "link.stl",
+                                  "convert --to stl - " + dir / "out.stl < " + dir / "in.stl"}) {
+        if (cmd.starts_with("convert")) {
+            // stdin from the input, stdout elsewhere: nothing is overwritten.
+            EXPECT_EQ(run(cmd).code, 0) << cmd;
+            fs::remove(dir / "out.stl");
+            continue;
+        }
+        CliRun r = run(cmd + " >> " + dir / "hard.stl");
+        EXPECT_EQ(r.code, 2) << cmd << ": " << r.err;
+        EXPECT_NE(r.err.find("<stdout>: would overwrite the input "), std::string::npos) << r.err;
+        EXPECT_EQ(slurp(dir / "in.stl"), before) << cmd;
+    }
+    // Side files: a .gltf output whose .bin would be the input, and an output over the buffer
+    // file an input .gltf reads.
+    write_file(dir / "mesh.bin", binary_stl(grid(4)));
+    CliRun side = run("convert --no-draco " + dir / "mesh.bin" + " " + dir / "mesh.gltf");
+    EXPECT_EQ(side.code, 2) << side.err;
+    EXPECT_NE(side.err.find(dir / "mesh.gltf: its side file " + dir / "mesh.bin" + " would overwrite the input " +
+                            dir / "mesh.bin"),
+              std::string::npos) << side.err;
+    EXPECT_FALSE(fs::exists(dir / "mesh.gltf"));
+    ASSERT_EQ(run("convert --no-draco " + dir / "in.stl" + " " + dir / "scene.gltf").code, 0);
+    const std::string buffer = slurp(dir / "scene.bin");
+    CliRun over = run("convert --to stl " + dir / "scene.gltf" + " " + dir / "scene.bin");
+    EXPECT_EQ(over.code, 2) << over.err;
+    EXPECT_NE(over.err.find(dir / "scene.bin: would overwrite " + dir / "scene.bin" + ", which the input " +
+                            dir / "scene.gltf" + " reads"),
+              std::string::npos) << over.err;
+    EXPECT_EQ(slurp(dir / "scene.bin"), buffer);
+    // stdin and stdout the same file.
+    CliRun both = run("convert --to stl - - < " + dir / "in.stl" + " >> " + dir / "link.stl");
+    EXPECT_EQ(both.code, 2) << both.err;
+    EXPECT_NE(both.err.find("<stdout>: would overwrite the input <stdin>"), std::string::npos) << both.err;
     EXPECT_EQ(slurp(dir / "in.stl"), before);
-    EXPECT_NE(hard.err.find("error vs input"), std::string::npos) << hard.err;
 }
 
 // A text file cut inside its last number reads as valid: the warning names the file.
@@ -503,7 +552,7 @@ TEST(CliBadInput, CommandLinesThatCannotWorkExit2BeforeAnyWork) {
         // used to do the whole job, then fail to rename "<input>: … .tmp-XXXXXX into place" (exit 1)
         {"convert " + in + " '' --to glb", "the output name is empty"},
         {"convert " + in + " " + out + " --from foo", "--from: unknown input format 'foo'"},
-        {"convert " + in + " -", "<stdout>: writing to stdout needs --to (one of: draco"},
+        {"convert " + in + " -", "<stdout>: writing to stdout needs --to unless it is a pipe (one of: draco"},
         {"decimate -r 0.5 " + in + " -", "<stdout>: writing to stdout needs --to"},
         {"sort --axis x " + in + " -", "<stdout>: writing to stdout needs --to"},
         {"sort - " + out + " < " + in, "<stdin>: --axis auto reads the input twice"},
@@ -576,7 +625,10 @@ TEST(CliBadInput, UnknownCommandIsNamedAndVersionIsPrinted) {
     EXPECT_EQ(slurp(dir / "version.txt").rfind("meshstream ", 0), 0u) << slurp(dir / "version.txt");
 }
 
-TEST(CliBadInput, NanAndDegenerateTrianglesAreSkippedWithCountedWarnings) {
+// convert and sort keep every triangle (issue 21: a converter does not edit geometry unasked);
+// --clean drops NaN/inf and degenerate ones with counted warnings, and decimate, which cannot
+// use them, skips them the same way (an error with --strict).
+TEST(CliBadInput, NanAndDegenerateTrianglesAreKeptOrDroppedWithCountedWarnings) {
     TempDir dir;
     const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
     std::vector<float> tris = grid(3);  // 18 good triangles
@@ -586,15 +638,28 @@ TEST(CliBadInput, NanAndDegenerateTrianglesAreSkippedWithCountedWarnings) {
     tris.insert(tris.end(), {-0.0f, 0, 0, 0, 0, 0, 5, 5, 5});  // -0 == +0: also degenerate
     write_file(dir / "bad.stl", binary_stl(tris));
 
-    CliRun c = run("convert " + dir / "bad.stl" + " " + dir / "out.stl");
+    // Lossless by default: the same 22 triangles, bit for bit (only the zero normals differ).
+    CliRun kept = run("convert " + dir / "bad.stl" + " " + dir / "kept.stl");
+    ASSERT_EQ(kept.code, 0) << kept.err;
+    EXPECT_EQ(kept.err.find("warning"), std::string::npos) << kept.err;
+    ASSERT_EQ(fs::file_size(dir / "kept.stl"), 84u + 50u * 22u);
+    const std::string in_bytes = slurp(dir / "bad.stl"), kept_bytes = slurp(dir / "kept.stl");
+    for (size_t t = 0; t < 22; ++t)
+        EXPECT_EQ(kept_bytes.substr(84 + 50 * t + 12, 36), in_bytes.substr(84 + 50 * t + 12, 36)) << "triangle " << t;
+    CliRun sorted_all = run("sort --axis x " + dir / "bad.stl" + " " + dir / "sorted_all.stl");
+    ASSERT_EQ(sorted_all.code, 0) << sorted_all.err;
+    EXPECT_EQ(fs::file_size(dir / "sorted_all.stl"), 84u + 50u * 22u);
+
+    CliRun c = run("convert --clean " + dir / "bad.stl" + " " + dir / "out.stl");
     ASSERT_EQ(c.code, 0) << c.err;
-    EXPECT_NE(c.err.find("warning: triangles with a NaN or infinite coordinate skipped (2)"), std::string::npos) << c.err;
-    EXPECT_NE(c.err.find("warning: degenerate triangles (two corners at the same position) skipped (2)"),
+    EXPECT_NE(c.err.find("warning: triangles with a NaN or infinite coordinate removed (--clean) (2)"),
+              std::string::npos) << c.err;
+    EXPECT_NE(c.err.find("warning: degenerate triangles (two corners at the same position) removed (--clean) (2)"),
               std::string::npos) << c.err;
     EXPECT_EQ(fs::file_size(dir / "out.stl"), 84u + 50u * 18u);  // header count patched to 18
     // To stdout nothing can be patched: formats with a count first spool until they know it.
     for (const char* to : {"stl", "ply"}) {
-        CliRun p = run("convert " + dir / "bad.stl" + " - --to " + to + " > " + dir / "piped");
+        CliRun p = run("convert --clean " + dir / "bad.stl" + " - --to " + to + " > " + dir / "piped");
         ASSERT_EQ(p.code, 0) << to << ": " << p.err;
         CliRun back = run("convert --from " + std::string(to) + " " + dir / "piped" + " " + dir / "back.stl");
         ASSERT_EQ(back.code, 0) << back.err;
@@ -603,9 +668,9 @@ TEST(CliBadInput, NanAndDegenerateTrianglesAreSkippedWithCountedWarnings) {
     fs::remove(dir / "piped");
     fs::remove(dir / "back.stl");
 
-    CliRun s = run("sort --axis x " + dir / "bad.stl" + " " + dir / "sorted.stl");
+    CliRun s = run("sort --clean --axis x " + dir / "bad.stl" + " " + dir / "sorted.stl");
     ASSERT_EQ(s.code, 0) << s.err;
-    EXPECT_NE(s.err.find("skipped (2)"), std::string::npos) << s.err;
+    EXPECT_NE(s.err.find("removed (--clean) (2)"), std::string::npos) << s.err;
     EXPECT_EQ(fs::file_size(dir / "sorted.stl"), 84u + 50u * 18u);
 
     CliRun d = run("decimate --ratio 0.5 " + dir / "bad.stl" + " " + dir / "dec.stl");
@@ -613,22 +678,26 @@ TEST(CliBadInput, NanAndDegenerateTrianglesAreSkippedWithCountedWarnings) {
     EXPECT_NE(d.err.find("warning: triangles with a NaN or infinite coordinate skipped (2)"), std::string::npos) << d.err;
     EXPECT_NE(d.err.find("triangles in 18,"), std::string::npos) << d.err;
 
-    // --strict: the first one is an error naming the file and the triangle; nothing is written.
-    for (const char* cmd : {"convert", "sort --axis x", "decimate"}) {
-        CliRun r = run(std::string(cmd) + " --strict " + dir / "bad.stl" + " " + dir / "strict.stl");
-        EXPECT_EQ(r.code, 1) << cmd;
-        EXPECT_NE(r.err.find("meshstream: error: " + dir / "bad.stl" +
-                             ": triangle 19 has a NaN or infinite coordinate (--strict)"),
-                  std::string::npos) << r.err;
-        EXPECT_FALSE(fs::exists(dir / "strict.stl"));
+    // decimate --strict: the first one is an error naming the file and the triangle; nothing
+    // is written. convert and sort --strict keep them (an STL holds them).
+    CliRun r = run("decimate --strict " + dir / "bad.stl" + " " + dir / "strict.stl");
+    EXPECT_EQ(r.code, 1);
+    EXPECT_NE(r.err.find("meshstream: error: " + dir / "bad.stl" +
+                         ": triangle 19 has a NaN or infinite coordinate (--strict)"),
+              std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir / "strict.stl"));
+    for (const char* cmd : {"convert", "sort --axis x"}) {
+        CliRun k = run(std::string(cmd) + " --strict " + dir / "bad.stl" + " " + dir / "strict.stl");
+        EXPECT_EQ(k.code, 0) << cmd << ": " << k.err;
+        EXPECT_EQ(fs::file_size(dir / "strict.stl"), 84u + 50u * 22u) << cmd;
     }
     // info and compare report the file as it is; --strict makes the same triangle an error.
     for (const std::string& cmd : {"info " + dir / "bad.stl", "compare " + dir / "bad.stl" + " " + dir / "bad.stl"}) {
         EXPECT_EQ(run(cmd).code, 0) << cmd;
-        CliRun r = run(cmd + " --strict");
-        EXPECT_EQ(r.code, 1) << cmd;
-        EXPECT_NE(r.err.find(dir / "bad.stl" + ": triangle 19 has a NaN or infinite coordinate (--strict)"),
-                  std::string::npos) << r.err;
+        CliRun e = run(cmd + " --strict");
+        EXPECT_EQ(e.code, 1) << cmd;
+        EXPECT_NE(e.err.find(dir / "bad.stl" + ": triangle 19 has a NaN or infinite coordinate (--strict)"),
+                  std::string::npos) << e.err;
     }
 }
 
@@ -641,12 +710,18 @@ TEST(CliBadInput, HelpDescribesTheSkipPolicy) {
         ::unlink(out_path);
         return help;
     };
-    for (const char* cmd : {"convert", "sort", "decimate"}) {
-        const std::string help = help_of(cmd);
+    {
+        const std::string help = help_of("decimate");
         // CLI11 wraps long descriptions; look for the key words.
-        EXPECT_NE(help.find("--strict"), std::string::npos) << cmd;
-        EXPECT_NE(help.find("NaN/inf"), std::string::npos) << cmd << help;
-        EXPECT_NE(help.find("skipped with a"), std::string::npos) << cmd;
+        EXPECT_NE(help.find("--strict"), std::string::npos);
+        EXPECT_NE(help.find("NaN/inf"), std::string::npos) << help;
+        EXPECT_NE(help.find("skipped with a"), std::string::npos) << help;
+    }
+    for (const char* cmd : {"convert", "sort"}) {  // lossless: only --clean drops
+        const std::string help = help_of(cmd);
+        EXPECT_NE(help.find("--clean"), std::string::npos) << cmd;
+        EXPECT_NE(help.find("every input triangle is kept"), std::string::npos) << cmd << help;
+        EXPECT_EQ(help.find("skipped with a"), std::string::npos) << cmd << help;
     }
     for (const char* cmd : {"info", "compare"}) {  // no skipping there: --strict only adds errors
         const std::string help = help_of(cmd);

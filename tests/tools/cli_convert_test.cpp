@@ -215,3 +215,40 @@ TEST(CliConvert, RoundedDoubleCoordinatesAreAWarning) {
     EXPECT_EQ(e.code, 0) << e.err;
     EXPECT_EQ(e.err.find("rounded to float"), std::string::npos) << e.err;
 }
+
+// issue 21 §6: on a pipe without --to, meshstream writes its triangle stream, which the next
+// command reads as it comes: sort into decimate needs no spool file at all (TMPDIR names no
+// directory, and the sort fits in --memory), and the sorted axis travels along.
+TEST(CliPipe, SortIntoDecimateStreamsWithoutASpool) {
+    TempDir dir;
+    const std::string glb = dir / "out.glb";
+    cli_test::CliRun r = run("sort --memory 64M " + kBunny + " - | TMPDIR=/nonexistent/tmp " + MESHSTREAM_BINARY +
+                       " -q decimate - " + glb + " -r 0.01",
+                   "TMPDIR=/nonexistent/tmp");
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.err.find("sorted along x (ascending)"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("triangles in 69451, out 695"), std::string::npos) << r.err;
+    nlohmann::json j = info_json(glb);
+    EXPECT_EQ(j["triangles"], 695);
+    EXPECT_EQ(listing(dir.path), (std::vector<std::string>{"out.glb"}));
+    // Into a file, stdout gets the format its --to says; without --to a file is refused.
+    cli_test::CliRun to_file = run("convert " + kBunny + " - > " + dir / "x");
+    EXPECT_EQ(to_file.code, 2) << to_file.err;
+    // --to stl to a pipe still works: binary STL spools its body until it knows the count.
+    cli_test::CliRun stl = run("convert --clean --to stl " + kBunny + " - | cat > " + dir / "piped.stl");
+    ASSERT_EQ(stl.code, 0) << stl.err;
+    ASSERT_EQ(run("convert " + kBunny + " " + dir / "direct.stl").code, 0);
+    EXPECT_TRUE(slurp(dir / "piped.stl") == slurp(dir / "direct.stl"));
+}
+
+// The stream carries what STL cannot: a PLY's colours survive a pipe between two commands.
+TEST(CliPipe, TheStreamCarriesEveryChannel) {
+    TempDir dir;
+    const std::string coloured = std::string(MESHSTREAM_FIXTURES_DIR) + "/ply/cactus_vcolor.binary_le.ply";
+    cli_test::CliRun r = run("convert " + coloured + " - | " + MESHSTREAM_BINARY + " -q convert - " + dir / "c.ply");
+    ASSERT_EQ(r.code, 0) << r.err;
+    cli_test::CliRun direct = run("convert " + coloured + " " + dir / "d.ply");
+    ASSERT_EQ(direct.code, 0) << direct.err;
+    EXPECT_EQ(slurp(dir / "c.ply"), slurp(dir / "d.ply"));
+    EXPECT_NE(slurp(dir / "c.ply").find("property uchar red"), std::string::npos);
+}
