@@ -17,12 +17,14 @@
 // Reader: the default scene's node tree (or, without scenes, every mesh once) with node
 // transforms applied, so the soup is in world space; winding is flipped under mirroring
 // transforms. TRIANGLES, TRIANGLE_STRIP and TRIANGLE_FAN are read (with or without indices,
-// Draco or plain accessors, KHR_mesh_quantization's integer positions); points and lines,
-// sparse accessors and other required extensions (e.g. EXT_meshopt_compression) are refused
-// with an io::Error naming the file and the mesh, primitive or extension; JSON nested deeper
-// than 512 arrays and objects, or ending inside one, is refused at its byte before any parser
-// sees it. Buffer files are read from the document's directory only (the current one for
-// stdin).
+// Draco or plain accessors, KHR_mesh_quantization's integer positions, EXT_meshopt_compression
+// bufferViews decoded with libmeshoptimizer and its filters); points and lines, sparse
+// accessors and other required extensions are refused with an io::Error naming the file and
+// the mesh, primitive or extension, as are compressed bufferViews whose parameters the spec
+// forbids or whose streams do not decode; JSON nested deeper than 512 arrays and objects, or
+// ending inside one, is refused at its byte before any parser sees it. Buffer files are read
+// from the document's directory only (the current one for stdin). Decoded meshopt bufferViews
+// are held with the document and count against --memory.
 #pragma once
 
 #include "io/format.hpp"

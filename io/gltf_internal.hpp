@@ -16,6 +16,7 @@ constexpr uint32_t kChunkJson = 0x4E4F534A;  // "JSON"
 constexpr uint32_t kChunkBin = 0x004E4942;   // "BIN\0"
 constexpr const char* kDracoExtension = "KHR_draco_mesh_compression";
 constexpr const char* kQuantizationExtension = "KHR_mesh_quantization";
+constexpr const char* kMeshoptExtension = "EXT_meshopt_compression";
 
 // Little-endian 32-bit fields of the GLB header and chunk headers.
 inline void put_u32(std::string& out, uint32_t v) {

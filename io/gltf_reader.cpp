@@ -12,6 +12,7 @@
 #include "io/draco.hpp"
 #endif
 
+#include <meshoptimizer.h>
 #include <nlohmann/json.hpp>
 #include <tiny_gltf.h>
 
@@ -21,6 +22,7 @@
 #include <cstring>
 #include <map>
 #include <memory>
+#include <set>
 #include <string_view>
 #include <sys/stat.h>
 
@@ -36,7 +38,7 @@ bool extension_supported(const std::string& ext) {
 #if MESHSTREAM_WITH_DRACO
     if (ext == kDracoExtension) return true;
 #endif
-    if (ext == kQuantizationExtension) return true;
+    if (ext == kQuantizationExtension || ext == kMeshoptExtension) return true;
     return ext.starts_with("KHR_materials_") || ext.starts_with("KHR_texture_") || ext.starts_with("EXT_texture_") ||
            ext == "KHR_lights_punctual";
 }
@@ -306,7 +308,14 @@ public:
         check_json_nesting(json_text(bytes, glb), glb ? 20 : 0, name_, glb ? "JSON chunk" : "file");
         header_.variant = glb ? "binary (GLB)" : "JSON";
 
-        hide_draco_indices(bytes, glb);
+        if (glb) {
+            // Where the BIN chunk's data starts in the file (buffer 0), for error positions;
+            // taken before the JSON is rewritten below.
+            const uint64_t json_end = 20 + uint64_t{get_u32(&bytes[12])};
+            if (bytes.size() >= 20 && json_end + 8 <= bytes.size() && get_u32(&bytes[json_end + 4]) == kChunkBin)
+                bin_offset_ = json_end + 8;
+        }
+        rewrite_for_tinygltf(bytes, glb);
         if (const uint64_t external = external_buffer_bytes(json_text(bytes, glb));
             bytes.size() + external > options.memory_budget_bytes)
             throw Error(name_, "glTF documents are read whole into memory with their buffers: this one and its buffer "
@@ -359,6 +368,7 @@ public:
             header_.notes.emplace_back("draco", draco_settings_);
             break;
         }
+        if (std::string meshopt = meshopt_summary(); !meshopt.empty()) header_.notes.emplace_back("meshopt", meshopt);
         std::string used;
         for (const std::string& e : model_.extensionsUsed) used += (used.empty() ? "" : ", ") + e;
         if (!used.empty()) header_.notes.emplace_back("extensions", used);
@@ -367,7 +377,9 @@ public:
     bool next(TriangleChunk& chunk) override;
 
 private:
-    void hide_draco_indices(std::vector<unsigned char>& bytes, bool glb);
+    void rewrite_for_tinygltf(std::vector<unsigned char>& bytes, bool glb);
+    const std::vector<unsigned char>& meshopt_view(int index, const std::string& what) const;
+    std::string meshopt_summary() const;
     [[noreturn]] void throw_unsupported_extension(const std::string& ext) const {
 #if !MESHSTREAM_WITH_DRACO
         if (ext == kDracoExtension)
@@ -401,8 +413,13 @@ private:
     tinygltf::Model model_;
     std::vector<Instance> instances_;
     std::map<std::pair<int, int>, std::shared_ptr<const PrimitiveGeometry>> draco_cache_;
-    std::map<std::pair<int, int>, int> draco_indices_;
-    std::string draco_settings_;  // of the first Draco primitive decoded, for `info`  // (mesh, primitive) -> hidden indices accessor
+    std::map<std::pair<int, int>, int> draco_indices_;  // (mesh, primitive) -> hidden indices accessor
+    std::string draco_settings_;  // of the first Draco primitive decoded, for `info`
+    std::optional<uint64_t> bin_offset_;  // file offset of a GLB's BIN chunk data (buffer 0)
+    std::set<int> fallback_buffers_;      // EXT_meshopt_compression fallback buffers, which hold no data
+    // EXT_meshopt_compression bufferViews decoded so far, and their bytes (held to --memory).
+    mutable std::map<int, std::vector<unsigned char>> meshopt_views_;
+    mutable uint64_t meshopt_bytes_ = 0;
     // Streaming position: instance, primitive, triangle; world-space positions of the current one.
     size_t inst_ = 0, prim_ = 0, tri_ = 0;
     bool loaded_ = false;
@@ -411,11 +428,15 @@ private:
     std::vector<float> world_;
 };
 
-// tinygltf 2.7 rejects an index accessor without a bufferView ("accessor[0] invalid
-// bufferView"), which is exactly what KHR_draco_mesh_compression primitives have: the indices
-// live in the Draco blob. So the "indices" of Draco primitives are taken out of the JSON before
-// tinygltf parses it and remembered here (they only state the triangle count).
-void GltfReader::hide_draco_indices(std::vector<unsigned char>& bytes, bool glb) {
+// Rewrites what tinygltf 2.7 cannot parse as it is, before it does, and remembers what was taken:
+// - KHR_draco_mesh_compression primitives have an index accessor without a bufferView (the
+//   indices live in the Draco blob), which tinygltf rejects ("accessor[0] invalid bufferView"):
+//   their "indices" are taken out and remembered in draco_indices_ (they only state the count);
+// - EXT_meshopt_compression's fallback buffers have no data (no "uri", and not the GLB's BIN
+//   chunk) when the extension is required, which tinygltf cannot load: they become one-byte
+//   data URIs, remembered in fallback_buffers_, and their bufferViews are decoded from the
+//   compressed data instead.
+void GltfReader::rewrite_for_tinygltf(std::vector<unsigned char>& bytes, bool glb) {
     size_t json_begin = 0, json_size = bytes.size();
     if (glb) {
         if (bytes.size() < 20 || get_u32(&bytes[16]) != kChunkJson) return;  // tinygltf reports it
@@ -424,21 +445,39 @@ void GltfReader::hide_draco_indices(std::vector<unsigned char>& bytes, bool glb)
         if (json_size > bytes.size() - 20) return;
     }
     std::string_view json(reinterpret_cast<const char*>(bytes.data()) + json_begin, json_size);
-    if (json.find(kDracoExtension) == std::string_view::npos) return;
+    if (json.find(kDracoExtension) == std::string_view::npos && json.find(kMeshoptExtension) == std::string_view::npos)
+        return;
     auto doc = nlohmann::ordered_json::parse(json, nullptr, false);
-    if (doc.is_discarded() || !doc.is_object() || !doc.contains("meshes") || !doc["meshes"].is_array()) return;
+    if (doc.is_discarded() || !doc.is_object()) return;
     bool changed = false;
-    for (size_t m = 0; m < doc["meshes"].size(); ++m) {
-        auto& mesh = doc["meshes"][m];
-        if (!mesh.is_object() || !mesh.contains("primitives") || !mesh["primitives"].is_array()) continue;
-        for (size_t p = 0; p < mesh["primitives"].size(); ++p) {
-            auto& prim = mesh["primitives"][p];
-            if (!prim.is_object() || !prim.contains("extensions") || !prim["extensions"].is_object() ||
-                !prim["extensions"].contains(kDracoExtension) || !prim.contains("indices") ||
-                !prim["indices"].is_number_integer())
+    if (doc.contains("meshes") && doc["meshes"].is_array()) {
+        for (size_t m = 0; m < doc["meshes"].size(); ++m) {
+            auto& mesh = doc["meshes"][m];
+            if (!mesh.is_object() || !mesh.contains("primitives") || !mesh["primitives"].is_array()) continue;
+            for (size_t p = 0; p < mesh["primitives"].size(); ++p) {
+                auto& prim = mesh["primitives"][p];
+                if (!prim.is_object() || !prim.contains("extensions") || !prim["extensions"].is_object() ||
+                    !prim["extensions"].contains(kDracoExtension) || !prim.contains("indices") ||
+                    !prim["indices"].is_number_integer())
+                    continue;
+                draco_indices_[{int(m), int(p)}] = prim["indices"].get<int>();
+                prim.erase("indices");
+                changed = true;
+            }
+        }
+    }
+    if (doc.contains("buffers") && doc["buffers"].is_array()) {
+        for (size_t b = 0; b < doc["buffers"].size(); ++b) {
+            auto& buffer = doc["buffers"][b];
+            if (!buffer.is_object() || buffer.contains("uri") || (glb && b == 0) || !buffer.contains("extensions") ||
+                !buffer["extensions"].is_object() || !buffer["extensions"].contains(kMeshoptExtension))
                 continue;
-            draco_indices_[{int(m), int(p)}] = prim["indices"].get<int>();
-            prim.erase("indices");
+            const auto& ext = buffer["extensions"][kMeshoptExtension];
+            if (!ext.is_object() || !ext.contains("fallback") || ext["fallback"] != true) continue;
+            // One zero byte: tinygltf refuses an empty data URI.
+            buffer["uri"] = "data:application/octet-stream;base64,AA==";
+            buffer["byteLength"] = 1;
+            fallback_buffers_.insert(int(b));
             changed = true;
         }
     }
@@ -462,6 +501,127 @@ void GltfReader::hide_draco_indices(std::vector<unsigned char>& bytes, bool glb)
     out.insert(out.end(), text.begin(), text.end());
     out.insert(out.end(), bytes.begin() + 20 + json_size, bytes.end());
     bytes.swap(out);
+}
+
+namespace {
+
+// An unsigned integer member of an extension object, `fallback` when absent; nullopt when
+// present but not a non-negative integer.
+std::optional<uint64_t> unsigned_member(const tinygltf::Value& object, const char* key, std::optional<uint64_t> fallback) {
+    if (!object.Has(key)) return fallback;
+    const tinygltf::Value& v = object.Get(key);
+    if (v.IsInt() && v.Get<int>() >= 0) return uint64_t(v.Get<int>());
+    if (v.IsNumber()) {
+        const double d = v.GetNumberAsDouble();
+        if (d >= 0 && d < 18446744073709551616.0 && d == std::floor(d)) return uint64_t(d);
+    }
+    return std::nullopt;
+}
+
+}  // namespace
+
+// EXT_meshopt_compression: the bufferView's data, decoded once from its compressed copy with
+// libmeshoptimizer's decoders and filters and cached. Every parameter the decoders assert on is
+// checked first, so bad input is an io::Error (naming the bufferView and where its compressed
+// bytes lie) and never reaches an assertion or a read out of bounds.
+const std::vector<unsigned char>& GltfReader::meshopt_view(int index, const std::string& what) const {
+    if (auto it = meshopt_views_.find(index); it != meshopt_views_.end()) return it->second;
+    const tinygltf::BufferView& bv = model_.bufferViews[index];
+    const tinygltf::Value& ext = bv.extensions.at(kMeshoptExtension);
+    const std::string at = what + ": bufferView " + std::to_string(index) + " (EXT_meshopt_compression)";
+    if (!ext.IsObject()) throw Error(name_, at + " is not a JSON object");
+    const auto buffer = unsigned_member(ext, "buffer", std::nullopt);
+    const auto offset = unsigned_member(ext, "byteOffset", 0), length = unsigned_member(ext, "byteLength", std::nullopt);
+    const auto stride = unsigned_member(ext, "byteStride", std::nullopt), count = unsigned_member(ext, "count", std::nullopt);
+    for (const auto& [value, key] : {std::pair{buffer, "buffer"}, std::pair{offset, "byteOffset"},
+                                     std::pair{length, "byteLength"}, std::pair{stride, "byteStride"},
+                                     std::pair{count, "count"}})
+        if (!value) throw Error(name_, at + " needs '" + key + "' as a non-negative integer");
+    const std::string mode = ext.Get("mode").IsString() ? ext.Get("mode").Get<std::string>() : std::string();
+    const std::string filter = !ext.Has("filter") ? std::string("NONE")
+                               : ext.Get("filter").IsString() ? ext.Get("filter").Get<std::string>()
+                                                              : std::string("?");
+    if (mode != "ATTRIBUTES" && mode != "TRIANGLES" && mode != "INDICES")
+        throw Error(name_, at + " has mode '" + printable(mode, 40) + "' (one of ATTRIBUTES, TRIANGLES, INDICES)");
+    if (filter != "NONE" && filter != "OCTAHEDRAL" && filter != "QUATERNION" && filter != "EXPONENTIAL")
+        throw Error(name_, at + " has filter '" + printable(filter, 40) + "' (one of NONE, OCTAHEDRAL, QUATERNION, EXPONENTIAL)");
+    // The spec's limits, which are also libmeshoptimizer's preconditions (asserted there).
+    if (mode == "ATTRIBUTES" && (*stride == 0 || *stride > 256 || *stride % 4 != 0))
+        throw Error(name_, at + ": ATTRIBUTES with byteStride " + std::to_string(*stride) + " (must be a multiple of 4, 4-256)");
+    if (mode != "ATTRIBUTES" && *stride != 2 && *stride != 4)
+        throw Error(name_, at + ": " + mode + " with byteStride " + std::to_string(*stride) + " (must be 2 or 4)");
+    if (mode == "TRIANGLES" && *count % 3 != 0)
+        throw Error(name_, at + ": TRIANGLES with count " + std::to_string(*count) + ", not a multiple of 3");
+    if (filter != "NONE" && mode != "ATTRIBUTES")
+        throw Error(name_, at + ": filter " + filter + " with mode " + mode + " (filters apply to ATTRIBUTES only)");
+    if ((filter == "OCTAHEDRAL" && *stride != 4 && *stride != 8) || (filter == "QUATERNION" && *stride != 8))
+        throw Error(name_, at + ": filter " + filter + " with byteStride " + std::to_string(*stride) + " (must be " +
+                               (filter == "QUATERNION" ? "8)" : "4 or 8)"));
+    if (mode == "ATTRIBUTES" && bv.byteStride != 0 && bv.byteStride != *stride)
+        throw Error(name_, at + " has byteStride " + std::to_string(*stride) + ", its bufferView " +
+                               std::to_string(bv.byteStride));
+    uint64_t decoded_bytes = 0;
+    if (__builtin_mul_overflow(*count, *stride, &decoded_bytes) || decoded_bytes != bv.byteLength)
+        throw Error(name_, at + " decodes to count " + std::to_string(*count) + " x byteStride " + std::to_string(*stride) +
+                               " bytes, but its bufferView's byteLength is " + std::to_string(bv.byteLength));
+    if (*buffer >= model_.buffers.size())
+        throw Error(name_, at + " refers to buffer " + std::to_string(*buffer) + ", which does not exist");
+    if (fallback_buffers_.count(int(*buffer)))
+        throw Error(name_, at + " refers to buffer " + std::to_string(*buffer) + ", a fallback buffer without data");
+    const std::vector<unsigned char>& data = model_.buffers[*buffer].data;
+    if (*offset > data.size() || *length > data.size() - *offset)
+        throw Error(name_, at + ": compressed bytes " + sum_text(*offset, 0) + " to " + sum_text(*offset, *length) +
+                               " lie outside buffer " + std::to_string(*buffer) + " (" + std::to_string(data.size()) +
+                               " bytes)");
+    if (decoded_bytes > budget_bytes_ || meshopt_bytes_ + decoded_bytes > budget_bytes_)
+        throw Error(name_, at + " decodes to " + binary_size(decoded_bytes) + ", which with the views decoded before " +
+                               "passes the memory budget of " + binary_size(budget_bytes_) + "; raise --memory");
+    std::vector<unsigned char> out(decoded_bytes);
+    const unsigned char* src = data.data() + *offset;
+    int rc = 0;
+    if (mode == "ATTRIBUTES") rc = meshopt_decodeVertexBuffer(out.data(), *count, *stride, src, *length);
+    else if (mode == "TRIANGLES") rc = meshopt_decodeIndexBuffer(out.data(), *count, *stride, src, *length);
+    else rc = meshopt_decodeIndexSequence(out.data(), *count, *stride, src, *length);
+    if (rc != 0) {
+        // Where the compressed bytes start: in the file for a GLB's own buffer, else in the buffer.
+        const bool in_file = *buffer == 0 && bin_offset_ && model_.buffers[0].uri.empty();
+        const std::string where = in_file ? std::string() : " (bytes " + std::to_string(*offset) + " to " +
+                                                                sum_text(*offset, *length) + " of buffer " +
+                                                                std::to_string(*buffer) + ")";
+        throw Error(name_, in_file ? *bin_offset_ + *offset : 0, 0,
+                    at + where + ": the compressed " + (mode == "ATTRIBUTES" ? "vertex" : "index") + " data is corrupt or cut short (" +
+                        std::to_string(*length) + " bytes for " + std::to_string(*count) + " " +
+                        (mode == "ATTRIBUTES" ? "elements" : "indices") + " of " + std::to_string(*stride) +
+                        " bytes; libmeshoptimizer's " +
+                        (mode == "ATTRIBUTES" ? "meshopt_decodeVertexBuffer" : mode == "TRIANGLES" ? "meshopt_decodeIndexBuffer" : "meshopt_decodeIndexSequence") +
+                        " returned " + std::to_string(rc) + ")");
+    }
+    if (filter == "OCTAHEDRAL") meshopt_decodeFilterOct(out.data(), *count, *stride);
+    else if (filter == "QUATERNION") meshopt_decodeFilterQuat(out.data(), *count, *stride);
+    else if (filter == "EXPONENTIAL") meshopt_decodeFilterExp(out.data(), *count, *stride);
+    meshopt_bytes_ += decoded_bytes;
+    return meshopt_views_.emplace(index, std::move(out)).first->second;
+}
+
+// For `info`: how many bufferViews are compressed, by mode and filter, and their sizes.
+std::string GltfReader::meshopt_summary() const {
+    std::map<std::string, int> kinds;
+    uint64_t compressed = 0, decoded = 0;
+    for (const tinygltf::BufferView& bv : model_.bufferViews) {
+        auto it = bv.extensions.find(kMeshoptExtension);
+        if (it == bv.extensions.end() || !it->second.IsObject()) continue;
+        const tinygltf::Value& ext = it->second;
+        std::string kind = ext.Get("mode").IsString() ? ext.Get("mode").Get<std::string>() : "?";
+        if (ext.Get("filter").IsString() && ext.Get("filter").Get<std::string>() != "NONE")
+            kind += "+" + ext.Get("filter").Get<std::string>();
+        ++kinds[kind];
+        compressed += unsigned_member(ext, "byteLength", 0).value_or(0);
+        decoded += bv.byteLength;
+    }
+    if (kinds.empty()) return {};
+    std::string out;
+    for (const auto& [kind, n] : kinds) out += (out.empty() ? "" : ", ") + std::to_string(n) + " " + kind;
+    return out + " buffer view(s), " + binary_size(compressed) + " compressed, " + binary_size(decoded) + " decoded";
 }
 
 void GltfReader::collect_instances() {
@@ -565,9 +725,14 @@ AccessorView GltfReader::view(int accessor, const std::string& what) const {
     if (a.bufferView >= static_cast<int>(model_.bufferViews.size()))
         throw Error(name_, where_acc + " refers to bufferView " + std::to_string(a.bufferView) + ", which does not exist");
     const tinygltf::BufferView& bv = model_.bufferViews[a.bufferView];
-    if (bv.buffer < 0 || bv.buffer >= static_cast<int>(model_.buffers.size()))
+    const bool meshopt = bv.extensions.count(kMeshoptExtension) > 0;
+    if (!meshopt && (bv.buffer < 0 || bv.buffer >= static_cast<int>(model_.buffers.size())))
         throw Error(name_, where_acc + ": bufferView refers to a missing buffer");
-    const std::vector<unsigned char>& data = model_.buffers[bv.buffer].data;
+    if (!meshopt && fallback_buffers_.count(bv.buffer))
+        throw Error(name_, where_acc + ": bufferView " + std::to_string(a.bufferView) + " lies in buffer " +
+                               std::to_string(bv.buffer) + ", an EXT_meshopt_compression fallback buffer without data");
+    // A compressed view is decoded whole; its bytes then stand for the view (offset 0).
+    const std::vector<unsigned char>& data = meshopt ? meshopt_view(a.bufferView, where_acc) : model_.buffers[bv.buffer].data;
     const size_t elem = csize * v.components;
     // glTF 2.0 §3.6.2.4: a stride spaces elements apart, it never overlaps them (the validator's
     // ACCESSOR_SMALL_BYTESTRIDE); byteStride 4 under VEC3 floats read each from the last one's y.
@@ -578,7 +743,7 @@ AccessorView GltfReader::view(int accessor, const std::string& what) const {
     v.stride = bv.byteStride ? bv.byteStride : elem;
     // Offsets, lengths and the count are 64-bit numbers from the JSON, so no sum or product of
     // them may wrap: a byteOffset near 2^64 made the view start before its buffer.
-    const uint64_t view_offset = bv.byteOffset, view_length = bv.byteLength;
+    const uint64_t view_offset = meshopt ? 0 : bv.byteOffset, view_length = bv.byteLength;
     if (view_offset > data.size() || view_length > data.size() - view_offset)
         throw Error(name_, where_acc + ": bufferView " + std::to_string(a.bufferView) + " ends at byte " +
                                sum_text(view_offset, view_length) + ", past the end of buffer " + std::to_string(bv.buffer) +
@@ -590,7 +755,7 @@ AccessorView GltfReader::view(int accessor, const std::string& what) const {
     if (wraps || end > view_length)
         throw Error(name_, where_acc + " reaches byte " + (wraps ? std::string("2^64 or more") : sum_text(view_offset, end)) +
                                " of a buffer view ending at " + std::to_string(view_offset + view_length));
-    v.base = data.data() + bv.byteOffset + a.byteOffset;
+    v.base = data.data() + view_offset + a.byteOffset;
     return v;
 }
 

@@ -14,9 +14,10 @@ jobs=$(nproc 2>/dev/null || echo 2)
 
 as_root() { if [ "$(id -u)" = 0 ]; then "$@"; else sudo "$@"; fi; }
 
-# Debian packages: build tools, libraries, and the real clients the tests check output with.
+# Debian packages: build tools, libraries, and the real clients the tests check output with
+# (draco_decoder; Chromium renders the GLBs the tests write with three.js).
 packages="cmake g++ make pkg-config libgtest-dev zlib1g-dev libdraco-dev draco libtinygltf-dev \
-nlohmann-json3-dev libcli11-dev"
+nlohmann-json3-dev libcli11-dev libmeshoptimizer-dev chromium"
 command -v node >/dev/null 2>&1 || packages="$packages nodejs"
 command -v npm >/dev/null 2>&1 || packages="$packages npm"
 missing=""
@@ -29,12 +30,17 @@ if [ -n "$missing" ]; then
   as_root env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends $missing >/dev/null
 fi
 
-# The Khronos glTF validator (npm), which the tests run on every glTF they write.
-if [ ! -f "$tools_dir/node_modules/gltf-validator/package.json" ]; then
-  echo "meshstream setup: installing gltf-validator into $tools_dir" >&2
-  as_root mkdir -p "$tools_dir"
-  as_root npm install --silent --no-audit --no-fund --prefix "$tools_dir" gltf-validator@2.0.0-dev.3.10 >/dev/null
-fi
+# npm tools: the Khronos glTF validator, which the tests run on every glTF they write; three.js,
+# whose GLTFLoader (with MeshoptDecoder and DRACOLoader) renders them in Chromium; gltfpack,
+# the size reference of bench/web.sh.
+for pkg in gltf-validator@2.0.0-dev.3.10 three@0.170.0 gltfpack@0.18.0; do
+  name=${pkg%@*}
+  if [ "$(node -p "try { require('$tools_dir/node_modules/$name/package.json').version } catch (e) { '' }" 2>/dev/null)" != "${pkg##*@}" ]; then
+    echo "meshstream setup: installing $pkg into $tools_dir" >&2
+    as_root mkdir -p "$tools_dir"
+    as_root npm install --silent --no-audit --no-fund --prefix "$tools_dir" "$pkg" >/dev/null
+  fi
+done
 
 if [ ! -f "$build_dir/CMakeCache.txt" ]; then
   cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release -DMESHSTREAM_TOOLS_DIR="$tools_dir" >/dev/null

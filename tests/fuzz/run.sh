@@ -17,7 +17,7 @@ BUILD_DIR=${BUILD_DIR:-$SRC/build-fuzz}
 JOBS=${JOBS:-2}
 SECONDS_PER_TARGET=${1:-600}
 shift || true
-ALL=(stl_binary stl_ascii ply obj gzip draco gltf decimate)
+ALL=(stl_binary stl_ascii ply obj gzip draco gltf gltf_meshopt decimate)
 [ $# -gt 0 ] && TARGETS=("$@") || TARGETS=("${ALL[@]}")
 
 cmake -S "$SRC" -B "$BUILD_DIR" -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo \
@@ -45,6 +45,18 @@ seed obj -name '*.obj' -o -name '*.obj.gz'
 seed gzip -name '*.gz'
 seed draco -name '*.drc'
 seed gltf -name '*.glb' -o -name '*.gltf'
+# EXT_meshopt_compression seeds (format in fuzz_gltf_meshopt.cpp): the compressed streams of
+# the meshopt fixtures behind a few choices of stride, filter and index mode.
+mkdir -p "$BUILD_DIR/fuzz-corpus/gltf_meshopt"
+python3 - "$BUILD_DIR/fuzz-corpus/gltf_meshopt" "$SRC/fixtures/gltf" <<'PY'
+import struct, sys
+for name in ("elephant_meshopt.glb", "BoxTextured_gltfpack_cc.glb"):
+    b = open(f"{sys.argv[2]}/{name}", "rb").read()
+    n = struct.unpack("<I", b[12:16])[0]
+    blob = b[28 + n:][:65000]
+    for select in (1, 5, 6, 15, 17, 33):
+        open(f"{sys.argv[1]}/{name}.{select}", "wb").write(bytes([select, 23, 12]) + blob)
+PY
 # Decimator seeds (format in fuzz_decimate.cpp): n×n grids of unit squares, a few options.
 mkdir -p "$BUILD_DIR/fuzz-corpus/decimate"
 python3 - "$BUILD_DIR/fuzz-corpus/decimate" <<'PY'
