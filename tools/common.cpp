@@ -317,11 +317,14 @@ void Progress::done() {
     drawn_ = false;
 }
 
+std::vector<std::string> Warnings::lines() const {
+    std::vector<std::string> out;
+    for (const auto& [kind, count] : counts_) out.push_back(count == 0 ? kind : kind + " (" + std::to_string(count) + ")");
+    return out;
+}
+
 void Warnings::print() const {
-    for (const auto& [kind, count] : counts_) {
-        if (count == 0) std::fprintf(stderr, "meshstream: warning: %s\n", kind.c_str());
-        else std::fprintf(stderr, "meshstream: warning: %s (%llu)\n", kind.c_str(), static_cast<unsigned long long>(count));
-    }
+    for (const std::string& line : lines()) std::fprintf(stderr, "meshstream: warning: %s\n", line.c_str());
 }
 
 std::string human_count(double n, int significant_digits) {
@@ -371,6 +374,19 @@ io::Bounds input_bounds(const std::string& path, std::string_view from, const io
         progress.update(done += chunk.size());
     }
     return box;
+}
+
+int longest_axis(const io::Bounds& box) {
+    int best = 2;
+    double best_extent = 0;
+    for (int a = 0; a < 3; ++a) {
+        const double extent = double(box.max[a]) - double(box.min[a]);
+        if (extent > best_extent) {
+            best_extent = extent;
+            best = a;
+        }
+    }
+    return best;
 }
 
 uint64_t peak_rss_bytes() {

@@ -131,6 +131,8 @@ public:
     // A one-off finding: printed as it is.
     void note(const std::string& text) { counts_.emplace(text, 0); }
     bool empty() const { return counts_.empty(); }
+    // The lines print() writes, without the "meshstream: warning: " prefix.
+    std::vector<std::string> lines() const;
     void print() const;
 
 private:
@@ -149,6 +151,8 @@ using io::is_stream;  // "-", pipes, devices: read or written once only
 // over the file (finite coordinates only; a progress bar on stderr). An input without finite
 // coordinates gives min = +inf, max = -inf. Throws io::Error like open_input.
 io::Bounds input_bounds(const std::string& path, std::string_view from, const io::ReadOptions& options);
+// The axis along which `box` is longest (z for an empty or flat box, the usual scan axis).
+int longest_axis(const io::Bounds& box);
 // Peak resident set size of this process in bytes (from /proc/self/status VmHWM).
 uint64_t peak_rss_bytes();
 

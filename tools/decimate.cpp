@@ -1,19 +1,30 @@
 // `meshstream decimate IN OUT --ratio p`: the Wu & Kobbelt stream decimator (decimate/) between
 // any reader and writer of the registry. Memory: the decimator's fixed buffer (--buffer) plus
 // what the two formats need; the output streams while the input is still being read.
-#include "decimate/phase_timers.hpp"
+//
+// --sort auto (the default): input not known to be sorted is decimated as it comes until the
+// first forced write, the sign that it is in no streaming order the buffer can hold. Then the
+// attempt is dropped (a file output's temporary file, or the output held back for a pipe), the
+// input is sorted out of core (sort/external_sort.hpp, within half of --memory, runs in
+// --tmpdir), from the file again or from a spool of stdin written meanwhile, and the sorted
+// stream is decimated. Input in streaming order costs nothing extra (an order pass, as
+// `info --order` makes, would read the whole file first); --sort always sorts first, never as
+// read.
 #include "decimate/stream_decimator.hpp"
 #include "io/error.hpp"
+#include "sort/external_sort.hpp"
 #include "tools/cli_checks.hpp"
 #include "tools/commands.hpp"
 #include "tools/common.hpp"
+#include "tools/decimate_report.hpp"
 #include "tools/input_filter.hpp"
 #include "compare/metro.hpp"
 
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
+#include <functional>
+#include <limits>
 #include <map>
 #include <memory>
 #include <new>
@@ -36,6 +47,7 @@ struct DecimateOptions {
     uint64_t seed = 1;
     std::string weld;  // "" / "0.001" / "0.01%"
     std::optional<int> sorted_axis;
+    std::string sort = "auto";  // --sort auto|always|never
     bool report = false;
     ReadFlags read;
     WriteFlags write;
@@ -73,6 +85,231 @@ double weld_epsilon(const DecimateOptions& opt, const std::string& input_name) {
     return std::isfinite(diag2) ? value / 100 * std::sqrt(diag2) : 0;  // no finite corner: nothing to weld
 }
 
+// What a decimation pass reads: fills a chunk, false at the end.
+using ChunkSource = std::function<bool(io::TriangleChunk&)>;
+
+double seconds_since(std::chrono::steady_clock::time_point t) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+// The positions of every triangle read from an input that can be read once only (stdin, a
+// pipe), spooled to a temporary file so that it can still be sorted: 36 bytes a triangle,
+// with the bounding box of its finite coordinates. The file is made on the first add(); a
+// file that cannot be made or written stops the spool (ok() false, error() says why) instead
+// of failing the command, which then decimates the input as it comes.
+class PositionSpool {
+public:
+    explicit PositionSpool(std::string tmpdir) : tmpdir_(std::move(tmpdir)) {
+        box_.min.fill(std::numeric_limits<float>::infinity());
+        box_.max.fill(-std::numeric_limits<float>::infinity());
+    }
+    void add(const io::TriangleChunk& chunk) {
+        if (!error_.empty()) return;
+        try {
+            if (!file_) file_ = std::make_unique<io::TempFile>(tmpdir_, "meshstream-spool");
+            file_->write(chunk.xyz().data(), chunk.xyz().size_bytes());
+        } catch (const io::Error& e) {
+            error_ = e.what();
+            file_.reset();
+            return;
+        }
+        const auto xyz = chunk.xyz();
+        for (size_t i = 0; i < xyz.size(); i += 3)
+            for (int a = 0; a < 3; ++a)
+                if (std::isfinite(xyz[i + a])) {
+                    box_.min[a] = std::min(box_.min[a], xyz[i + a]);
+                    box_.max[a] = std::max(box_.max[a], xyz[i + a]);
+                }
+        triangles_ += chunk.size();
+    }
+    bool ok() const { return error_.empty(); }
+    const std::string& error() const { return error_; }
+    const io::Bounds& bounds() const { return box_; }
+    uint64_t bytes() const { return triangles_ * 36; }
+    // Reads the spool back in order, a chunk at a time (positions only); false at the end.
+    bool next(io::TriangleChunk& chunk) {
+        chunk.clear();
+        const uint64_t n = std::min<uint64_t>(chunk.capacity(), triangles_ - read_);
+        if (n == 0) return false;
+        file_->read_at(read_ * 36, chunk.xyz_storage(), size_t(n) * 36);
+        chunk.resize(size_t(n));
+        read_ += n;
+        return true;
+    }
+
+private:
+    std::string tmpdir_;
+    std::unique_ptr<io::TempFile> file_;
+    std::string error_;
+    io::Bounds box_;
+    uint64_t triangles_ = 0, read_ = 0;
+};
+
+// Where the decimator's output goes while decimate may still start over on sorted input. A
+// file output is written as it comes (a restart drops its temporary file); an output written
+// in place (stdout, a pipe) is held in memory up to `hold_triangles`, then written out: from
+// there on nothing can be taken back (released()).
+class HeldOutput {
+public:
+    HeldOutput(io::Output& out, uint64_t hold_triangles) : out_(&out), limit_(hold_triangles) {}
+    void write(const io::TriangleChunk& chunk) {
+        if (!holding()) return out_->write(chunk);
+        held_.push_back(chunk);
+        held_triangles_ += chunk.size();
+        if (held_triangles_ > limit_) release();
+    }
+    bool holding() const { return limit_ > 0 && !released_; }
+    bool released() const { return released_; }
+    uint64_t held_triangles() const { return held_triangles_; }
+    // Writes what is held, and everything from now on.
+    void release() {
+        if (released_ || limit_ == 0) return;
+        released_ = true;
+        for (const io::TriangleChunk& c : held_) out_->write(c);
+        held_.clear();
+    }
+    // Forgets what is held (the attempt it came from was dropped).
+    void discard() {
+        held_.clear();
+        held_triangles_ = 0;
+    }
+    void rebind(io::Output& out) { out_ = &out; }
+
+private:
+    io::Output* out_;
+    uint64_t limit_;
+    std::vector<io::TriangleChunk> held_;
+    uint64_t held_triangles_ = 0;
+    bool released_ = false;
+};
+
+// The decimator's options from the command line and the input's header. Options that cannot
+// work with this input are UsageErrors (exit 2).
+decimate::Options decimation_options(const DecimateOptions& opt, const io::MeshHeader& header, const std::string& name) {
+    decimate::Options options;
+    if (opt.target) {
+        if (!header.triangle_count)
+            throw UsageError(name + ": --target needs the input triangle count, which this format does "
+                                    "not state up front (binary STL, Draco and glTF do); use --ratio");
+        if (*opt.target > *header.triangle_count)
+            throw UsageError(name + ": --target " + std::to_string(*opt.target) + " is more than the " +
+                             std::to_string(*header.triangle_count) +
+                             " triangles of the input (decimation only removes triangles)");
+        options.target = *opt.target;
+    } else {
+        options.ratio = opt.ratio.value_or(0.1);
+    }
+    options.buffer_triangles = opt.buffer;
+    options.candidates = opt.candidates;
+    options.seed = opt.seed;
+    options.weld_eps = weld_epsilon(opt, name);
+    options.sorted_axis = opt.sorted_axis ? opt.sorted_axis : header.sorted_axis;
+    // The file's flag comes from `meshstream sort` (or a convert that kept its order): ascending
+    // by triangle minimum. A --sorted-axis of the user's own says less: the key is not known.
+    options.sorted_by_minimum = header.sorted_axis && options.sorted_axis == header.sorted_axis;
+    return options;
+}
+
+std::unique_ptr<decimate::StreamDecimator> make_decimator(const decimate::Options& options, const io::InputCount& count) {
+    try {  // on the heap only to catch a refused reservation here
+        return std::make_unique<decimate::StreamDecimator>(options, count);
+    } catch (const std::bad_alloc&) {
+        throw std::runtime_error(
+            "--buffer " + std::to_string(options.buffer_triangles) + " reserves " +
+            human_bytes(double(decimate::HalfEdgeBuffer::reserved_bytes(options.buffer_triangles))) +
+            " of memory (about 500 bytes a triangle), which this system refused: give a smaller --buffer (the "
+            "default 400000 reserves " +
+            human_bytes(double(decimate::HalfEdgeBuffer::reserved_bytes(400000))) + ")");
+    }
+}
+
+// Pushes what `next` gives through `decimator`; returns false when `stop`, asked after each
+// chunk, said to stop, true at the end of the input.
+bool decimate_pass(const ChunkSource& next, decimate::StreamDecimator& decimator, const decimate::Emit& emit,
+                   Progress& progress, const std::function<uint64_t()>& done, const std::function<bool()>& stop) {
+    // The decimator rates and writes positions only: no other channel is read.
+    io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, io::Channels{});
+    while (next(chunk)) {
+        decimator.push(chunk, emit);
+        progress.update(done());
+        if (stop && stop()) return false;
+    }
+    return true;
+}
+
+// The input, sorted: the sorter to read it from, what reading it counted, and what it cost.
+struct SortedInput {
+    std::unique_ptr<sort::ExternalSorter> sorter;
+    int axis = 0;
+    io::InputCount count;
+    DroppedTriangles dropped;
+    io::MeshHeader end_header;  // the reader's header at the end (its notes)
+    uint64_t temp_bytes = 0;    // peak temporary disk of the sort
+};
+
+std::unique_ptr<sort::ExternalSorter> make_sorter(int axis, uint64_t budget, const std::string& tmpdir,
+                                                  Progress& progress) {
+    sort::SorterOptions so;
+    so.axis = axis;
+    so.memory_budget_bytes = budget;
+    so.tmpdir = tmpdir;
+    so.on_merge_progress = [&progress](int pass, int pass_count, uint64_t merged) {
+        progress.phase("sorting: merge pass " + std::to_string(pass) + "/" + std::to_string(pass_count), std::nullopt);
+        progress.update(merged);
+    };
+    return std::make_unique<sort::ExternalSorter>(so);
+}
+
+// Sorts a file input: its bounding box first (the longest axis), then its triangles, read
+// again through the read loop.
+SortedInput sort_file(const DecimateOptions& opt, uint64_t sort_budget, const io::ReadOptions& ro,
+                      const std::string& tmpdir, Progress& progress) {
+    SortedInput s;
+    s.axis = longest_axis(input_bounds(opt.input, opt.read.from, ro));
+    io::TriangleInput in = open_triangle_input(opt.input, opt.read, ro, Command::kDecimate);
+    s.sorter = make_sorter(s.axis, sort_budget, tmpdir, progress);
+    progress.phase("sorting: reading", in.header().triangle_count);
+    io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, io::Channels{});
+    while (in.next(chunk)) {
+        s.sorter->add(chunk);
+        progress.update(in.count().read);
+    }
+    s.count = in.count();
+    s.dropped = dropped_triangles(in);
+    s.end_header = in.header();
+    in.close();
+    s.sorter->finish_input();
+    s.temp_bytes = s.sorter->stats().peak_temp_bytes;
+    return s;
+}
+
+// Sorts an input read once: the rest of it goes to the spool, which is then sorted.
+SortedInput sort_spooled(io::TriangleInput& in, PositionSpool& spool, uint64_t sort_budget, const std::string& tmpdir,
+                         Progress& progress) {
+    progress.phase("spooling the input", in.header().triangle_count);
+    io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, io::Channels{});
+    while (in.next(chunk)) {
+        spool.add(chunk);
+        progress.update(in.count().read);
+    }
+    if (!spool.ok()) throw io::Error(in.name(), "cannot spool the input to sort it: " + spool.error());
+    SortedInput s;
+    s.count = in.count();
+    s.dropped = dropped_triangles(in);
+    s.end_header = in.header();
+    s.axis = longest_axis(spool.bounds());
+    s.sorter = make_sorter(s.axis, sort_budget, tmpdir, progress);
+    progress.phase("sorting: reading the spool", s.count.passed());
+    uint64_t done = 0;
+    while (spool.next(chunk)) {
+        s.sorter->add(chunk);
+        progress.update(done += chunk.size());
+    }
+    s.sorter->finish_input();
+    s.temp_bytes = spool.bytes() + s.sorter->stats().peak_temp_bytes;
+    return s;
+}
+
 void run_decimate(const DecimateOptions& opt) {
     const auto start = std::chrono::steady_clock::now();
     // Checked before any work: the comparison re-reads both files once the output is done.
@@ -86,197 +323,157 @@ void run_decimate(const DecimateOptions& opt) {
         }
     }
     io::TriangleInput in = open_triangle_input(opt.input, opt.read, Command::kDecimate);
-    const io::MeshHeader& header = in.header();
-
-    decimate::Options options;
-    if (opt.target) {
-        // Options that cannot work with this input: exit 2, like the command line's own errors.
-        if (!header.triangle_count)
-            throw UsageError(in.name() + ": --target needs the input triangle count, which this format does "
-                                                 "not state up front (binary STL, Draco and glTF do); use --ratio");
-        if (*opt.target > *header.triangle_count)
-            throw UsageError(in.name() + ": --target " + std::to_string(*opt.target) + " is more than the " +
-                             std::to_string(*header.triangle_count) +
-                             " triangles of the input (decimation only removes triangles)");
-        options.target = *opt.target;
-    } else {
-        options.ratio = opt.ratio.value_or(0.1);
-    }
-    options.buffer_triangles = opt.buffer;
-    options.candidates = opt.candidates;
-    options.seed = opt.seed;
-    options.weld_eps = weld_epsilon(opt, in.name());
-    options.sorted_axis = opt.sorted_axis ? opt.sorted_axis : header.sorted_axis;
-    // The file's flag comes from `meshstream sort` (or a convert that kept its order): ascending
-    // by triangle minimum. A --sorted-axis of the user's own says less: the key is not known.
-    options.sorted_by_minimum = header.sorted_axis && options.sorted_axis == header.sorted_axis;
-    std::unique_ptr<decimate::StreamDecimator> made;  // on the heap only to catch a refused reservation here
-    try {
-        made = std::make_unique<decimate::StreamDecimator>(options, in.count());
-    } catch (const std::bad_alloc&) {
-        throw std::runtime_error(
-            "--buffer " + std::to_string(opt.buffer) + " reserves " +
-            human_bytes(double(decimate::HalfEdgeBuffer::reserved_bytes(opt.buffer))) +
-            " of memory (about 500 bytes a triangle), which this system refused: give a smaller --buffer (the "
-            "default 400000 reserves " + human_bytes(double(decimate::HalfEdgeBuffer::reserved_bytes(400000))) + ")");
-    }
-    decimate::StreamDecimator& decimator = *made;
+    const io::MeshHeader header = in.header();
+    const std::string input_name = in.name();
+    const decimate::Options options = decimation_options(opt, header, input_name);
 
     io::WriteOptions wo = opt.write.options(opt.read);
     // The output count, for whole-mesh writers to refuse a --memory too small before the work.
     if (header.triangle_count)
-        wo.expected_triangle_count = options.target ? *options.target
-                                                    : decimate::StreamDecimator::expected_output(options.ratio, *header.triangle_count);
+        wo.expected_triangle_count =
+            options.target ? *options.target
+                           : decimate::StreamDecimator::expected_output(options.ratio, *header.triangle_count);
     // No output count is promised to the writer: the decimator lands on round(p·N_in) except
     // when the in-core rest is closed and one triangle too many is left (collapses remove two
     // faces; it then ends one over, with a warning), and skipped input triangles change N_in.
     // Writers patch their header counts at finish() (or spool when the output cannot seek).
     refuse_output_over_inputs(opt.output, out_format, wo, {input_files(opt.input, header)});
-    io::Output out = io::open_output(opt.output, out_format.name, wo, opt.write.gzip_level);
 
-    const decimate::Emit emit = [&out](const io::TriangleChunk& chunk) { out.write(chunk); };
-    // The decimator rates and writes positions only: no other channel is read.
-    io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, io::Channels{});
-    Progress progress("decimating", header.triangle_count);
-    while (in.next(chunk)) {
-        decimator.push(chunk, emit);
-        progress.update(in.count().read);
+    // --sort: what may happen. Input known to be sorted (its flag, --sorted-axis) is decimated
+    // as it comes in auto: sorting again cannot help it, a larger buffer can.
+    const bool sort_first = opt.sort == "always";
+    const bool may_restart = opt.sort == "auto" && !options.sorted_axis;
+    const bool read_once = !is_regular_file(opt.input);
+    const uint64_t budget = opt.read.options().memory_budget_bytes;
+    io::ReadOptions sort_ro = opt.read.options();  // the reader's share while sorting
+    sort_ro.memory_budget_bytes = budget / 4;
+    const uint64_t sort_budget = budget / 2;
+    std::optional<PositionSpool> spool;
+    if (read_once && (sort_first || may_restart)) spool.emplace(opt.read.tmpdir);
+
+    std::optional<io::Output> out(io::open_output(opt.output, out_format.name, wo, opt.write.gzip_level));
+    // An output written in place cannot be taken back: it is held while a restart may come, up
+    // to a quarter of --memory (60 bytes a triangle with vertex ids).
+    HeldOutput gate(*out, out->sink->in_place() && may_restart ? std::max<uint64_t>(budget / 4 / 60, 1) : 0);
+    const decimate::Emit emit = [&gate](const io::TriangleChunk& chunk) { gate.write(chunk); };
+    Progress progress(sort_first ? "reading" : "decimating", header.triangle_count);
+
+    SortOutcome outcome;
+    outcome.requested = sort_first;
+    std::unique_ptr<decimate::StreamDecimator> decimator;
+    decimate::Options used = options;
+    std::optional<SortedInput> sorted;
+    if (!sort_first) {
+        decimator = make_decimator(options, in.count());
+        const auto attempt = std::chrono::steady_clock::now();
+        const ChunkSource next = [&](io::TriangleChunk& chunk) {
+            if (!in.next(chunk)) return false;
+            if (spool) spool->add(chunk);
+            return true;
+        };
+        const bool whole = decimate_pass(
+            next, *decimator, emit, progress, [&] { return in.count().read; },
+            [&] { return may_restart && decimator->stats().forced_writes > 0 && !gate.released() && (!spool || spool->ok()); });
+        if (!whole) {
+            outcome.kind = SortOutcome::Kind::kSorted;
+            outcome.detected_at = in.count().read;
+            outcome.attempt_seconds = seconds_since(attempt);
+        } else if (may_restart && decimator->stats().forced_writes > 0) {
+            outcome.kind = SortOutcome::Kind::kCouldNot;
+            outcome.why_not = spool && !spool->ok()
+                                  ? "its spool could not be written: " + spool->error()
+                                  : "its output to " + out->sink->name() + " was already under way (" +
+                                        human_count(double(gate.held_triangles())) +
+                                        " triangles held back first; write to a file, or sort first)";
+        }
+    }
+    if (sort_first || outcome.kind == SortOutcome::Kind::kSorted) {
+        if (decimator) {
+            // The attempt is dropped: its decimator, and its output (held back, or a
+            // temporary file that a new one replaces).
+            decimator.reset();
+            if (gate.holding()) {
+                gate.discard();
+            } else {
+                out.reset();
+                out.emplace(io::open_output(opt.output, out_format.name, wo, opt.write.gzip_level));
+                gate.rebind(*out);
+            }
+        }
+        if (!read_once) in.close();
+        const auto sorting = std::chrono::steady_clock::now();
+        try {
+            sorted = spool ? sort_spooled(in, *spool, sort_budget, opt.read.tmpdir, progress)
+                           : sort_file(opt, sort_budget, sort_ro, opt.read.tmpdir, progress);
+        } catch (const io::Error& e) {
+            // A sort auto chose may fail (a full --tmpdir) where decimating as read would not:
+            // the file is then decimated as it is. A spooled stdin is gone with the spool.
+            if (sort_first || spool) throw;
+            outcome.kind = SortOutcome::Kind::kCouldNot;
+            outcome.why_not = std::string("sorting failed: ") + e.what();
+        }
+        gate.release();  // no restart after this one
+        if (sorted) {
+            outcome.kind = SortOutcome::Kind::kSorted;
+            outcome.axis = sorted->axis;
+            outcome.sort_seconds = seconds_since(sorting);
+            outcome.temp_bytes = sorted->temp_bytes;
+            used.sorted_axis = sorted->axis;
+            used.sorted_by_minimum = true;
+            decimator = make_decimator(used, sorted->count);
+            progress.phase("decimating the sorted input", sorted->count.passed());
+            uint64_t done = 0;
+            const ChunkSource next = [&](io::TriangleChunk& chunk) {
+                if (!sorted->sorter->next(chunk)) return false;
+                done += chunk.size();
+                return true;
+            };
+            decimate_pass(next, *decimator, emit, progress, [&] { return done; }, {});
+        } else {
+            in = open_triangle_input(opt.input, opt.read, Command::kDecimate);
+            decimator = make_decimator(options, in.count());
+            progress.phase("decimating", header.triangle_count);
+            decimate_pass([&](io::TriangleChunk& chunk) { return in.next(chunk); }, *decimator, emit, progress,
+                          [&] { return in.count().read; }, {});
+        }
     }
     progress.phase("finishing", std::nullopt);
-    decimator.finish(emit);
+    decimator->finish(emit);
+    gate.release();
     progress.done();
-    out.finish();
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    out->finish();
+    const double seconds = seconds_since(start);
 
-    const decimate::Stats& s = decimator.stats();
-    std::fprintf(stderr, "decimated %s -> %s\n", in.name().c_str(), opt.output.c_str());
-    std::fprintf(stderr, "  triangles in %llu, out %llu (target %llu, ratio %.6g)\n",
-                 (unsigned long long)s.triangles_in, (unsigned long long)s.triangles_out,
-                 (unsigned long long)s.target_triangles, decimator.ratio());
-    std::fprintf(stderr, "  time %.3f s, %s input triangles/s, peak RSS %s\n", seconds,
-                 human_count(seconds > 0 ? double(s.triangles_in) / seconds : 0).c_str(),
-                 human_bytes(double(peak_rss_bytes())).c_str());
-    std::fprintf(stderr, "  buffer %zu triangles, peak fill %zu (%.1f %%), collapses %llu, forced writes %llu\n",
-                 s.buffer_capacity, s.peak_buffer_triangles,
-                 100.0 * double(s.peak_buffer_triangles) / double(s.buffer_capacity),
-                 (unsigned long long)s.collapses, (unsigned long long)s.forced_writes);
-    if (options.weld_eps > 0)
-        std::fprintf(stderr, "  weld %.6g: %llu vertices merged\n", options.weld_eps,
-                     (unsigned long long)s.vertices_merged);
-    if (options.sorted_axis)
-        std::fprintf(stderr, "  sorted along %c (%s): %llu hole-boundary vertices finalized by the sweep\n",
-                     "xyz"[*options.sorted_axis],
-                     s.sweep_direction > 0 ? "ascending" : s.sweep_direction < 0 ? "descending" : "direction not seen",
-                     (unsigned long long)s.vertices_finalized_by_sweep);
-    decimate::print_phase_report(stderr);  // only in builds with MESHSTREAM_PHASE_TIMERS
+    DecimateFacts facts;
+    facts.stats = decimator->stats();
+    facts.ratio = decimator->ratio();
+    facts.target_given = options.target.has_value();
+    facts.buffer = opt.buffer;
+    facts.default_buffer = opt.buffer == DecimateOptions{}.buffer;
+    facts.given_axis = opt.sorted_axis;
+    facts.file_axis = header.sorted_axis;
+    facts.used_axis = used.sorted_axis;
+    facts.weld_eps = options.weld_eps;
+    facts.weld_text = opt.weld;
+    facts.skipped = sorted ? sorted->count.dropped : in.count().dropped;
+    facts.input_name = input_name;
+    facts.sort = outcome;
+    print_decimate_summary(facts, opt.output, seconds);
 
     Warnings warnings;
     if (const std::string dropped = io::describe_missing(header.channels, io::Channels{}); !dropped.empty())
         warnings.note(dropped + " dropped: decimate keeps positions only");
-    char ratio_text[32];
-    std::snprintf(ratio_text, sizeof ratio_text, "%.6g", decimator.ratio());
-    // The command that judges this run's buffer (info assumes the default one).
-    const std::string order_command = "`meshstream info --order --ratio " + std::string(ratio_text) +
-                                      (opt.buffer != DecimateOptions{}.buffer ? " --buffer " + std::to_string(opt.buffer) : "") + "`";
-    note_unused_write_flags(opt.write, *out.format, opt.output, warnings);
-    for (const std::string& note : out.writer->notes()) warnings.note(note);
-    const uint64_t skipped = in.count().dropped;
-    note_dropped_triangles(dropped_triangles(in), "skipped", warnings);
-    note_input_changes(in.header(), in.name(), warnings);
-    const bool axis_conflict = opt.sorted_axis && header.sorted_axis && *opt.sorted_axis != *header.sorted_axis;
-    if (axis_conflict)
-        warnings.note(std::string("--sorted-axis ") + "xyz"[*opt.sorted_axis] + " was given, but " + in.name() +
-                      " says it is sorted along " + "xyz"[*header.sorted_axis] + ": the sweep used " +
-                      "xyz"[*opt.sorted_axis] + ", as given");
-    if (s.forced_writes > 0)
-        warnings.note("buffer full of undecimatable triangles: " + std::to_string(s.forced_writes) +
-                     " triangles force-written at full resolution (" +
-                     std::to_string(s.premature_writes) +
-                     " written before reaching the target resolution; near them a few triangles may come out twice, "
-                     "back to back)" +
-                     (s.orphans_evicted > 0
-                          ? "; " + std::to_string(s.orphans_evicted) +
-                                " of their vertices were evicted from the weld table to make room, so triangles "
-                                "read later at those positions are not joined to them (the output has cracks there)"
-                          : std::string()) +
-                     (axis_conflict
-                          ? std::string("; --sorted-axis overrode the axis the file gives (see below)")
-                      : options.sorted_axis && s.sort_violations == 0 && s.sweep_direction == 0
-                          ? std::string("; the input is said to be sorted along ") + "xyz"[*options.sorted_axis] +
-                                ", but its triangles never moved along it by more than three of their lengths, so the "
-                                "sweep that finalizes hole boundaries never started: check the axis (" + order_command +
-                                " counts the key descents along each)"
-                      : options.sorted_axis && s.sort_violations == 0
-                          ? "; the input is sorted, so the buffer is too small for it at this ratio: raise --buffer (" +
-                                order_command + " estimates the buffer it needs)"
-                          : "; either the input is not in streaming order (run `meshstream sort` on it first) or the "
-                            "buffer is too small for it at this ratio (raise --buffer): " + order_command + " tells which"));
-    if (s.sort_violations > 0)
-        warnings.note(std::string("the input is not sorted along ") + "xyz"[*options.sorted_axis] +
-                     " as stated: " + std::to_string(s.sort_violations) +
-                     (s.sort_violations == 1 ? " triangle" : " triangles") +
-                     " reached behind the sweep, which was switched off at the first (boundary finalized before it "
-                     "may show as cracks); " +
-                     (axis_conflict ? std::string("leave out --sorted-axis to use the file's own axis")
-                                    : std::string("run `meshstream sort` on it first")));
-    if (s.nonmanifold_edges > 0)
-        warnings.add("non-manifold, duplicate or mis-oriented edges frozen and passed through", s.nonmanifold_edges);
-    if (s.degenerate_passed > 0)
-        warnings.add("degenerate triangles (repeated corners) passed through", s.degenerate_passed);
-    if (s.weld_dropped > 0) warnings.add("triangles dropped because --weld merged their corners", s.weld_dropped);
-    // Welding that collapses many triangles is coarser than the mesh: it removes surface
-    // detail the decimation would have kept.
-    if (options.weld_eps > 0 && s.weld_dropped * 100 > s.triangles_in)
-        warnings.note("--weld " + opt.weld + " welded the corners of " +
-                      std::to_string(s.weld_dropped * 100 / s.triangles_in) +
-                      " % of the triangles together: it is coarser than the mesh; weld on a smaller size");
-    // Triangles that share no corners exactly (cracks from float round-off, a soup written
-    // triangle by triangle) leave every edge open: decimation then eats the surface from every
-    // crack and still lands on its count. A mesh has far fewer open edges than triangles (a
-    // strip one triangle wide about one per triangle); a soup has three. (A few loose triangles
-    // are no surface to warn about; an input without triangles: the filter's report says so.)
-    if (s.triangles_in >= 100 && s.boundary_edges * 2 > s.triangles_in * 3)
-        warnings.note(std::to_string(s.boundary_edges) + " edges had no partner, " +
-                      std::to_string(s.boundary_edges / s.triangles_in) + "." +
-                      std::to_string(s.boundary_edges * 10 / s.triangles_in % 10) +
-                      " per triangle: the triangles share few corners exactly (an unwelded surface?), and "
-                      "decimation removes surface along every open edge; --weld EPS snaps corners to a grid of EPS");
-    const std::string missed = "output has " + std::to_string(s.triangles_out) + " triangles instead of the target " +
-                               std::to_string(s.target_triangles);
-    // Skipped triangles that come late leave --target short: the part read before them was
-    // decimated for the larger input the header promised.
-    const std::string skipped_late = std::to_string(skipped) +
-                                     " input triangles were skipped (above), most of them after the part before "
-                                     "them had been decimated for the larger input the header promised; `meshstream "
-                                     "convert --clean` drops them into a copy that lands on the target";
-    if (s.triangles_in > 0 && s.target_triangles > s.triangles_in)
-        warnings.note("the target " + std::to_string(s.target_triangles) + " is more than the " +
-                      std::to_string(s.triangles_in) + " usable input triangles: " +
-                      (s.collapses == 0 ? std::string("nothing was decimated") : missed + "; " + skipped_late));
-    else if (options.target && s.triangles_in > 0 && s.triangles_out < s.target_triangles && skipped > 0)
-        warnings.note(missed + " (" + skipped_late + ")");
-    else if (s.triangles_in > 0 && s.triangles_out == s.target_triangles + 1)
-        warnings.note(missed + " (a collapse removes two triangles, and no boundary edge could be collapsed to remove the odd one)");
-    else if (s.triangles_in > 0 && s.triangles_out != s.target_triangles && s.forced_writes > 0)
-        warnings.note(missed + " (the triangles force-written at full resolution, above, count against it)");
-    else if (s.triangles_in > 0 && s.triangles_out != s.target_triangles && s.no_valid_collapse_left)
-        warnings.note(missed + " (no allowed collapse is left: each would fold a face over or change the topology, "
-                               "or move a vertex that must stay, as on a non-manifold edge)");
-    else if (s.triangles_in > 0 && s.triangles_out > s.target_triangles && s.nonmanifold_edges > 0)
-        warnings.note(missed + " (the " + std::to_string(s.nonmanifold_edges) +
-                      " non-manifold, duplicate or mis-oriented edges above are frozen with their vertices: "
-                      "faces wound against their neighbours join none of them)");
-    else if (s.triangles_in > 0 && s.triangles_out != s.target_triangles)
-        warnings.note(missed + " (too little left that could be decimated)");
-    else if (s.triangles_in > 0 && s.target_triangles == 0)
-        warnings.note("the target rounds to 0 triangles (" + std::to_string(s.triangles_in) +
-                      " in): the output is empty; give a larger --ratio or --target");
+    note_unused_write_flags(opt.write, *out->format, opt.output, warnings);
+    for (const std::string& note : out->writer->notes()) warnings.note(note);
+    note_dropped_triangles(sorted ? sorted->dropped : dropped_triangles(in), "skipped", warnings);
+    note_input_changes(sorted ? sorted->end_header : in.header(), input_name, warnings);
+    note_decimate_warnings(facts, warnings);
     warnings.print();
 
     if (opt.report) {
         // An output without triangles (or only zero-area ones) has nothing to compare: that is
         // said, and the written output stands (compare itself refuses such a mesh).
-        if (s.triangles_out == 0) {
+        if (facts.stats.triangles_out == 0) {
             std::fprintf(stderr, "  error vs input: not measured (the output has no triangles)\n");
             return;
         }
@@ -290,9 +487,11 @@ void run_decimate(const DecimateOptions& opt) {
             return;
         }
         const double diag = r.diagonal > 0 ? r.diagonal : 1;
-        std::fprintf(stderr, "  error vs input (%% of bbox diagonal %.6g): Hausdorff %.6g (%.4f %%), mean %.6g (%.4f %%), "
-                             "rms %.6g (%.4f %%)\n", r.diagonal, r.hausdorff(), 100 * r.hausdorff() / diag,
-                     r.mean(), 100 * r.mean() / diag, r.rms(), 100 * r.rms() / diag);
+        std::fprintf(stderr,
+                     "  error vs input (%% of bbox diagonal %.6g): Hausdorff %.6g (%.4f %%), mean %.6g (%.4f %%), "
+                     "rms %.6g (%.4f %%)\n",
+                     r.diagonal, r.hausdorff(), 100 * r.hausdorff() / diag, r.mean(), 100 * r.mean() / diag, r.rms(),
+                     100 * r.rms() / diag);
     }
 }
 
@@ -332,6 +531,11 @@ void add_decimate(CLI::App& app) {
                 return {};
             },
             "x|y|z"));
+    cmd->add_option("--sort", opt->sort,
+                    "auto (default): input not known to be sorted whose order the buffer cannot hold (forced writes) "
+                    "is sorted out of core first, within half of --memory, in --tmpdir (stdin is spooled there); "
+                    "always: sort first; never: decimate as read")
+        ->check(CLI::IsMember({"auto", "always", "never"}));
     cmd->add_flag("--report", opt->report, "Compare the output against the input (Hausdorff, mean, RMS) at the end");
     add_read_flags(cmd, opt->read);
     strict_refuses_dropped_triangles(cmd);

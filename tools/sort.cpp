@@ -135,21 +135,6 @@ double seconds_since(std::chrono::steady_clock::time_point t) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
 }
 
-// The longest axis of the input's bounding box, from a first reading pass. Precondition: the input can be opened twice.
-int longest_axis(const SortOptions& opt, const io::ReadOptions& ro) {
-    const io::Bounds box = input_bounds(opt.input, opt.read.from, ro);
-    int best = 2;  // empty or flat input: z, the usual scan axis
-    double best_extent = 0;
-    for (int a = 0; a < 3; ++a) {
-        double extent = double(box.max[a]) - double(box.min[a]);
-        if (extent > best_extent) {
-            best_extent = extent;
-            best = a;
-        }
-    }
-    return best;
-}
-
 void run_sort(const SortOptions& opt) {
     const auto t0 = std::chrono::steady_clock::now();
     const io::Format& out_format = resolve_output_format(opt.output, opt.write);
@@ -186,7 +171,7 @@ void run_sort(const SortOptions& opt) {
     const io::MeshHeader header = in.header();
     const std::string input_name = in.name();  // the reader is released before the merge
     refuse_output_over_inputs(opt.output, out_format, opt.write.options(opt.read), {input_files(opt.input, header)});
-    const int axis = opt.axis == "auto" ? longest_axis(opt, ro)
+    const int axis = opt.axis == "auto" ? longest_axis(input_bounds(opt.input, opt.read.from, ro))
                                         : static_cast<int>(std::find(std::begin(kAxisNames), std::end(kAxisNames), opt.axis) -
                                                            std::begin(kAxisNames));
     sort::SorterOptions so;

@@ -1,0 +1,58 @@
+// What `meshstream decimate` tells its user, built from the run's statistics apart from the
+// run itself: the summary lines, the notice of a sort it did first (--sort), and the counted
+// warnings (forced writes and their remedy, a missed target and why, an unwelded surface...).
+// Plain functions of plain facts, so each message can be tested without a mesh.
+#pragma once
+
+#include "decimate/stream_decimator.hpp"
+#include "tools/common.hpp"
+
+#include <cstdint>
+#include <optional>
+#include <string>
+
+namespace meshstream::tools {
+
+// What --sort did. kSorted: the input was sorted out of core first and the sorted stream
+// decimated; kCouldNot: --sort auto found it out of streaming order but could not sort it
+// (`why_not`); kNone: decimated as read.
+struct SortOutcome {
+    enum class Kind : uint8_t { kNone, kSorted, kCouldNot };
+    Kind kind = Kind::kNone;
+    bool requested = false;      // --sort always (else auto decided)
+    int axis = 0;                // the sort axis (kSorted)
+    uint64_t detected_at = 0;    // auto: input triangles read when the first forced write came
+    double attempt_seconds = 0;  // auto: the first attempt, abandoned there
+    double sort_seconds = 0;     // reading (and spooling) the input and sorting it
+    uint64_t temp_bytes = 0;     // peak temporary disk: the stdin spool and the sort's runs
+    std::string why_not;         // kCouldNot
+};
+
+// The facts the messages are made of.
+struct DecimateFacts {
+    decimate::Stats stats;
+    double ratio = 0;               // the ratio in use (decimator.ratio())
+    bool target_given = false;      // --target
+    size_t buffer = 400000;         // --buffer
+    bool default_buffer = true;     // --buffer not given
+    std::optional<int> given_axis;  // --sorted-axis
+    std::optional<int> file_axis;   // the axis the input says it is sorted along
+    std::optional<int> used_axis;   // the axis the decimator swept along
+    double weld_eps = 0;            // --weld, as a size
+    std::string weld_text;          // --weld as given
+    uint64_t skipped = 0;           // input triangles the read loop dropped
+    std::string input_name;
+    SortOutcome sort;
+};
+
+// The warnings about the decimation itself (not the read loop's or the writer's, which the
+// command adds), in the order they are printed.
+void note_decimate_warnings(const DecimateFacts& facts, Warnings& warnings);
+
+// "sorted along x first (...): 1.23 s, 36.0 MB of temporary disk"; empty unless kSorted.
+std::string sort_notice(const SortOutcome& sort);
+
+// The summary lines on stderr after a run (triangles, time, buffer, weld, sweep, sort).
+void print_decimate_summary(const DecimateFacts& facts, const std::string& output, double seconds);
+
+}  // namespace meshstream::tools
