@@ -52,7 +52,10 @@ struct MeshHeader {
     std::optional<uint64_t> vertex_count;    // indexed formats
     std::optional<int> sorted_axis;          // 0,1,2 when the file says it is sorted (meshstream sort)
     Channels channels;                       // channels the reader will fill
-    std::vector<Material> materials;         // the table the material channel indexes
+    // The table the material channel indexes. A reader may append to it while reading (OBJ: a
+    // `usemtl` name that no MTL file defines, met after the first face); entries already in it
+    // never change, so the table as it stands after the last next() holds every index read.
+    std::vector<Material> materials;
     std::string variant;                     // e.g. "binary", "ascii", "binary_big_endian"
     std::vector<std::pair<std::string, std::string>> notes;  // extra facts for `info`
     // Files besides the input that the reader read (a .gltf's buffer files, an OBJ's .mtl and
@@ -102,6 +105,14 @@ public:
         finished_ = true;
         finish_output();
     }
+    // Before finish(): the stream's material table as it stands at the end of the input, when
+    // the reader added to it while reading (MeshHeader::materials); it begins with
+    // WriteOptions::materials. Writers that keep the material channel take it; std::logic_error
+    // after finish().
+    void update_materials(const std::vector<Material>& materials) {
+        if (finished_) throw std::logic_error("io::Writer::update_materials after finish()");
+        materials_updated(materials);
+    }
     // After finish(): what the user should know about the output written (lossy encodings
     // that lost something), one sentence each. The commands print them as warnings.
     virtual std::vector<std::string> notes() const { return {}; }
@@ -110,6 +121,8 @@ protected:
     // What each format does: the calls above, checked.
     virtual void write_chunk(const TriangleChunk& chunk) = 0;
     virtual void finish_output() = 0;
+    // Writers that keep materials replace their table with this one (see update_materials).
+    virtual void materials_updated(const std::vector<Material>& materials) { (void)materials; }
 
 private:
     bool finished_ = false;

@@ -72,6 +72,16 @@ void VertexTable::append(const float* xyz, const std::byte* attributes) {
     ++size_;
 }
 
+void VertexTable::set_budget(uint64_t budget_bytes) {
+    budget_bytes_ = budget_bytes;
+    if (storage_ == Storage::kMemory) {
+        if (size_ * stride_ > budget_bytes_) spill();
+    } else if (storage_ == Storage::kTempFile) {
+        pages_.reset();             // the old cache goes before the new one is mapped
+        start_cache(~uint64_t{0});  // as spill() sizes it, for the new budget
+    }
+}
+
 void VertexTable::spill() {
     temp_ = std::make_unique<TempFile>(tmpdir_, "meshstream-vertices");
     for (uint64_t done = 0; done < size_;) {

@@ -43,6 +43,10 @@ public:
     VertexTable(const VertexTable&) = delete;
     VertexTable& operator=(const VertexTable&) = delete;
 
+    // Changes the budget of an owned table, for a reader that shares its budget among several
+    // (OBJ: positions, texture coordinates, normals). A table in memory past the new budget
+    // spills now; a spilled one's page cache is made anew at the new size.
+    void set_budget(uint64_t budget_bytes);
     // Appends a vertex (owned tables only): xyz[3] and attribute_bytes() of `attributes`.
     void append(const float* xyz, const std::byte* attributes);
     uint64_t size() const { return size_; }

@@ -43,6 +43,8 @@ void run_convert(const ConvertOptions& opt) {
         out.write(chunk);
         progress.update(in.count().read);
     }
+    // A reader may have added materials while reading (OBJ: names met after the first face).
+    if (wo.channels.material) out.writer->update_materials(in.header().materials);
     // Whole-mesh formats encode, and spooled or compressed ones copy, only now: can be most of
     // the run.
     progress.status("converting: finishing " + std::string(out.format->name) + " output (" +

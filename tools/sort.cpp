@@ -245,7 +245,7 @@ void run_sort(const SortOptions& opt) {
     wo.triangle_count = total;
     wo.sorted_axis = axis;
     wo.channels = so.channels;
-    if (wo.channels.material) wo.materials = header.materials;
+    if (wo.channels.material) wo.materials = end_header.materials;  // with materials added while reading
     io::Output out = io::open_output(opt.output, out_format.name, wo, opt.write.gzip_level);
     const int passes = sorter.stats().merge_passes;
     progress.phase(passes == 0 ? "writing" : "merge " + std::to_string(passes) + "/" + std::to_string(passes), total);

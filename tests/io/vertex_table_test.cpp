@@ -83,6 +83,28 @@ TEST(VertexTable, StaysInMemoryWithinTheBudget) {
     for (uint64_t i = 0; i < 1000; ++i) expect_vertex(t, i);
 }
 
+// A reader that shares its budget among tables lowers it: a table in memory past the new
+// budget spills at once, a spilled one keeps its records under a smaller page cache.
+TEST(VertexTable, ALowerBudgetSpillsOrShrinksTheCacheAndKeepsEveryRecord) {
+    test::TempDir dir;
+    io::VertexTable t(uint64_t{8} << 20, dir.path(), 3);
+    auto add = [&](uint64_t i) {
+        const float xyz[3] = {static_cast<float>(i) * 0.5f, -static_cast<float>(i), 3.0f};
+        const std::byte attributes[3] = {std::byte{1}, static_cast<std::byte>(i), std::byte{2}};
+        t.append(xyz, attributes);
+    };
+    uint64_t n = 0;
+    for (; n < 20000; ++n) add(n);  // 300 KB
+    t.set_budget(uint64_t{1} << 20);
+    EXPECT_EQ(t.storage(), io::VertexTable::Storage::kMemory);
+    t.set_budget(100 << 10);
+    EXPECT_EQ(t.storage(), io::VertexTable::Storage::kTempFile);
+    EXPECT_EQ(dir.entries().size(), 1u);
+    for (uint64_t i = 0; i < n; i += 3) expect_vertex(t, i);
+    for (; n < 150000; ++n) add(n);
+    t.set_budget(64 << 10);
+    for (uint64_t i = n; i-- > 0;) expect_vertex(t, (i * 7919) % n);
+}
 TEST(VertexTable, ReadsRecordsOfAnInputFileInPlace) {
     test::TempDir dir;
     // 5 junk bytes, then records of 20 bytes: pad(2) x y z pad(8) (stride 20).
