@@ -255,6 +255,7 @@ private:
         }
         if (!exists) add_once(findings_.missing_images, found);
         if (over_budget) add_once(findings_.unloaded_images, found);
+        if (exists && !over_budget) add_once(findings_.images_read, found);
         t.uri = uri;
         t.mime_type = image_mime_type(t.bytes, name);
         current_.texture = std::move(t);

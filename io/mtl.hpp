@@ -23,6 +23,7 @@ struct MtlFindings {
     std::vector<std::string> unloaded_images;   // found, but past the image budget: kept by name
     std::vector<std::string> skipped_keywords;  // statements not kept: "Ka", "Ks", "map_Bump", ...
     std::vector<std::string> redefined;         // material names defined again (the first kept)
+    std::vector<std::string> images_read;       // texture files read (MeshHeader::side_files)
 };
 
 // Reads the MTL file at `path` and returns its materials in file order (a name defined twice

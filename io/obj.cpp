@@ -583,10 +583,15 @@ private:
                 missing_libraries_.push_back(path);
                 continue;
             }
+            header_.side_files.push_back(path);
             const size_t slash = name.find_last_of('/');
             const std::string uri_dir =
                 name[0] == '/' || slash == std::string::npos ? std::string() : name.substr(0, slash + 1);
-            for (Material& m : read_mtl(path, uri_dir, &image_budget_, findings_)) {
+            const size_t images_before = findings_.images_read.size();
+            std::vector<Material> library = read_mtl(path, uri_dir, &image_budget_, findings_);
+            header_.side_files.insert(header_.side_files.end(), findings_.images_read.begin() + images_before,
+                                      findings_.images_read.end());
+            for (Material& m : library) {
                 auto it = material_ids_.find(m.name);
                 if (it == material_ids_.end()) {
                     const uint32_t index = material_index(m.name);
@@ -1172,6 +1177,14 @@ Channels obj_keep_channels(const Channels& in, const WriteOptions&) {
     return out;
 }
 
+// The material library beside the output. Texture images are not listed: the writer never
+// writes over a file of other bytes (it numbers the name), and one with the same bytes (the
+// input's own image, when writing into its directory) is used as it is.
+std::vector<std::string> obj_side_files(const std::string& path, const WriteOptions& options) {
+    if (!options.channels.material || is_stream(path)) return {};
+    return {output_stem(path) + ".mtl"};
+}
+
 }  // namespace
 
 bool guess_obj(std::span<const std::byte> head) {
@@ -1207,6 +1220,7 @@ const Format kObjFormat = {
     0,
     &guess_obj,
     &obj_keep_channels,
+    &obj_side_files,
 };
 
 }  // namespace meshstream::io

@@ -23,7 +23,7 @@
 //    follows at all: that cannot be known at the first face). A usemtl name first
 //    met after the first face is appended to the table while reading (see
 //    Writer::update_materials). With neither before the first face, later ones are dropped,
-//    counted.
+//    counted. The MTL files and images read are listed in MeshHeader::side_files.
 // Vertex ids: with texture coordinates or normals in the chunk, one id per distinct
 // (v, vt, vn) triple in use, so seams are different vertices (ids in order of first use,
 // from a table of 40 bytes a triple within its share of the budget; a triple not met again
@@ -46,7 +46,8 @@
 // other than letters, digits, . - _ become _); an image file already there with the same
 // bytes is used as it is, any other file gives a numbered name (tex_2.png): nothing is
 // overwritten. An existing `<stem>.mtl` is replaced only when an existing OBJ of the output's
-// name uses it, else refused before any work. All side files are written to temporary names
+// name uses it, else refused before any work; Format::side_files names it, so the commands
+// also refuse it when it is a file an input's reader read. All side files are written to temporary names
 // and renamed only once every one of them and the OBJ are complete. On stdout, a pipe or a
 // device there are no side files: `usemtl` names only, and a note saying so.
 #pragma once

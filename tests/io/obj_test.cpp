@@ -1033,3 +1033,18 @@ TEST(ObjMemory, TinyBudgetSpillsEveryTableWithTheSameResult) {
     EXPECT_TRUE(test::slurp(dir / "tiny.obj") == test::slurp(dir / "memory.obj"));
     expect_same_mesh(read_mesh(dir / "memory.obj"), memory);
 }
+
+// The reader lists the MTL files and images it read; an output whose .mtl would replace one
+// of them is refused by the command before anything is written.
+TEST(ObjCli, AnOutputLibraryOverAnInputsLibraryIsRefused) {
+    EXPECT_EQ(read_mesh(fixture("obj/cube_usemtl.obj")).header.side_files,
+              (std::vector<std::string>{fixture("obj/cube_usemtl.mtl"), fixture("obj/checker.png")}));
+    TempDir dir;
+    for (const char* name : {"cube_usemtl.obj", "cube_usemtl.mtl", "checker.png"})
+        test::spit(dir / name, test::slurp(fixture(std::string("obj/") + name)));
+    CliRun r = run_cli("convert " + dir / "cube_usemtl.obj" + " " + dir / "cube_usemtl.obj.gz", dir.path());
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find("its side file " + dir / "cube_usemtl.mtl" + " would overwrite"), std::string::npos) << r.err;
+    EXPECT_EQ(entries_of(dir.path()), (std::vector<std::string>{"checker.png", "cube_usemtl.mtl", "cube_usemtl.obj"}));
+    EXPECT_TRUE(test::slurp(dir / "cube_usemtl.mtl") == test::slurp(fixture("obj/cube_usemtl.mtl")));
+}
