@@ -24,6 +24,9 @@ constexpr uint64_t kUnknownCount = ~uint64_t{0};
 constexpr uint32_t kMaxChunkTriangles = uint32_t{1} << 24;  // larger: a corrupt stream
 constexpr size_t kPreambleBytes = 8 + 4 + 8;                // magic, version, body bytes
 constexpr uint8_t kNoAxis = 0xFF;
+// Named scalar channels of each kind a stream may declare: each costs every chunk a slot per
+// triangle, so a corrupt count must not allocate gigabytes (a PLY rarely has ten).
+constexpr uint32_t kMaxScalarChannels = 64;
 // Corner flags of the header body.
 constexpr uint8_t kNormalFlag = 1, kColorFlag = 2, kVertexIdFlag = 4;
 
@@ -197,15 +200,19 @@ private:
     size_t field_ = 0;  // where the last field read began
 };
 
-std::vector<ScalarChannel> get_scalars(BodyCursor& in, const char* what) {
-    const uint32_t n = in.get<uint32_t>(what);
+// The scalar channels of one kind ("vertex scalar", "face scalar"): a count, then each one's
+// type and name.
+std::vector<ScalarChannel> get_scalars(BodyCursor& in, const std::string& kind) {
+    const std::string what = "the " + kind + " channels";
+    const uint32_t n = in.get<uint32_t>(what.c_str());
+    if (n > kMaxScalarChannels)
+        in.fail(std::to_string(n) + " " + kind + " channels (at most " + std::to_string(kMaxScalarChannels) + ")");
     std::vector<ScalarChannel> scalars;
     for (uint32_t i = 0; i < n; ++i) {
-        const uint8_t code = in.get<uint8_t>(what);
+        const uint8_t code = in.get<uint8_t>(what.c_str());
         const std::optional<ScalarType> type = type_from_code(code);
-        if (!type)
-            in.fail(std::string(what) + " " + std::to_string(i) + ": unknown scalar type " + std::to_string(code));
-        scalars.push_back({in.string(what), *type});
+        if (!type) in.fail(kind + " channel " + std::to_string(i) + ": unknown scalar type " + std::to_string(code));
+        scalars.push_back({in.string(what.c_str()), *type});
     }
     return scalars;
 }
@@ -293,8 +300,8 @@ private:
         if (uv_sets > kMaxUvSets) in.fail(std::to_string(uv_sets) + " uv sets (at most 4)");
         c.uv_sets = uv_sets;
         c.material = material != 0;
-        c.vertex_scalars = get_scalars(in, "the vertex scalars");
-        c.face_scalars = get_scalars(in, "the face scalars");
+        c.vertex_scalars = get_scalars(in, "vertex scalar");
+        c.face_scalars = get_scalars(in, "face scalar");
         const uint32_t materials = in.get<uint32_t>("the material count");
         for (uint32_t i = 0; i < materials; ++i) {
             Material m;

@@ -127,8 +127,8 @@ std::string sort_notice(const SortOutcome& sort) {
     if (sort.requested) {
         text += "--sort always";
     } else {
-        text += "the input is not in streaming order: forced writes began after " +
-                human_count(double(sort.detected_at)) + " triangles read; `--sort never` decimates it as it is";
+        text += "forced writes began after " + human_count(double(sort.detected_at)) +
+                " triangles read, so the input is in no order this buffer holds; `--sort never` decimates it as read";
     }
     text += "): " + std::string(cost);
     if (!sort.requested) {

@@ -17,7 +17,7 @@ BUILD_DIR=${BUILD_DIR:-$SRC/build-fuzz}
 JOBS=${JOBS:-2}
 SECONDS_PER_TARGET=${1:-600}
 shift || true
-ALL=(stl_binary stl_ascii ply obj gzip draco gltf gltf_meshopt decimate)
+ALL=(stl_binary stl_ascii ply obj stream gzip draco gltf gltf_meshopt decimate)
 [ $# -gt 0 ] && TARGETS=("$@") || TARGETS=("${ALL[@]}")
 
 cmake -S "$SRC" -B "$BUILD_DIR" -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo \
@@ -56,6 +56,26 @@ for name in ("elephant_meshopt.glb", "BoxTextured_gltfpack_cc.glb"):
     blob = b[28 + n:][:65000]
     for select in (1, 5, 6, 15, 17, 33):
         open(f"{sys.argv[1]}/{name}.{select}", "wb").write(bytes([select, 23, 12]) + blob)
+PY
+# Triangle stream seeds (layout in docs/formats.md): positions only, and every channel with a
+# textured material, two chunks each.
+mkdir -p "$BUILD_DIR/fuzz-corpus/stream"
+python3 - "$BUILD_DIR/fuzz-corpus/stream" <<'PY'
+import struct, sys
+def s(b): return struct.pack("<I", len(b)) + b
+def stream(name, body, record_bytes, chunks):
+    out = b"\x89MSH\r\n\x1a\n" + struct.pack("<IQ", 1, len(body)) + body
+    total = 0
+    for n in chunks:
+        out += struct.pack("<I", n) + bytes(range(256)) * (n * record_bytes // 256) + bytes(n * record_bytes % 256)
+        total += n
+    open(f"{sys.argv[1]}/{name}", "wb").write(out + struct.pack("<IQ", 0, total) + b"MSHE")
+stream("positions", struct.pack("<QBBBBBBH", 2**64 - 1, 255, 0, 0, 0, 0, 0, 0) + struct.pack("<III", 0, 0, 0), 36, (3, 2))
+body = struct.pack("<QBBBBBBH", 5, 2, 7, 3, 1, 2, 1, 0)
+body += struct.pack("<I", 1) + bytes([6]) + s(b"intensity") + struct.pack("<I", 1) + bytes([4]) + s(b"label")
+body += struct.pack("<I", 1) + s(b"wood") + struct.pack("<4f", 1, 1, 1, 1) + bytes([1]) + s(b"w.png") + s(b"image/png")
+body += struct.pack("<Q", 4) + b"\x89PNG"
+stream("channels", body, 36 + 36 + 48 + 48 + 24 + 24 + 4 + 8, (4, 1))
 PY
 # Decimator seeds (format in fuzz_decimate.cpp): n×n grids of unit squares, a few options.
 mkdir -p "$BUILD_DIR/fuzz-corpus/decimate"

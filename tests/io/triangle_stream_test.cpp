@@ -215,6 +215,10 @@ TEST(TriangleStream, BadFieldsAreNamedAtTheirByte) {
     chunk_count[body + 3] = char(0x7F);  // a chunk of about 2^31 triangles
     EXPECT_NE(error_of(chunk_count).find("byte " + std::to_string(body) + ": chunk of 21"), std::string::npos)
         << error_of(chunk_count);
+    std::string scalars = good;
+    scalars[36] = char(0xFF);  // the vertex scalar count
+    EXPECT_NE(error_of(scalars).find("byte 36: 255 vertex scalar channels (at most 64)"), std::string::npos)
+        << error_of(scalars);
     std::string axis = good;
     axis[28] = 7;
     EXPECT_NE(error_of(axis).find("byte 28: sorted axis 7"), std::string::npos) << error_of(axis);

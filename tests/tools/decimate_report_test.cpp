@@ -91,9 +91,9 @@ TEST(DecimateReport, TheSortNoticeSaysWhyAndWhatItCost) {
     automatic.sort_seconds = 0.25;
     automatic.temp_bytes = 36000000;
     EXPECT_EQ(tools::sort_notice(automatic),
-              "sorted along z first (the input is not in streaming order: forced writes began after 409.6 k triangles "
-              "read; `--sort never` decimates it as it is): 1.75 s (1.50 s of it in the first attempt), 36.0 MB of "
-              "temporary disk");
+              "sorted along z first (forced writes began after 409.6 k triangles read, so the input is in no order "
+              "this buffer holds; `--sort never` decimates it as read): 1.75 s (1.50 s of it in the first attempt), "
+              "36.0 MB of temporary disk");
     SortOutcome asked = automatic;
     asked.requested = true;
     asked.attempt_seconds = 0;
