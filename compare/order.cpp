@@ -225,8 +225,10 @@ BufferVerdict buffer_verdict(const OrderReport& report, uint64_t buffer_triangle
 std::optional<OrderReport> measure_file_order(const std::string& path, std::string_view from,
                                               const io::ReadOptions& options) {
     if (path == "-") return std::nullopt;
-    io::Input in = io::open_input(path, from, options);
-    io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, in.reader->header().channels);
+    io::ReadOptions positions = options;  // the order measure looks at positions only
+    positions.channels = io::ChannelKinds::none();
+    io::Input in = io::open_input(path, from, positions);
+    io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity);
     OrderMeter meter(options.memory_budget_bytes);
     while (in.reader->next(chunk)) meter.add(chunk);
     return meter.finish();

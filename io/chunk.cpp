@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace meshstream::io {
 
@@ -94,7 +95,7 @@ CornerLayout::CornerLayout(const Channels& channels) : channels_(channels) {
         bytes_ += (channels_.color->alpha ? 4 : 3) * color_bytes_;
     }
     bytes_ += size_t(channels_.uv_sets) * 2 * sizeof(float);
-    bytes_ += channels_.vertex_scalars.size() * sizeof(double);
+    for (const ScalarChannel& c : channels_.vertex_scalars) bytes_ += scalar_type_bytes(c.type);
 }
 
 namespace {
@@ -108,6 +109,50 @@ template <class T>
 const std::byte* get(const std::byte* src, T& v) {
     std::memcpy(&v, src, sizeof v);
     return src + sizeof v;
+}
+
+// A value as an integer type T stores it: rounded to nearest, clamped to T's range; NaN is 0.
+template <class T>
+T to_integer(double v) {
+    if (!(v == v)) return 0;
+    constexpr double lo = double(std::numeric_limits<T>::min()), hi = double(std::numeric_limits<T>::max());
+    return static_cast<T>(std::clamp(std::nearbyint(v), lo, hi));
+}
+
+// A named scalar in its channel's type (what a record and a file store).
+std::byte* put_scalar(std::byte* dst, double v, ScalarType type) {
+    switch (type) {
+        case ScalarType::kInt8: return put(dst, to_integer<int8_t>(v));
+        case ScalarType::kUInt8: return put(dst, to_integer<uint8_t>(v));
+        case ScalarType::kInt16: return put(dst, to_integer<int16_t>(v));
+        case ScalarType::kUInt16: return put(dst, to_integer<uint16_t>(v));
+        case ScalarType::kInt32: return put(dst, to_integer<int32_t>(v));
+        case ScalarType::kUInt32: return put(dst, to_integer<uint32_t>(v));
+        case ScalarType::kFloat32: return put(dst, static_cast<float>(v));
+        case ScalarType::kFloat64: return put(dst, v);
+    }
+    return dst;
+}
+
+template <class T>
+double get_as_double(const std::byte* src) {
+    T v;
+    std::memcpy(&v, src, sizeof v);
+    return static_cast<double>(v);
+}
+
+double get_scalar(const std::byte* src, ScalarType type) {
+    switch (type) {
+        case ScalarType::kInt8: return get_as_double<int8_t>(src);
+        case ScalarType::kUInt8: return get_as_double<uint8_t>(src);
+        case ScalarType::kInt16: return get_as_double<int16_t>(src);
+        case ScalarType::kUInt16: return get_as_double<uint16_t>(src);
+        case ScalarType::kInt32: return get_as_double<int32_t>(src);
+        case ScalarType::kUInt32: return get_as_double<uint32_t>(src);
+        case ScalarType::kFloat32: return get_as_double<float>(src);
+        case ScalarType::kFloat64: return get_as_double<double>(src);
+    }
+    return 0;
 }
 
 // A float colour component as the integer type stores it (rounded, clamped to the range).
@@ -136,7 +181,8 @@ void CornerLayout::pack_values(const float* normal, const float* rgba, const flo
         }
     }
     for (int a = 0; a < 2 * channels_.uv_sets; ++a) dst = put(dst, uv[a]);
-    for (size_t c = 0; c < channels_.vertex_scalars.size(); ++c) dst = put(dst, scalars[c]);
+    for (size_t c = 0; c < channels_.vertex_scalars.size(); ++c)
+        dst = put_scalar(dst, scalars[c], channels_.vertex_scalars[c].type);
 }
 
 void CornerLayout::unpack_values(const std::byte* src, float* normal, float* rgba, float* uv, double* scalars) const {
@@ -166,7 +212,12 @@ void CornerLayout::unpack_values(const std::byte* src, float* normal, float* rgb
         if (uv) std::memcpy(uv, src, 2 * sizeof(float) * size_t(channels_.uv_sets));
         src += 2 * sizeof(float) * size_t(channels_.uv_sets);
     }
-    if (scalars) std::memcpy(scalars, src, channels_.vertex_scalars.size() * sizeof(double));
+    if (scalars)
+        for (size_t c = 0; c < channels_.vertex_scalars.size(); ++c) {
+            const ScalarType type = channels_.vertex_scalars[c].type;
+            scalars[c] = get_scalar(src, type);
+            src += scalar_type_bytes(type);
+        }
 }
 
 void CornerLayout::pack(const TriangleChunk& chunk, size_t i, int k, std::byte* dst) const {

@@ -72,6 +72,28 @@ struct Channels {
     }
 };
 
+// Kinds of channel, to say which a reader should fill (ReadOptions::channels); the groups of
+// `--drop normals,colors,uvs,extra`.
+struct ChannelKinds {
+    bool normals = true;
+    bool colors = true;
+    bool uvs = true;
+    bool extras = true;  // named vertex and face scalars
+    bool materials = true;
+    static ChannelKinds none() { return {false, false, false, false, false}; }
+    // The channels of `c` of these kinds (and its vertex ids).
+    Channels of(const Channels& c) const {
+        Channels out;
+        out.normal = normals && c.normal;
+        if (colors) out.color = c.color;
+        out.uv_sets = uvs ? c.uv_sets : 0;
+        if (extras) out.vertex_scalars = c.vertex_scalars, out.face_scalars = c.face_scalars;
+        out.material = materials && c.material;
+        out.vertex_id = c.vertex_id;
+        return out;
+    }
+};
+
 // The channels present in `a` but not in `b`, in words ("normals, colour alpha, texture
 // coordinates, 'intensity'"); empty when `b` holds everything of `a` (vertex ids ignored).
 std::string describe_missing(const Channels& a, const Channels& b);
@@ -222,9 +244,10 @@ inline void TriangleChunk::copy_triangle(size_t to, const TriangleChunk& src, si
 
 // A fixed-size byte record of one corner's attributes (everything per corner but the position
 // and the vertex id), for what stores vertices outside a chunk: the indexed readers' vertex
-// table, the welder's keys, the sorter's runs. Colours are packed in the source's type (RGBA8
-// takes 4 bytes), so a record is as small as the source's vertex. Equal values give equal bytes
-// (-0 normals aside), so records compare with memcmp.
+// table, the welder's keys, the sorter's runs. Colours and named scalars are packed in the
+// source's type (RGBA8 takes 4 bytes, a uchar label 1; a scalar is rounded and clamped to an
+// integer type's range), so a record is as small as the source's vertex. Equal values give
+// equal bytes (-0 normals aside), so records compare with memcmp.
 class CornerLayout {
 public:
     explicit CornerLayout(const Channels& channels);

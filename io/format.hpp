@@ -42,6 +42,23 @@ struct Material {
     bool operator==(const Material&) const = default;
 };
 
+// Something a reader repaired or skipped because the file's intent was clear (a header line
+// that is no PLY keyword, an STL facet of four corners, a face of two), or could not keep (a
+// PLY list property): one entry per kind, counted, with where the first one was. The
+// commands print each once, with its count, as a warning; under ReadOptions::strict the
+// readers throw io::Error instead for what is bad input.
+struct ReaderWarning {
+    std::string text;                           // what happened, e.g. "faces with fewer than 3 corners skipped"
+    uint64_t count = 0;                         // how often
+    uint64_t first_line = 0;                    // of the first one: 1-based line, 0 = not known
+    uint64_t first_byte_offset = ~uint64_t{0};  // and byte offset, ~0 = not known
+    bool operator==(const ReaderWarning&) const = default;
+};
+// " (first at line L, byte B)" (" (at ...)" for one), or "" when the position is not known.
+std::string warning_position(const ReaderWarning& warning);
+// "<file>: <text> (first at line L, byte B)", for a message (the count is the caller's).
+std::string describe_warning(const std::string& file, const ReaderWarning& warning);
+
 // What a reader knows from the file's header, before or while streaming. Every field is
 // optional: formats fill what they know.
 struct MeshHeader {
@@ -64,6 +81,9 @@ struct MeshHeader {
     // Set by readers of double coordinates (PLY) once they are read: the largest change that
     // rounding them to float made (0: none). The commands warn when it is above 0.
     std::optional<double> coordinate_rounding;
+    // What the reader repaired, skipped or could not keep so far (complete once next() has
+    // returned false); see ReaderWarning.
+    std::vector<ReaderWarning> warnings;
 };
 // The note such a reader adds for `info`, saying the same in words.
 inline constexpr const char* kPrecisionNote = "coordinates";
@@ -86,6 +106,17 @@ public:
     std::optional<uint64_t> triangle_count() const { return header_.triangle_count; }
 
 protected:
+    // Counts `n` more of the warning `text` (one fixed sentence per kind), keeping the
+    // position of the first.
+    void warn(std::string_view text, uint64_t line = 0, uint64_t byte_offset = ~uint64_t{0}, uint64_t n = 1) {
+        for (ReaderWarning& w : header_.warnings)
+            if (w.text == text) {
+                w.count += n;
+                return;
+            }
+        header_.warnings.push_back({std::string(text), n, line, byte_offset});
+    }
+
     MeshHeader header_;
 };
 
@@ -132,6 +163,11 @@ struct ReadOptions {
     uint64_t memory_budget_bytes = uint64_t{256} << 20;  // --memory: spill indexed tables past this
     std::string tmpdir;                                  // empty: system temp dir
     bool strict = false;                                 // --strict: skip-with-warning becomes error
+    // The kinds of channel the caller's chunks will have. Readers that keep vertices (PLY)
+    // store only these, so a positions-only consumer (decimate, info) pays nothing for a
+    // coloured file's colours. header().channels still lists all the file carries; a chunk
+    // channel of a kind not wanted is left at its default.
+    ChannelKinds channels;
 };
 
 struct WriteOptions {

@@ -63,6 +63,21 @@ bool has_extension(const Format& f, const std::string& ext) {
 
 }  // namespace
 
+std::string warning_position(const ReaderWarning& warning) {
+    const bool line = warning.first_line != 0, byte = warning.first_byte_offset != ~uint64_t{0};
+    if (!line && !byte) return {};
+    std::string out = warning.count > 1 ? " (first at " : " (at ";
+    if (line) out += "line " + std::to_string(warning.first_line);
+    if (line && byte) out += ", ";
+    if (byte) out += "byte " + std::to_string(warning.first_byte_offset);
+    out += ')';
+    return out;
+}
+
+std::string describe_warning(const std::string& file, const ReaderWarning& warning) {
+    return (file.empty() ? std::string("<input>") : file) + ": " + warning.text + warning_position(warning);
+}
+
 std::string format_names(bool for_writing) {
     std::string out;
     for (const Format* f : kFormats) {

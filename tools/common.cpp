@@ -66,6 +66,7 @@ void note_input_changes(const io::MeshHeader& header, const std::string& input_n
             warnings.note(input_name + ": the last line " + text + " (a truncated download or pipe?): check its last face");
         else if (key == io::kPrecisionNote && header.coordinate_rounding.value_or(0) > 0)
             warnings.note(input_name + ": coordinates are " + text + "; meshstream works in float (32-bit)");
+    for (const io::ReaderWarning& w : header.warnings) warnings.add(io::describe_warning(input_name, w), w.count);
 }
 
 void note_unused_write_flags(const WriteFlags& flags, const io::Format& output, const std::string& output_path,
@@ -356,11 +357,13 @@ bool is_regular_file(const std::string& path) {
 }
 
 io::Bounds input_bounds(const std::string& path, std::string_view from, const io::ReadOptions& options) {
-    io::Input in = io::open_input(path, from, options);
+    io::ReadOptions positions = options;  // nothing but positions is looked at
+    positions.channels = io::ChannelKinds::none();
+    io::Input in = io::open_input(path, from, positions);
     io::Bounds box;
     box.min.fill(std::numeric_limits<float>::infinity());
     box.max.fill(-std::numeric_limits<float>::infinity());
-    io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, in.reader->header().channels);
+    io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity);
     Progress progress("bounding box", in.reader->triangle_count());
     uint64_t done = 0;
     while (in.reader->next(chunk)) {

@@ -88,7 +88,8 @@ void note_unused_write_flags(const WriteFlags& flags, const io::Format& output, 
 // The warning for channels an output cannot hold: "`dropped` dropped: <format> output carries
 // positions only" (or "does not carry them" when it keeps some others, `kept`).
 std::string dropped_channels_text(const std::string& dropped, const io::Format& output, const io::Channels& kept);
-// Repeats as warnings what the reader noted that changes the data (double coordinates rounded).
+// Repeats as warnings what the reader noted that changes the data (double coordinates rounded,
+// a last line without its end) and the reader's counted warnings (MeshHeader::warnings).
 void note_input_changes(const io::MeshHeader& header, const std::string& input_name, Warnings& warnings);
 
 // Global flags (set by main before a subcommand runs).

@@ -322,7 +322,11 @@ void run_decimate(const DecimateOptions& opt) {
             throw UsageError(name + ": --report needs to re-read both files; it does not work with '-' or a pipe");
         }
     }
-    io::TriangleInput in = open_triangle_input(opt.input, opt.read, Command::kDecimate);
+    // The decimator keeps positions only: the reader stores no attribute (a coloured PLY then
+    // costs what a plain one does), while the header still lists what is dropped.
+    io::ReadOptions read = opt.read.options();
+    read.channels = io::ChannelKinds::none();
+    io::TriangleInput in = open_triangle_input(opt.input, opt.read, read, Command::kDecimate);
     const io::MeshHeader header = in.header();
     const std::string input_name = in.name();
     const decimate::Options options = decimation_options(opt, header, input_name);

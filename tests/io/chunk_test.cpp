@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <vector>
 
 using namespace meshstream;
@@ -81,8 +82,8 @@ TEST(CornerLayout, RoundTripsEachChannelInTheSourcesType) {
     const io::Channels ch = every_channel();
     const io::CornerLayout corner(ch);
     const io::FaceLayout face(ch);
-    // normal 12 + RGBA16 8 + two uv sets 16 + two scalars 16; material 4 + one scalar 8.
-    EXPECT_EQ(corner.bytes(), 52u);
+    // normal 12 + RGBA16 8 + two uv sets 16 + float and uchar scalars 5; material 4 + one scalar 8.
+    EXPECT_EQ(corner.bytes(), 41u);
     EXPECT_EQ(face.bytes(), 12u);
     io::TriangleChunk a(2, ch), b(2, ch);
     fill(a, (a.push_slot(), 0), 5);
@@ -98,6 +99,31 @@ TEST(CornerLayout, RoundTripsEachChannelInTheSourcesType) {
     std::copy(a.xyz().begin(), a.xyz().end(), b.xyz().begin());
     std::copy(a.vertex_ids().begin(), a.vertex_ids().end(), b.vertex_ids().begin());
     expect_same_triangle(a, 0, b, 0);  // 16-bit colours survive float exactly
+}
+
+TEST(CornerLayout, ScalarsTakeTheirTypesBytesRoundedAndClampedToIntegerRanges) {
+    io::Channels ch;
+    ch.vertex_scalars = {{"label", io::ScalarType::kUInt8},
+                         {"offset", io::ScalarType::kInt16},
+                         {"count", io::ScalarType::kUInt32},
+                         {"q", io::ScalarType::kFloat32},
+                         {"exact", io::ScalarType::kFloat64}};
+    const io::CornerLayout layout(ch);
+    EXPECT_EQ(layout.bytes(), 1u + 2 + 4 + 4 + 8);
+    const double in[5] = {300.0, -2.6, 4294967295.0, 0.1, 0.1};
+    std::vector<std::byte> rec(layout.bytes());
+    layout.pack_values(nullptr, nullptr, nullptr, in, rec.data());
+    double out[5];
+    layout.unpack_values(rec.data(), nullptr, nullptr, nullptr, out);
+    EXPECT_EQ(out[0], 255.0);  // clamped
+    EXPECT_EQ(out[1], -3.0);   // rounded to nearest
+    EXPECT_EQ(out[2], 4294967295.0);
+    EXPECT_EQ(out[3], double(0.1f));
+    EXPECT_EQ(out[4], 0.1);
+    const double nan[5] = {std::nan(""), 0, 0, 0, 0};
+    layout.pack_values(nullptr, nullptr, nullptr, nan, rec.data());
+    layout.unpack_values(rec.data(), nullptr, nullptr, nullptr, out);
+    EXPECT_EQ(out[0], 0.0);
 }
 
 TEST(CornerLayout, EightBitColourWithoutAlphaTakesThreeBytesAndRoundsToItsSteps) {
