@@ -9,6 +9,7 @@
 #include "io/stl.hpp"
 
 #include "io/error.hpp"
+#include "io/triangulate.hpp"
 
 #include <algorithm>
 #include <bit>
@@ -244,7 +245,7 @@ bool parse_float(std::string_view token, float& out) {
 
 class AsciiReader : public Reader {
 public:
-    explicit AsciiReader(ByteSource& source) : source_(source) {
+    AsciiReader(ByteSource& source, bool strict) : source_(source), strict_(strict) {
         header_.variant = "ascii";
         if (has_utf8_bom(source_.peek(3))) source_.consume(3);
         // Read up to the first solid's name so header() can report it before the first chunk.
@@ -255,13 +256,15 @@ public:
 
     bool next(TriangleChunk& chunk) override {
         chunk.clear();
+        if (!drain(chunk)) return true;
         parse(&chunk);
         return !chunk.empty();
     }
 
 private:
     // What the parser expects next.
-    enum class State { kSolid, kFacetOrEnd, kNormal, kLoop, kVertex, kCoordinate, kEndLoop, kEndFacet };
+    enum class State { kSolid, kFacetOrEnd, kNormal, kLoop, kVertex, kCoordinate, kEndFacet };
+    static constexpr size_t kMaxFacetCorners = size_t{1} << 16;
 
     [[noreturn]] void fail(const std::string& message) const {
         throw Error(source_.name(), Error::kNoOffset, line_, message);
@@ -296,14 +299,23 @@ private:
             std::string_view text = segment();
             if (text.empty()) {
                 if (state_ == State::kSolid && solids_ > 0) return;
+                // Facets read and all complete, only 'endsolid' missing: read, with a warning
+                // (the file may still have been cut between facets). A solid without facets
+                // is more likely cut right after its first line: an error.
+                if (state_ == State::kFacetOrEnd && facets_in_solid_ > 0 && !strict_) {
+                    warn("no 'endsolid' at the end of the file (cut short between facets?)", line_);
+                    state_ = State::kSolid;
+                    return;
+                }
                 switch (state_) {
                     case State::kSolid: fail("expected 'solid', found end of file");
                     case State::kFacetOrEnd: fail("expected 'facet' or 'endsolid', found end of file");
                     case State::kNormal: fail("expected 'outer', found end of file");
                     case State::kLoop: fail("expected 'loop', found end of file");
-                    case State::kVertex: fail("expected 'vertex', found end of file");
+                    case State::kVertex:
+                        fail(corners_.size() < 9 ? "expected 'vertex', found end of file"
+                                                 : "expected 'endloop', found end of file");
                     case State::kCoordinate: fail("expected a number, found end of file");
-                    case State::kEndLoop: fail("expected 'endloop', found end of file");
                     case State::kEndFacet: fail("expected 'endfacet', found end of file");
                 }
             }
@@ -324,6 +336,7 @@ private:
                         if (!keyword_is(token, "solid")) expected("'solid'", token);
                         pos = skip_line(text, pos, solids_ == 0 ? &first_name_ : nullptr);
                         ++solids_;
+                        facets_in_solid_ = 0;
                         state_ = State::kFacetOrEnd;
                         if (!chunk) stop = true;
                         break;
@@ -331,6 +344,7 @@ private:
                         if (keyword_is(token, "facet")) {
                             state_ = State::kNormal;
                             normal_tokens_ = 0;
+                            facet_line_ = line_;
                         } else if (keyword_is(token, "endsolid")) {
                             pos = skip_line(text, pos, nullptr);
                             state_ = State::kSolid;
@@ -350,27 +364,34 @@ private:
                     case State::kLoop:
                         if (!keyword_is(token, "loop")) expected("'loop'", token);
                         state_ = State::kVertex;
-                        corner_ = 0;
+                        corners_.clear();
                         break;
                     case State::kVertex:
-                        if (!keyword_is(token, "vertex")) expected("'vertex'", token);
-                        state_ = State::kCoordinate;
-                        axis_ = 0;
+                        // Three vertices, then 'endloop'; other counts are read leniently.
+                        if (keyword_is(token, "vertex")) {
+                            if (corners_.size() == 3 * kMaxFacetCorners)
+                                fail("facet with more than " + std::to_string(kMaxFacetCorners) + " vertices");
+                            state_ = State::kCoordinate;
+                            axis_ = 0;
+                            corners_.resize(corners_.size() + 3);
+                        } else if (keyword_is(token, "endloop")) {
+                            end_loop();
+                            state_ = State::kEndFacet;
+                        } else {
+                            expected(corners_.size() < 9 ? "'vertex'" : "'endloop'", token);
+                        }
                         break;
                     case State::kCoordinate:
-                        if (!parse_float(token, tri_[3 * corner_ + axis_])) expected("a number", token);
-                        if (++axis_ == 3) state_ = ++corner_ == 3 ? State::kEndLoop : State::kVertex;
-                        break;
-                    case State::kEndLoop:
-                        if (!keyword_is(token, "endloop")) expected("'endloop'", token);
-                        state_ = State::kEndFacet;
+                        if (!parse_float(token, corners_[corners_.size() - 3 + size_t(axis_)]))
+                            expected("a number", token);
+                        if (++axis_ == 3) state_ = State::kVertex;
                         break;
                     case State::kEndFacet:
                         if (!keyword_is(token, "endfacet")) expected("'endfacet'", token);
                         state_ = State::kFacetOrEnd;
+                        ++facets_in_solid_;
                         assert(chunk);  // the constructor's pass stops after the first 'solid' line
-                        std::memcpy(chunk->push_slot(), tri_, sizeof tri_);
-                        if (chunk->full()) stop = true;
+                        if (!drain(*chunk)) stop = true;
                         break;
                 }
             }
@@ -393,14 +414,55 @@ private:
         return end;
     }
 
+    // A facet's loop has ended: its triangles go to pending_. Three vertices make one; more
+    // are triangulated as PLY and OBJ polygons are (io/triangulate.hpp: the fan when convex);
+    // fewer make none. Both are counted warnings, or errors under --strict.
+    void end_loop() {
+        const size_t n = corners_.size() / 3;
+        if (n == 3) {
+            pending_.insert(pending_.end(), corners_.begin(), corners_.end());
+            return;
+        }
+        if (strict_)
+            throw Error(source_.name(), Error::kNoOffset, facet_line_,
+                        "facet with " + std::to_string(n) + " vertices (--strict)");
+        if (n < 3) {
+            warn("facets with fewer than 3 vertices skipped", facet_line_);
+            return;
+        }
+        warn("facets with more than 3 vertices split into triangles", facet_line_);
+        triangles_.clear();
+        triangulate_polygon(corners_, triangulate_scratch_, triangles_);
+        for (uint32_t corner : triangles_)
+            pending_.insert(pending_.end(), corners_.begin() + 3 * corner, corners_.begin() + 3 * corner + 3);
+    }
+
+    // Moves pending triangles into `chunk`; false when it filled up before they ran out.
+    bool drain(TriangleChunk& chunk) {
+        while (pending_next_ < pending_.size()) {
+            if (chunk.full()) return false;
+            std::memcpy(chunk.push_slot(), &pending_[pending_next_], 9 * sizeof(float));
+            pending_next_ += 9;
+        }
+        pending_.clear();
+        pending_next_ = 0;
+        return !chunk.full();
+    }
+
     ByteSource& source_;
+    bool strict_;
     State state_ = State::kSolid;
     uint64_t line_ = 1;
+    uint64_t facet_line_ = 0;
     uint64_t solids_ = 0;
+    uint64_t facets_in_solid_ = 0;
     int normal_tokens_ = 0;
-    int corner_ = 0;
     int axis_ = 0;
-    float tri_[9] = {};
+    std::vector<float> corners_;  // the current facet's vertices, 3 floats each
+    std::vector<float> pending_;  // triangles read but not yet in a chunk, 9 floats each
+    size_t pending_next_ = 0;
+    std::vector<uint32_t> triangles_;
+    TriangulateScratch triangulate_scratch_;
     std::string first_name_;
 };
 
@@ -559,16 +621,16 @@ bool probe_stl_ascii(std::span<const std::byte> head, std::optional<uint64_t> si
 }
 
 // "stl" reads both encodings: binary when the size says so or the content is not ASCII text.
-std::unique_ptr<Reader> open_stl_reader(ByteSource& source, const ReadOptions&) {
+std::unique_ptr<Reader> open_stl_reader(ByteSource& source, const ReadOptions& options) {
     auto head = source.peek(4096);
     if (probe_stl_binary(head, source.size()) || !looks_like_ascii_stl(head))
         return std::make_unique<BinaryReader>(source);
-    return std::make_unique<AsciiReader>(source);
+    return std::make_unique<AsciiReader>(source, options.strict);
 }
 
 // "stl-ascii" (--from stl-ascii) insists on ASCII.
-std::unique_ptr<Reader> open_stl_ascii_reader(ByteSource& source, const ReadOptions&) {
-    return std::make_unique<AsciiReader>(source);
+std::unique_ptr<Reader> open_stl_ascii_reader(ByteSource& source, const ReadOptions& options) {
+    return std::make_unique<AsciiReader>(source, options.strict);
 }
 
 std::unique_ptr<Writer> open_stl_writer(ByteSink& sink, const WriteOptions& options) {

@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cctype>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -64,10 +65,10 @@ struct Mesh {
     size_t chunks = 0;
 };
 
-// Reads every chunk, checking that all but the last are full.
+// Reads every chunk, checking that all but the last are full; the header as it is at the end
+// (with the reader's warnings).
 Mesh drain(io::Reader& reader, size_t capacity) {
     Mesh mesh;
-    mesh.header = reader.header();
     io::TriangleChunk chunk(capacity);
     bool short_seen = false;
     while (reader.next(chunk)) {
@@ -77,6 +78,7 @@ Mesh drain(io::Reader& reader, size_t capacity) {
         ++mesh.chunks;
     }
     EXPECT_TRUE(chunk.empty());
+    mesh.header = reader.header();
     return mesh;
 }
 
@@ -90,10 +92,25 @@ Mesh read_path(const std::string& path, size_t capacity = io::TriangleChunk::kDe
 
 // Reads from memory through the "stl" format's reader (auto-detecting binary/ASCII).
 Mesh read_memory(std::string bytes, const std::string& name, bool sized, size_t capacity = 4096,
-                 size_t piece = std::numeric_limits<size_t>::max()) {
+                 size_t piece = std::numeric_limits<size_t>::max(), const io::ReadOptions& options = {}) {
     auto source = memory_source(std::move(bytes), name, sized, piece);
-    auto reader = io::kStlFormat.open_reader(*source, {});
+    auto reader = io::kStlFormat.open_reader(*source, options);
     return drain(*reader, capacity);
+}
+
+constexpr size_t kWhole = std::numeric_limits<size_t>::max();  // read_memory's piece: all at once
+
+io::ReadOptions strict_options() {
+    io::ReadOptions o;
+    o.strict = true;
+    return o;
+}
+
+// The reader's warning that starts with `text`, or one with count 0 when there is none.
+io::ReaderWarning warning_of(const Mesh& mesh, std::string_view text) {
+    for (const io::ReaderWarning& w : mesh.header.warnings)
+        if (w.text.starts_with(text)) return w;
+    return {std::string(text), 0};
 }
 
 void write_path(const std::string& path, const std::vector<float>& xyz, std::string_view to,
@@ -381,20 +398,113 @@ TEST(StlReader, RejectsTruncatedBinaryAtEveryByte) {
     }
 }
 
-TEST(StlReader, TruncatedAsciiFailsUnlessOnlyTheEndsolidNameIsCut) {
+// A cut inside a facet or a keyword is an error. A cut between facets is a file whose facets
+// are complete but lacks 'endsolid' (issue 21): read, with one warning, and an error under
+// --strict. A cut in the name after 'endsolid' (or of the final newline) loses nothing.
+TEST(StlReader, TruncatedAsciiFailsUnlessCutBetweenFacetsOrInTheEndsolidName) {
     const std::string text = slurp(fixture("tetrahedron.ascii.stl"));
     const size_t endsolid = text.rfind("endsolid");
     ASSERT_NE(endsolid, std::string::npos);
+    size_t between = 0;
     for (size_t length = 0; length < text.size(); ++length) {
         SCOPED_TRACE(length);
         std::string cut = text.substr(0, length);
+        std::string_view trimmed = cut;
+        while (!trimmed.empty() && std::isspace(static_cast<unsigned char>(trimmed.back()))) trimmed.remove_suffix(1);
         if (length >= endsolid + 8) {
-            // Only the name after "endsolid" (or the final newline) is missing: a complete file.
-            EXPECT_EQ(read_memory(cut, "cut.stl", false).xyz.size(), 9u * 4);
+            Mesh mesh = read_memory(cut, "cut.stl", false);
+            EXPECT_EQ(mesh.xyz.size(), 9u * 4);
+            EXPECT_TRUE(mesh.header.warnings.empty());
+        } else if (trimmed.ends_with("endfacet")) {
+            ++between;
+            size_t facets = 0;
+            for (size_t at = cut.find("endfacet"); at != std::string::npos; at = cut.find("endfacet", at + 1)) ++facets;
+            Mesh mesh = read_memory(cut, "cut.stl", false);
+            EXPECT_EQ(mesh.xyz.size(), 9 * facets);
+            EXPECT_EQ(warning_of(mesh, "no 'endsolid' at the end").count, 1u);
+            EXPECT_THROW(read_memory(cut, "cut.stl", false, 4096, kWhole, strict_options()), io::Error);
         } else {
             EXPECT_THROW(read_memory(cut, "cut.stl", false), io::Error);
         }
     }
+    EXPECT_GT(between, 3u);  // after each of the 4 facets, with and without its line end
+}
+
+// Issue 21: facets of more than three vertices are triangulated as PLY and OBJ polygons are
+// (the fan when convex, else ear clipping), facets of fewer are skipped, and a file lacking
+// 'endsolid' is read: each one counted warning naming the first facet's line; under --strict
+// each is an error naming the line.
+TEST(StlReader, AsciiLenientFacetsAreCountedWarningsOrStrictErrors) {
+    const std::string text =
+        "solid lenient\n"
+        "facet normal 0 0 1\n outer loop\n  vertex 0 0 0\n  vertex 2 0 0\n  vertex 2 2 0\n  vertex 0 2 0\n"  // line 2:
+                                                                                                             // a square
+        " endloop\nendfacet\n"
+        "facet normal 0 0 1\n outer loop\n  vertex 0 0 1\n  vertex 1 0 1\n endloop\nendfacet\n"  // line 10: two
+                                                                                                 // vertices
+        "facet normal 0 0 1\n outer loop\n endloop\nendfacet\n"                                  // line 16: none
+        "facet normal 0 0 1\n outer loop\n  vertex 0 0 2\n  vertex 4 0 2\n  vertex 4 4 2\n  vertex 2 1 2\n"  // line 20:
+        "  vertex 0 4 2\n endloop\nendfacet\n"  // a concave arrow
+        "facet normal 0 0 1\n outer loop\n  vertex 0 0 3\n  vertex 1 0 3\n  vertex 0 1 3\n endloop\nendfacet\n";
+    const std::vector<float> expected = {
+        0, 0, 0, 2, 0, 0, 2, 2, 0, 0, 0, 0, 2, 2, 0, 0, 2, 0,  // the square's fan
+    };
+    Mesh whole = read_memory(text, "lenient.stl", true);
+    ASSERT_EQ(whole.xyz.size(), 9u * (2 + 3 + 1));
+    EXPECT_TRUE(std::equal(expected.begin(), expected.end(), whole.xyz.begin()));
+    // The arrow's three triangles keep its orientation (+z) and cover its area (10) once.
+    double area = 0;
+    for (size_t t = 2; t < 5; ++t) {
+        const float* p = &whole.xyz[9 * t];
+        const double cross_z = double(p[3] - p[0]) * (p[7] - p[1]) - double(p[4] - p[1]) * (p[6] - p[0]);
+        EXPECT_GT(cross_z, 0) << t;
+        area += cross_z / 2;
+    }
+    EXPECT_DOUBLE_EQ(area, 10.0);
+    const io::ReaderWarning split = warning_of(whole, "facets with more than 3 vertices split into triangles");
+    EXPECT_EQ(split.count, 2u);
+    EXPECT_EQ(split.first_line, 2u);
+    const io::ReaderWarning skipped = warning_of(whole, "facets with fewer than 3 vertices skipped");
+    EXPECT_EQ(skipped.count, 2u);
+    EXPECT_EQ(skipped.first_line, 10u);
+    const io::ReaderWarning end = warning_of(whole, "no 'endsolid' at the end of the file");
+    EXPECT_EQ(end.count, 1u);
+    EXPECT_EQ(io::describe_warning("lenient.stl", split),
+              "lenient.stl: facets with more than 3 vertices split into triangles (first at line 2)");
+    for (size_t capacity : {size_t{1}, size_t{2}, size_t{7}}) {
+        SCOPED_TRACE(capacity);
+        Mesh part = read_memory(text, "lenient.stl", false, capacity, 5);
+        EXPECT_TRUE(same_bits(part.xyz, whole.xyz));
+        EXPECT_EQ(part.header.warnings, whole.header.warnings);
+    }
+    // --strict: the first of them is an error naming its line.
+    EXPECT_STREQ(error_of([&] { read_memory(text, "lenient.stl", true, 16, kWhole, strict_options()); }).what(),
+                 "lenient.stl:2: facet with 4 vertices (--strict)");
+    const std::string two = "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nendloop\n";
+    EXPECT_STREQ(error_of([&] { read_memory(two, "two.stl", true, 16, kWhole, strict_options()); }).what(),
+                 "two.stl:2: facet with 2 vertices (--strict)");
+    const std::string open =
+        "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
+        "endloop\nendfacet\n";
+    EXPECT_STREQ(error_of([&] { read_memory(open, "open.stl", true, 16, kWhole, strict_options()); }).what(),
+                 "open.stl:9: expected 'facet' or 'endsolid', found end of file");
+    EXPECT_EQ(read_memory(open, "open.stl", true).xyz.size(), 9u);
+    // A solid with no facet and no 'endsolid' is a file cut after its first line: an error.
+    EXPECT_STREQ(error_of([&] { read_memory("solid t\n", "empty.stl", true); }).what(),
+                 "empty.stl:2: expected 'facet' or 'endsolid', found end of file");
+}
+
+// Binary STL's attribute word has two colour conventions (VisCAM/SolidView: bit 15 set means
+// a colour; Materialise Magics: bit 15 clear means one, red and blue swapped) that no byte of
+// the file tells apart, and most writers leave it 0 or fill it with junk (CGAL's sphere.stl
+// holds two spaces in every facet): it is not read as colour.
+TEST(StlReader, BinaryAttributeBytesAreNotColour) {
+    Mesh mesh = read_path(fixture("cgal_sphere_attrbytes.bin.stl"));
+    EXPECT_EQ(mesh.xyz.size(), 9u * 320);
+    EXPECT_EQ(mesh.header.channels, io::Channels{});
+    EXPECT_TRUE(mesh.header.warnings.empty());
+    EXPECT_EQ(io::kStlFormat.keep_channels, nullptr);  // writes positions only
+    EXPECT_EQ(io::kStlAsciiFormat.keep_channels, nullptr);
 }
 
 TEST(StlReader, HeaderCountLyingBothWays) {
@@ -441,17 +551,18 @@ TEST(StlReader, AsciiBadInputNamesLine) {
     };
     const Case cases[] = {
         // CRLF lines count once each.
-        {"solid x\r\nfacet normal 0 0 1\r\nouter loop\r\nvertex 1 2 zz\r\n", "bad.stl:4: expected a number, found 'zz'"},
-        {"solid x\nfacet normal 0 0 1\nouter loop\nvertex 1 2 3 4\n",
-         "bad.stl:4: expected 'vertex', found '4'"},
+        {"solid x\r\nfacet normal 0 0 1\r\nouter loop\r\nvertex 1 2 zz\r\n",
+         "bad.stl:4: expected a number, found 'zz'"},
+        {"solid x\nfacet normal 0 0 1\nouter loop\nvertex 1 2 3 4\n", "bad.stl:4: expected 'vertex', found '4'"},
+        // Read with a counted warning, except under --strict (as here).
         {"solid x\nfacet normal 0 0 1\nouter loop\nvertex 1 2 3\nvertex 1 2 3\nendloop\n",
-         "bad.stl:6: expected 'vertex', found 'endloop'"},
+         "bad.stl:2: facet with 2 vertices (--strict)"},
         {"solid x\nfacet normal 0 0 1 7 8\nouter loop\n", "bad.stl:2: expected 'outer', found '7'"},
         {"solid x\nfacet normal 0 0 1\nouter loop\nvertex 1 +-2 3\n", "bad.stl:4: expected a number, found '+-2'"},
         {"solid x\nfacet normal 0 0 1\nouter loop\nvertex 1 2 1e999z\n",
          "bad.stl:4: expected a number, found '1e999z'"},
         {"solid x\nfacet normal 0 0 1\nouter\n", "bad.stl:4: expected 'loop', found end of file"},
-        // Every facet complete but no endsolid: a cut file, not a shorter mesh.
+        // Every facet complete but no endsolid: a warning, an error under --strict (as here).
         {"solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\n",
          "bad.stl:9: expected 'facet' or 'endsolid', found end of file"},
         {"solid x\nendsolid x\ngarbage\n", "bad.stl:3: expected 'solid', found 'garbage'"},
@@ -462,7 +573,7 @@ TEST(StlReader, AsciiBadInputNamesLine) {
         SCOPED_TRACE(c.text);
         EXPECT_STREQ(error_of([&] {
                          auto source = memory_source(c.text, "bad.stl", true);
-                         auto reader = io::kStlAsciiFormat.open_reader(*source, {});
+                         auto reader = io::kStlAsciiFormat.open_reader(*source, strict_options());
                          drain(*reader, 16);
                      }).what(),
                      c.what);
