@@ -1,5 +1,7 @@
-// `meshstream info FILE`: format, counts, bounding box, file size and degenerate triangles,
-// in one streaming pass (memory: one chunk), as plain text or --json.
+// `meshstream info FILE`: format, counts, bounding box, file size, degenerate triangles, the
+// channels the file carries (normals, colours, texture coordinates, named scalars, materials)
+// and what the reader skipped or repaired, in one streaming pass (memory: one chunk of
+// positions; attribute values are not read), as plain text or --json.
 #include "io/error.hpp"
 #include "tools/cli_checks.hpp"
 #include "tools/commands.hpp"
@@ -11,6 +13,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -74,14 +77,60 @@ void accumulate(const io::TriangleChunk& chunk, InfoStats& s) {
     s.triangles += chunk.size();
 }
 
+// "uchar RGBA", "float RGB".
+std::string color_text(const io::ColorFormat& c) {
+    return std::string(io::scalar_type_name(c.type)) + (c.alpha ? " RGBA" : " RGB");
+}
+
+// "uchar red, int label".
+std::string scalars_text(const std::vector<io::ScalarChannel>& list) {
+    std::string out;
+    for (const io::ScalarChannel& s : list) {
+        if (!out.empty()) out += ", ";
+        out += std::string(io::scalar_type_name(s.type)) + " " + io::printable(s.name, 64);
+    }
+    return out;
+}
+
+nlohmann::ordered_json scalars_json(const std::vector<io::ScalarChannel>& list) {
+    nlohmann::ordered_json out = nlohmann::ordered_json::array();
+    for (const io::ScalarChannel& s : list) out.push_back({{"name", s.name}, {"type", io::scalar_type_name(s.type)}});
+    return out;
+}
+
+// The channels a file carries, per corner and per triangle.
+nlohmann::ordered_json channels_json(const io::Channels& c) {
+    nlohmann::ordered_json j = nlohmann::ordered_json::object();
+    if (c.normal) j["normal"] = {{"type", "float"}, {"components", 3}};
+    if (c.color) j["color"] = {{"type", io::scalar_type_name(c.color->type)}, {"components", c.color->alpha ? 4 : 3}};
+    if (c.uv_sets > 0) j["uv"] = {{"sets", c.uv_sets}, {"type", "float"}, {"components", 2}};
+    if (!c.vertex_scalars.empty()) j["vertex_scalars"] = scalars_json(c.vertex_scalars);
+    if (c.vertex_id) j["vertex_id"] = true;
+    if (c.material) j["material"] = {{"type", "uint"}, {"components", 1}};
+    if (!c.face_scalars.empty()) j["face_scalars"] = scalars_json(c.face_scalars);
+    return j;
+}
+
+std::string color_values(const std::array<float, 4>& rgba) {
+    char buf[96];
+    std::snprintf(buf, sizeof buf, "%.6g %.6g %.6g %.6g", rgba[0], rgba[1], rgba[2], rgba[3]);
+    return buf;
+}
+
 void run_info(const InfoOptions& opt) {
-    // info reports bad triangles; --strict makes the first one an error instead.
-    io::TriangleInput in = open_triangle_input(opt.input, opt.read, Command::kMeasure);
+    // info reports bad triangles; --strict makes the first one an error instead. It looks at
+    // positions (and vertex ids, for --topology) only: the reader stores no attribute values,
+    // and the header still lists every channel.
+    io::ReadOptions read = opt.read.options();
+    read.channels = io::ChannelKinds::none();
+    io::TriangleInput in = open_triangle_input(opt.input, opt.read, read, Command::kMeasure);
     const io::MeshHeader& header = in.header();
     // What info prints must not land in the file it reads (`info scan.stl >> scan.stl`).
     refuse_output_over_inputs("-", {}, {input_files(opt.input, header)});
     InfoStats stats;
-    io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, header.channels);
+    io::Channels positions;
+    positions.vertex_id = header.channels.vertex_id;
+    io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, positions);
     std::unique_ptr<TopologyCounter> topology;
     if (opt.topology) topology = std::make_unique<TopologyCounter>(opt.read.options().memory_budget_bytes, opt.read.tmpdir);
     std::optional<OrderMeter> meter;
@@ -123,7 +172,30 @@ void run_info(const InfoOptions& opt) {
             j["bbox_max"] = nullptr;
         }
         if (header.sorted_axis) j["sorted_axis"] = kAxes[*header.sorted_axis];
+        j["channels"] = channels_json(header.channels);
+        if (!header.materials.empty()) {
+            auto& list = j["materials"] = nlohmann::ordered_json::array();
+            for (const io::Material& m : header.materials) {
+                nlohmann::ordered_json e = {
+                    {"name", m.name},
+                    {"base_color", {m.base_color[0], m.base_color[1], m.base_color[2], m.base_color[3]}}};
+                if (m.texture)
+                    e["texture"] = {{"uri", m.texture->uri},
+                                    {"mime_type", m.texture->mime_type},
+                                    {"bytes", m.texture->bytes.size()}};
+                list.push_back(e);
+            }
+        }
         for (const auto& [k, v] : header.notes) j["notes"][k] = v;
+        if (!header.warnings.empty()) {
+            auto& list = j["warnings"] = nlohmann::ordered_json::array();
+            for (const io::ReaderWarning& w : header.warnings) {
+                nlohmann::ordered_json e = {{"text", w.text}, {"count", w.count}};
+                if (w.first_line != 0) e["line"] = w.first_line;
+                if (w.first_byte_offset != io::Error::kNoOffset) e["byte"] = w.first_byte_offset;
+                list.push_back(e);
+            }
+        }
         if (topology) {
             TopologyReport t = topology->finish();
             j["topology"] = {{"welded_by", t.by_vertex_id ? "vertex id" : "position"},
@@ -167,7 +239,41 @@ void run_info(const InfoOptions& opt) {
         std::printf("bbox:        empty\n");
     }
     if (header.sorted_axis) std::printf("sorted along: %s\n", kAxes[*header.sorted_axis]);
+    const io::Channels& c = header.channels;
+    std::string channels;
+    auto add = [&](const std::string& item) { channels += (channels.empty() ? "" : ", ") + item; };
+    if (c.normal) add("normal (3 × float)");
+    if (c.color) add("colour (" + color_text(*c.color) + ")");
+    if (c.uv_sets > 0)
+        add("texture coordinates (" + std::to_string(c.uv_sets) + (c.uv_sets == 1 ? " set" : " sets") +
+            " of 2 × float)");
+    if (!c.vertex_scalars.empty())
+        add(std::to_string(c.vertex_scalars.size()) + " vertex scalar" + (c.vertex_scalars.size() == 1 ? "" : "s"));
+    if (c.material) add("material index");
+    if (!c.face_scalars.empty())
+        add(std::to_string(c.face_scalars.size()) + " face scalar" + (c.face_scalars.size() == 1 ? "" : "s"));
+    std::printf("channels:    %s\n", channels.empty() ? "positions only" : channels.c_str());
+    if (!c.vertex_scalars.empty()) std::printf("vertex scalars: %s\n", scalars_text(c.vertex_scalars).c_str());
+    if (!c.face_scalars.empty()) std::printf("face scalars: %s\n", scalars_text(c.face_scalars).c_str());
+    if (!header.materials.empty()) {
+        std::printf("materials:   %zu\n", header.materials.size());
+        for (size_t i = 0; i < header.materials.size(); ++i) {
+            const io::Material& m = header.materials[i];
+            std::string line = "  " + std::to_string(i) + ": '" + io::printable(m.name, 64) + "', base colour " +
+                               color_values(m.base_color);
+            if (m.texture)
+                line += ", texture '" + io::printable(m.texture->uri, 200) + "'" +
+                        (m.texture->mime_type.empty() ? "" : " (" + m.texture->mime_type + ")") + ", " +
+                        (m.texture->bytes.empty() ? std::string("not loaded")
+                                                  : std::to_string(m.texture->bytes.size()) + " bytes");
+            std::printf("%s\n", line.c_str());
+        }
+    }
     for (const auto& [k, v] : header.notes) std::printf("%-12s %s\n", (k + ":").c_str(), v.c_str());
+    for (const io::ReaderWarning& w : header.warnings) {
+        std::printf("warning:     %s%s (%llu)\n", w.text.c_str(), io::warning_position(w).c_str(),
+                    (unsigned long long)w.count);
+    }
     if (topology) {
         TopologyReport t = topology->finish();
         std::printf("topology:    %llu vertices (welded by %s), %llu edges, %llu boundary, %llu non-manifold\n",
@@ -182,7 +288,9 @@ void run_info(const InfoOptions& opt) {
 
 void add_info(CLI::App& app) {
     auto opt = std::make_shared<InfoOptions>();
-    CLI::App* cmd = app.add_subcommand("info", "Print format, triangle count, bounding box, file size and degenerate triangles");
+    CLI::App* cmd = app.add_subcommand("info",
+                                       "Print format, triangle count, bounding box, file size, degenerate triangles, "
+                                       "the channels the file carries and what its reader skipped");
     cmd->add_option("file", opt->input, "Mesh file ('-' = stdin; gzip is detected)")->required();
     cmd->add_flag("--json", opt->json, "Print JSON instead of text");
     cmd->add_flag("--topology", opt->topology,
