@@ -349,7 +349,7 @@ void run_decimate(const DecimateOptions& opt) {
     const bool may_restart = opt.sort == "auto" && !options.sorted_axis;
     const bool read_once = !is_regular_file(opt.input);
     const uint64_t budget = opt.read.options().memory_budget_bytes;
-    io::ReadOptions sort_ro = opt.read.options();  // the reader's share while sorting
+    io::ReadOptions sort_ro = read;  // the reader's share while sorting
     sort_ro.memory_budget_bytes = budget / 4;
     const uint64_t sort_budget = budget / 2;
     std::optional<PositionSpool> spool;
@@ -434,7 +434,7 @@ void run_decimate(const DecimateOptions& opt) {
             };
             decimate_pass(next, *decimator, emit, progress, [&] { return done; }, {});
         } else {
-            in = open_triangle_input(opt.input, opt.read, Command::kDecimate);
+            in = open_triangle_input(opt.input, opt.read, read, Command::kDecimate);
             decimator = make_decimator(options, in.count());
             progress.phase("decimating", header.triangle_count);
             decimate_pass([&](io::TriangleChunk& chunk) { return in.next(chunk); }, *decimator, emit, progress,
