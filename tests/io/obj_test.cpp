@@ -965,14 +965,12 @@ TEST(ObjFormat, KeepsNormalsRgbColourOneUvSetAndMaterials) {
 // PLY's uchar colours as OBJ floats (value / 255, which reads back to the same byte).
 TEST(ObjRoundTrip, ColoursSurviveObjToPlyAndPlyToObj) {
     TempDir dir;
-    io::Channels colour = io::Channels::ids_only();  // what PLY keeps of it (normals not yet)
-    colour.color = io::ColorFormat{io::ScalarType::kFloat32, false};
-    Mesh obj = read_mesh(fixture("obj/cube_with_vertexcolors.obj"), io::TriangleChunk::kDefaultCapacity, {}, &colour);
+    // PLY keeps every channel an OBJ has (normals, texture coordinates, colour), and the seams.
+    Mesh obj = read_mesh(fixture("obj/cube_with_vertexcolors.obj"));
     convert_all(fixture("obj/cube_with_vertexcolors.obj"), dir / "c.ply");
     convert_all(dir / "c.ply", dir / "c.obj");
     Mesh back = read_mesh(dir / "c.obj");
-    EXPECT_TRUE(back.xyz == obj.xyz);
-    EXPECT_TRUE(back.rgba == obj.rgba);
+    expect_same_mesh(obj, back);
     expect_same_vertices(obj.ids, back.ids);
 
     Mesh ply = read_mesh(fixture("ply/cactus_vcolor.binary_le.ply"));
