@@ -135,6 +135,27 @@ double seconds_since(std::chrono::steady_clock::time_point t) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
 }
 
+// --stats' line: triangles, axis, time and rate, each phase's time, runs, merge passes,
+// temporary disk and peak RSS.
+std::string sort_stats_line(const sort::SortStats& s, int axis, double seconds, double input_seconds,
+                            double sort_seconds, uint64_t peak_rss) {
+    char line[512];
+    std::snprintf(line, sizeof line,
+                  "sorted %llu triangles along %s in %.2f s (%s triangles/s; input and runs %.2f s, "
+                  "last run sort and merge passes %.2f s, final merge and output %.2f s): %s, "
+                  "%d merge pass%s, %s temporary written, peak temporary disk %s, peak RSS %s",
+                  (unsigned long long)s.triangles, kAxisNames[axis], seconds,
+                  human_count(seconds > 0 ? double(s.triangles) / seconds : 0).c_str(), input_seconds, sort_seconds,
+                  seconds - input_seconds - sort_seconds,
+                  (s.runs == 0 ? "in memory (room for " + std::to_string(s.run_capacity) + " triangles), no runs"
+                               : std::to_string(s.runs) + (s.runs == 1 ? " run" : " runs") + " of up to " +
+                                     std::to_string(s.run_capacity))
+                      .c_str(),
+                  s.merge_passes, s.merge_passes == 1 ? "" : "es", human_bytes(double(s.temp_bytes_written)).c_str(),
+                  human_bytes(double(s.peak_temp_bytes)).c_str(), human_bytes(double(peak_rss)).c_str());
+    return line;
+}
+
 void run_sort(const SortOptions& opt) {
     const auto t0 = std::chrono::steady_clock::now();
     const io::Format& out_format = resolve_output_format(opt.output, opt.write);
@@ -287,23 +308,11 @@ void run_sort(const SortOptions& opt) {
     note_input_changes(end_header, input_name, warnings);
     warnings.print();
 
-    if (opt.stats) {
-        const sort::SortStats& s = sorter.stats();
-        const double seconds = seconds_since(t0);
-        std::fprintf(stderr,
-                     "sorted %llu triangles along %s in %.2f s (%s triangles/s; input and runs %.2f s, "
-                     "last run sort and merge passes %.2f s, final merge and output %.2f s): %s, "
-                     "%d merge pass%s, %s temporary written, peak temporary disk %s, peak RSS %s\n",
-                     (unsigned long long)s.triangles, kAxisNames[axis], seconds,
-                     human_count(seconds > 0 ? double(s.triangles) / seconds : 0).c_str(), input_seconds, sort_seconds,
-                     seconds - input_seconds - sort_seconds,
-                     (s.runs == 0 ? "in memory (room for " + std::to_string(s.run_capacity) + " triangles), no runs"
-                                  : std::to_string(s.runs) + (s.runs == 1 ? " run" : " runs") + " of up to " +
-                                        std::to_string(s.run_capacity))
-                         .c_str(),
-                     s.merge_passes, s.merge_passes == 1 ? "" : "es", human_bytes(double(s.temp_bytes_written)).c_str(),
-                     human_bytes(double(s.peak_temp_bytes)).c_str(), human_bytes(double(peak_rss_bytes())).c_str());
-    }
+    if (opt.stats)
+        std::fprintf(stderr, "%s\n",
+                     sort_stats_line(sorter.stats(), axis, seconds_since(t0), input_seconds, sort_seconds,
+                                     peak_rss_bytes())
+                         .c_str());
 }
 
 }  // namespace
