@@ -900,7 +900,7 @@ public:
         : sink_(sink),
           options_(options),
           welder_(options.memory_budget_bytes, options.tmpdir, sink.name(), options.channels),
-          materials_(options.materials) {
+          materials_(std::move(options_.materials)) {  // with its images: held once
         const Channels& c = options_.channels;
         normal_ = c.normal;
         color_ = c.color.has_value();
@@ -931,7 +931,12 @@ public:
         }
     }
 
-    void materials_updated(const std::vector<Material>& materials) override { materials_ = materials; }
+    // The table only grows at its end: the entries (and images) held already stay.
+    void materials_updated(const std::vector<Material>& materials) override {
+        if (materials.size() > materials_.size())
+            materials_.insert(materials_.end(), materials.begin() + static_cast<ptrdiff_t>(materials_.size()),
+                              materials.end());
+    }
 
     void finish_output() override;
 

@@ -545,6 +545,10 @@ TEST(ObjMaterials, DefaultMaterialLateNamesAndDroppedStatements) {
     ASSERT_EQ(m.header.materials.size(), 3u);
     EXPECT_EQ(m.header.materials[0].base_color, (std::array<float, 4>{1, 0, 0, 1}));
     EXPECT_EQ(warnings_of(m.header), "materials used but defined in no material library, kept by name only: 'blue'\n");
+    // The writer gets the table as it ended (convert's update_materials): 'blue' is in it.
+    convert_all(dir / "first.obj", dir / "out.obj");
+    EXPECT_EQ(read_mesh(dir / "out.obj").material, (std::vector<std::string>{"default", "red", "blue"}));
+    EXPECT_NE(test::slurp(dir / "out.mtl").find("newmtl blue\nKd 1 1 1\n"), std::string::npos);
 
     test::spit(dir / "named.obj", "usemtl red\nmtllib lib.mtl\n" + v + "f 1 2 3\n");  // usemtl before its library
     Mesh named = read_mesh(dir / "named.obj");
