@@ -6,6 +6,8 @@
 #include "io/format.hpp"
 #include "compare/metro.hpp"
 
+#include "test_util.hpp"
+
 #include <gtest/gtest.h>
 
 #include <array>
@@ -23,21 +25,10 @@ namespace fs = std::filesystem;
 using namespace meshstream;
 using namespace meshstream::compare;
 
+using meshstream::test::slurp;
+using meshstream::test::TempDir;
+
 namespace {
-
-fs::path make_temp_dir() {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    fs::path dir = fs::temp_directory_path() / (std::string("metro_test_") + info->test_suite_name() + "_" + info->name() +
-                                                "_" + std::to_string(::getpid()));
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-    return dir;
-}
-
-struct TempDir {
-    fs::path path = make_temp_dir();
-    ~TempDir() { fs::remove_all(path); }
-};
 
 void push_tri(std::vector<float>& out, const float* a, const float* b, const float* c) {
     out.insert(out.end(), a, a + 3);
@@ -257,16 +248,16 @@ TEST(Metro, ClosedSphereHasNoBoundary) {
 
 TEST(Metro, HoldsTheSmallerFileAndStreamsTheLarger) {
     TempDir tmp;
-    write_mesh(tmp.path / "big.stl", sphere(5));
-    write_mesh(tmp.path / "small.stl", sphere(2));
+    write_mesh(tmp.path() / "big.stl", sphere(5));
+    write_mesh(tmp.path() / "small.stl", sphere(2));
     CompareOptions options;
     options.samples = 20'000;
-    CompareResult r1 = compare_meshes(file_source((tmp.path / "big.stl").string()),
-                                      file_source((tmp.path / "small.stl").string()), options);
+    CompareResult r1 = compare_meshes(file_source((tmp.path() / "big.stl").string()),
+                                      file_source((tmp.path() / "small.stl").string()), options);
     EXPECT_FALSE(r1.a.in_memory);
     EXPECT_TRUE(r1.b.in_memory);
-    CompareResult r2 = compare_meshes(file_source((tmp.path / "small.stl").string()),
-                                      file_source((tmp.path / "big.stl").string()), options);
+    CompareResult r2 = compare_meshes(file_source((tmp.path() / "small.stl").string()),
+                                      file_source((tmp.path() / "big.stl").string()), options);
     EXPECT_TRUE(r2.a.in_memory);
     EXPECT_FALSE(r2.b.in_memory);
     EXPECT_EQ(r1.a.triangles, 8u * 1024u);
@@ -278,15 +269,15 @@ TEST(Metro, HoldsTheSmallerFileAndStreamsTheLarger) {
     // estimate: a small PLY as A is held too (B, the 8 k-triangle STL, was).
     {
         const std::vector<float> small = sphere(2);
-        std::ofstream ply(tmp.path / "small.ply");
+        std::ofstream ply(tmp.path() / "small.ply");
         ply << "ply\nformat ascii 1.0\nelement vertex " << small.size() / 3
             << "\nproperty float x\nproperty float y\nproperty float z\nelement face " << small.size() / 9
             << "\nproperty list uchar int vertex_indices\nend_header\n";
         for (size_t i = 0; i < small.size(); i += 3) ply << small[i] << ' ' << small[i + 1] << ' ' << small[i + 2] << '\n';
         for (size_t t = 0; t < small.size() / 9; ++t) ply << "3 " << 3 * t << ' ' << 3 * t + 1 << ' ' << 3 * t + 2 << '\n';
     }
-    CompareResult r3 = compare_meshes(file_source((tmp.path / "small.ply").string()),
-                                      file_source((tmp.path / "big.stl").string()), options);
+    CompareResult r3 = compare_meshes(file_source((tmp.path() / "small.ply").string()),
+                                      file_source((tmp.path() / "big.stl").string()), options);
     EXPECT_TRUE(r3.a.in_memory);
     EXPECT_FALSE(r3.b.in_memory);
     EXPECT_EQ(r3.a.triangles, r2.a.triangles);
@@ -294,10 +285,10 @@ TEST(Metro, HoldsTheSmallerFileAndStreamsTheLarger) {
 
 TEST(Metro, EmptyMeshIsAnErrorNamingTheFile) {
     TempDir tmp;
-    write_mesh(tmp.path / "empty.stl", {});
-    write_mesh(tmp.path / "s.stl", sphere(1));
+    write_mesh(tmp.path() / "empty.stl", {});
+    write_mesh(tmp.path() / "s.stl", sphere(1));
     try {
-        compare_meshes(file_source((tmp.path / "s.stl").string()), file_source((tmp.path / "empty.stl").string()));
+        compare_meshes(file_source((tmp.path() / "s.stl").string()), file_source((tmp.path() / "empty.stl").string()));
         FAIL() << "expected io::Error";
     } catch (const io::Error& e) {
         EXPECT_NE(std::string(e.what()).find("empty.stl"), std::string::npos) << e.what();
@@ -314,13 +305,6 @@ struct RunResult {
     std::string out, err;
 };
 
-std::string slurp(const fs::path& p) {
-    std::ifstream in(p);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
-
 RunResult run_cli(const fs::path& dir, const std::string& args) {
     std::string cmd = std::string(MESHSTREAM_BINARY) + " -q " + args + " > " + (dir / "stdout.txt").string() + " 2> " +
                       (dir / "stderr.txt").string();
@@ -332,8 +316,8 @@ RunResult run_cli(const fs::path& dir, const std::string& args) {
 
 TEST(CompareCli, MissingFileExitsOneNamingTheFile) {
     TempDir tmp;
-    write_mesh(tmp.path / "s.stl", sphere(1));
-    RunResult r = run_cli(tmp.path, "compare " + (tmp.path / "s.stl").string() + " " + (tmp.path / "nope.stl").string());
+    write_mesh(tmp.path() / "s.stl", sphere(1));
+    RunResult r = run_cli(tmp.path(), "compare " + (tmp.path() / "s.stl").string() + " " + (tmp.path() / "nope.stl").string());
     EXPECT_EQ(r.exit_code, 1);
     EXPECT_NE(r.err.find("nope.stl"), std::string::npos) << r.err;
     EXPECT_EQ(r.err.rfind("meshstream: error: ", 0), 0u) << r.err;
@@ -341,23 +325,23 @@ TEST(CompareCli, MissingFileExitsOneNamingTheFile) {
 
 TEST(CompareCli, GarbageFileExitsOneNamingTheFile) {
     TempDir tmp;
-    write_mesh(tmp.path / "s.stl", sphere(1));
-    std::ofstream(tmp.path / "bad.stl") << "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 zero\n";
-    RunResult r = run_cli(tmp.path, "compare " + (tmp.path / "bad.stl").string() + " " + (tmp.path / "s.stl").string());
+    write_mesh(tmp.path() / "s.stl", sphere(1));
+    std::ofstream(tmp.path() / "bad.stl") << "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 zero\n";
+    RunResult r = run_cli(tmp.path(), "compare " + (tmp.path() / "bad.stl").string() + " " + (tmp.path() / "s.stl").string());
     EXPECT_EQ(r.exit_code, 1);
     EXPECT_NE(r.err.find("bad.stl"), std::string::npos) << r.err;
 }
 
 TEST(CompareCli, BadOptionExitsTwo) {
     TempDir tmp;
-    RunResult r = run_cli(tmp.path, "compare a.stl b.stl --samples zero");
+    RunResult r = run_cli(tmp.path(), "compare a.stl b.stl --samples zero");
     EXPECT_EQ(r.exit_code, 2);
-    r = run_cli(tmp.path, "compare a.stl");
+    r = run_cli(tmp.path(), "compare a.stl");
     EXPECT_EQ(r.exit_code, 2);
     // More samples than memory can hold: refused before any work (it used to fail after a
     // minute and 12 GB as a bare "out of memory"). 2^32 samples take 258 GB.
     if (double(::sysconf(_SC_PHYS_PAGES)) * double(::sysconf(_SC_PAGESIZE)) < 2.5e11) {
-        r = run_cli(tmp.path, "compare a.stl b.stl --samples 4294967296");
+        r = run_cli(tmp.path(), "compare a.stl b.stl --samples 4294967296");
         EXPECT_EQ(r.exit_code, 2);
         EXPECT_NE(r.err.find("--samples 4294967296: the held mesh's samples alone take about 257.70 GB (60 bytes each), "
                              "more than this machine's memory"),
@@ -367,15 +351,15 @@ TEST(CompareCli, BadOptionExitsTwo) {
 
 TEST(CompareCli, JsonReportsBothDirectionsAndCounts) {
     TempDir tmp;
-    write_mesh(tmp.path / "a.stl", sphere(3));
-    write_mesh(tmp.path / "b.stl", sphere(3));
-    RunResult r = run_cli(tmp.path, "compare --samples 5000 --json " + (tmp.path / "a.stl").string() + " " +
-                                        (tmp.path / "b.stl").string());
+    write_mesh(tmp.path() / "a.stl", sphere(3));
+    write_mesh(tmp.path() / "b.stl", sphere(3));
+    RunResult r = run_cli(tmp.path(), "compare --samples 5000 --json " + (tmp.path() / "a.stl").string() + " " +
+                                        (tmp.path() / "b.stl").string());
     ASSERT_EQ(r.exit_code, 0) << r.err;
     for (const char* key : {"\"a_to_b\"", "\"b_to_a\"", "\"symmetric\"", "\"rms_pct\"", "\"boundary_edges\": 0",
                             "\"non_manifold_edges\": 0", "\"triangles\": 512", "\"held_in_memory\": true"})
         EXPECT_NE(r.out.find(key), std::string::npos) << key << "\n" << r.out;
-    r = run_cli(tmp.path, "compare --samples 5000 " + (tmp.path / "a.stl").string() + " " + (tmp.path / "b.stl").string());
+    r = run_cli(tmp.path(), "compare --samples 5000 " + (tmp.path() / "a.stl").string() + " " + (tmp.path() / "b.stl").string());
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_NE(r.out.find("symmetric"), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("boundary edges 0"), std::string::npos) << r.out;
@@ -402,36 +386,36 @@ TEST(CompareCli, ADirectionWithoutSamplesIsNotMeasuredNotZero) {
     // A's triangles have no area, so nothing on A is sampled: A -> B used to print max 0, mean 0,
     // though every point of A is 99 or more away from B.
     TempDir tmp;
-    write_mesh(tmp.path / "sphere.stl", sphere(1));
-    write_mesh(tmp.path / "flat.stl", {100, 0, 0, 101, 0, 0, 102, 0, 0, 100, 1, 0, 100, 2, 0, 100, 3, 0});
-    const std::string args = (tmp.path / "flat.stl").string() + " " + (tmp.path / "sphere.stl").string();
-    RunResult r = run_cli(tmp.path, "compare " + args);
+    write_mesh(tmp.path() / "sphere.stl", sphere(1));
+    write_mesh(tmp.path() / "flat.stl", {100, 0, 0, 101, 0, 0, 102, 0, 0, 100, 1, 0, 100, 2, 0, 100, 3, 0});
+    const std::string args = (tmp.path() / "flat.stl").string() + " " + (tmp.path() / "sphere.stl").string();
+    RunResult r = run_cli(tmp.path(), "compare " + args);
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_NE(r.out.find("A -> B     no samples: not measured"), std::string::npos) << r.out;
-    EXPECT_NE(r.err.find("warning: no samples on " + (tmp.path / "flat.stl").string() +
+    EXPECT_NE(r.err.find("warning: no samples on " + (tmp.path() / "flat.stl").string() +
                          " (its triangles have no area): A -> B is not measured"),
               std::string::npos) << r.err;
     EXPECT_NE(r.err.find("A -> B is not measured, and the symmetric figures are the other direction's alone"),
               std::string::npos) << r.err;
-    r = run_cli(tmp.path, "compare --json " + args);
+    r = run_cli(tmp.path(), "compare --json " + args);
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_NE(r.out.find("\"samples\": 0,\n    \"max\": null"), std::string::npos) << r.out;
     // Neither measured: no "other direction" to speak of.
-    r = run_cli(tmp.path, "compare " + (tmp.path / "flat.stl").string() + " " + (tmp.path / "flat.stl").string());
+    r = run_cli(tmp.path(), "compare " + (tmp.path() / "flat.stl").string() + " " + (tmp.path() / "flat.stl").string());
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_NE(r.out.find("symmetric  no samples: not measured"), std::string::npos) << r.out;
     EXPECT_NE(r.err.find("B -> A is not measured\n"), std::string::npos) << r.err;
     EXPECT_EQ(r.err.find("other direction"), std::string::npos) << r.err;
     // decimate --report used to print "Hausdorff 0 (0.0000 %)" for the same meshes, and to
     // fail (exit 1, after writing) when the output had no triangles.
-    r = run_cli(tmp.path, "decimate -r 0.5 --report " + (tmp.path / "flat.stl").string() + " " +
-                              (tmp.path / "flat_out.stl").string());
+    r = run_cli(tmp.path(), "decimate -r 0.5 --report " + (tmp.path() / "flat.stl").string() + " " +
+                              (tmp.path() / "flat_out.stl").string());
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_NE(r.err.find("error vs input: not measured (no samples: the triangles have no area)"), std::string::npos)
         << r.err;
-    write_mesh(tmp.path / "one.stl", {0, 0, 0, 1, 0, 0, 0, 1, 0});
-    r = run_cli(tmp.path, "decimate -r 0.1 --report " + (tmp.path / "one.stl").string() + " " +
-                              (tmp.path / "none.stl").string());
+    write_mesh(tmp.path() / "one.stl", {0, 0, 0, 1, 0, 0, 0, 1, 0});
+    r = run_cli(tmp.path(), "decimate -r 0.1 --report " + (tmp.path() / "one.stl").string() + " " +
+                              (tmp.path() / "none.stl").string());
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_NE(r.err.find("error vs input: not measured (the output has no triangles)"), std::string::npos) << r.err;
 }
@@ -440,9 +424,9 @@ TEST(CompareCli, ADirectionWithoutSamplesIsNotMeasuredNotZero) {
 // ("(1059636245964496754530782254475" with no "%)").
 TEST(CompareCli, HugePercentagesAreWrittenInFull) {
     TempDir tmp;
-    write_mesh(tmp.path / "small.stl", {0, 0, 0, 1, 0, 0, 0, 1, 0});
-    write_mesh(tmp.path / "far.stl", {0, 0, 0, 3e30f, 0, 0, 0, 3e30f, 0});
-    RunResult r = run_cli(tmp.path, "compare " + (tmp.path / "small.stl").string() + " " + (tmp.path / "far.stl").string());
+    write_mesh(tmp.path() / "small.stl", {0, 0, 0, 1, 0, 0, 0, 1, 0});
+    write_mesh(tmp.path() / "far.stl", {0, 0, 0, 3e30f, 0, 0, 0, 3e30f, 0});
+    RunResult r = run_cli(tmp.path(), "compare " + (tmp.path() / "small.stl").string() + " " + (tmp.path() / "far.stl").string());
     ASSERT_EQ(r.exit_code, 0) << r.err;
     const size_t b_to_a = r.out.find("B -> A     max ");
     ASSERT_NE(b_to_a, std::string::npos) << r.out;

@@ -10,6 +10,8 @@
 #include "io/error.hpp"
 #include "io/format.hpp"
 
+#include "test_util.hpp"
+
 #include <gtest/gtest.h>
 #include <zlib.h>
 
@@ -27,31 +29,15 @@
 namespace io = meshstream::io;
 namespace fs = std::filesystem;
 
+using meshstream::test::slurp;
+using meshstream::test::TempDir;
+
 namespace {
-
-class TempDir {
-public:
-    TempDir() {
-        std::string pattern = (fs::temp_directory_path() / "meshstream-bad-XXXXXX").string();
-        path_ = ::mkdtemp(pattern.data()) ? pattern : std::string();
-        EXPECT_FALSE(path_.empty());
-    }
-    ~TempDir() { fs::remove_all(path_); }
-    std::string operator/(const std::string& name) const { return path_ + "/" + name; }
-
-private:
-    std::string path_;
-};
 
 void write_file(const std::string& path, std::string_view bytes) {
     std::ofstream out(path, std::ios::binary);
     out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
     ASSERT_TRUE(out.good()) << path;
-}
-
-std::string slurp(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
 // Bytes in memory, optionally without a known size (like stdin).

@@ -7,6 +7,8 @@
 #include "io/format.hpp"
 #include "io/stl.hpp"
 
+#include "test_util.hpp"
+
 #include <gtest/gtest.h>
 
 #include <csignal>
@@ -27,13 +29,9 @@
 namespace io = meshstream::io;
 namespace fs = std::filesystem;
 
-namespace {
+using meshstream::test::slurp;
 
-std::string slurp(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    EXPECT_TRUE(in.good()) << path;
-    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
+namespace {
 
 // Deterministic test data: half xorshift noise (incompressible), half repeated text.
 std::string test_bytes(size_t n, uint64_t seed) {

@@ -3,6 +3,8 @@
 // format, and a generated grid surface.
 #pragma once
 
+#include "test_util.hpp"
+
 #include "io/byte_stream.hpp"
 #include "io/error.hpp"
 #include "io/format.hpp"
@@ -25,28 +27,6 @@ namespace meshstream::test {
 inline std::string fixture(const std::string& name) { return std::string(MESHSTREAM_FIXTURES_DIR) + "/" + name; }
 
 // A fresh directory under the system temp dir, removed with its contents at scope exit.
-class TempDir {
-public:
-    TempDir() {
-        std::string pattern = (std::filesystem::temp_directory_path() / "meshstream-test-XXXXXX").string();
-        std::vector<char> buf(pattern.begin(), pattern.end());
-        buf.push_back('\0');
-        path_ = ::mkdtemp(buf.data());
-    }
-    ~TempDir() { std::filesystem::remove_all(path_); }
-    std::string operator/(const std::string& name) const { return path_ + "/" + name; }
-    const std::string& path() const { return path_; }
-    // Names of the entries in the directory (to check that nothing was left behind).
-    std::vector<std::string> entries() const {
-        std::vector<std::string> out;
-        for (const auto& e : std::filesystem::directory_iterator(path_)) out.push_back(e.path().filename().string());
-        return out;
-    }
-
-private:
-    std::string path_;
-};
-
 struct Soup {
     std::vector<float> xyz;       // 9 per triangle
     std::vector<uint8_t> rgb;     // 9 per triangle: rgba as 8 bits, without alpha
@@ -118,19 +98,6 @@ inline void convert(const std::string& from, const std::string& to, std::string_
     io::TriangleChunk chunk(capacity, in.reader->header().channels);
     while (in.reader->next(chunk)) out.write(chunk);
     out.finish();
-}
-
-inline std::string slurp(const std::string& path) {
-    std::ifstream f(path, std::ios::binary);
-    return std::string(std::istreambuf_iterator<char>(f), {});
-}
-
-inline void spit(const std::string& path, std::string_view bytes) {
-    // A new file, not a truncated one: ext4 flushes files truncated and rewritten
-    // (auto_da_alloc), which made loops over many small files wait on the disk.
-    std::filesystem::remove(path);
-    std::ofstream f(path, std::ios::binary);
-    f.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
 }
 
 // A wavy n × n vertex grid: 2 (n-1)^2 triangles sharing vertices, with irregular floats.

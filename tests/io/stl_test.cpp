@@ -6,6 +6,8 @@
 #include "io/error.hpp"
 #include "io/format.hpp"
 
+#include "test_util.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cctype>
@@ -21,15 +23,11 @@
 namespace io = meshstream::io;
 namespace fs = std::filesystem;
 
+using meshstream::test::slurp;
+
 namespace {
 
 std::string fixture(const std::string& name) { return std::string(MESHSTREAM_FIXTURES_DIR) + "/" + name; }
-
-std::string slurp(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    EXPECT_TRUE(in.good()) << path;
-    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
 
 // Bytes in memory as a RawInput: with or without a known size (a file vs. stdin), handing out at
 // most `piece` bytes per read to exercise refills.

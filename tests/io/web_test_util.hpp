@@ -3,6 +3,8 @@
 // quantization-bound matcher for lossy round trips.
 #pragma once
 
+#include "test_util.hpp"
+
 #include "io/error.hpp"
 #include "io/format.hpp"
 
@@ -23,28 +25,12 @@ namespace web_test {
 
 namespace io = meshstream::io;
 namespace fs = std::filesystem;
+using meshstream::test::slurp;
+using meshstream::test::TempDir;
 
 inline std::string fixture(const std::string& name) { return std::string(MESHSTREAM_FIXTURES_DIR) + "/" + name; }
 
 // A fresh directory per test, removed afterwards.
-class TempDir {
-public:
-    TempDir() {
-        std::string pattern = (fs::temp_directory_path() / "meshstream-web-XXXXXX").string();
-        path_ = ::mkdtemp(pattern.data()) ? pattern : std::string();
-        EXPECT_FALSE(path_.empty());
-    }
-    ~TempDir() {
-        std::error_code ec;
-        fs::remove_all(path_, ec);
-    }
-    std::string operator/(const std::string& name) const { return path_ + "/" + name; }
-    const std::string& path() const { return path_; }
-
-private:
-    std::string path_;
-};
-
 struct Soup {
     std::vector<float> xyz;  // 9 per triangle
     size_t triangles() const { return xyz.size() / 9; }
@@ -76,11 +62,6 @@ inline std::vector<std::string> write_soup(const Soup& soup, const std::string& 
     if (!chunk.empty()) out.write(chunk);
     out.finish();
     return out.writer->notes();
-}
-
-inline std::string slurp(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
 // Runs a shell command; returns its exit status and captures stdout into `out`.

@@ -6,6 +6,8 @@
 #include "io/error.hpp"
 #include "sort/radix.hpp"
 
+#include "test_util.hpp"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -21,19 +23,11 @@ namespace fs = std::filesystem;
 using namespace meshstream;
 using Tri = std::array<float, 9>;
 
+using meshstream::test::TempDir;
+
 namespace {
 
 // A fresh directory under the system temp dir, removed with its contents afterwards.
-struct TempDir {
-    fs::path path;
-    TempDir() {
-        std::string pattern = (fs::temp_directory_path() / "sort_test-XXXXXX").string();
-        path = ::mkdtemp(pattern.data());
-    }
-    ~TempDir() { fs::remove_all(path); }
-    size_t file_count() const { return static_cast<size_t>(std::distance(fs::directory_iterator(path), {})); }
-};
-
 // Binary STL read by hand (84-byte header, 50-byte facets) so this test needs no format code.
 std::vector<Tri> read_binary_stl(const std::string& name) {
     std::ifstream in(std::string(MESHSTREAM_FIXTURES_DIR) + "/" + name, std::ios::binary);
@@ -106,7 +100,7 @@ TEST(ExternalSorter, ShuffledFixtureComesOutSortedBitExact) {
             sort::SorterOptions o;
             o.axis = axis;
             o.memory_budget_bytes = budget;
-            o.tmpdir = dir.path.string();
+            o.tmpdir = dir.path().string();
             Result r = sort_triangles(shuffled, o, 777);
             ASSERT_EQ(r.tris.size(), bunny.size());
             for (size_t i = 1; i < r.tris.size(); ++i)
@@ -134,7 +128,7 @@ TEST(ExternalSorter, EqualKeysKeepInputOrderAcrossRuns) {
     TempDir dir;
     sort::SorterOptions o;
     o.memory_budget_bytes = 256 << 10;  // runs of 5041 triangles
-    o.tmpdir = dir.path.string();
+    o.tmpdir = dir.path().string();
     Result r = sort_triangles(input, o);
     EXPECT_GT(r.stats.runs, 10u);
     ASSERT_EQ(r.tris.size(), input.size());
@@ -152,7 +146,7 @@ TEST(ExternalSorter, MultiPassMergeUnderTinyBudget) {
     TempDir dir;
     sort::SorterOptions o;
     o.memory_budget_bytes = 768 << 10;
-    o.tmpdir = dir.path.string();
+    o.tmpdir = dir.path().string();
     int passes_seen = 0;
     o.on_merge_progress = [&](int pass, int pass_count, uint64_t) {
         passes_seen = std::max(passes_seen, pass);
@@ -196,7 +190,7 @@ TEST(ExternalSorter, CarriesChannelsWithTheirTriangle) {
     o.channels = ch;
     o.memory_budget_bytes = 64 << 10;  // 1024-triangle runs
     TempDir dir;
-    o.tmpdir = dir.path.string();
+    o.tmpdir = dir.path().string();
     EXPECT_EQ(sort::ExternalSorter::record_bytes_for(ch), 36u + 9 + 36 + 24);  // colour as RGB8
     sort::ExternalSorter sorter(o);
     io::TriangleChunk chunk(300, ch);
@@ -241,7 +235,7 @@ TEST(ExternalSorter, AbandonedSortLeavesNoTemporaryFiles) {
     TempDir dir;
     sort::SorterOptions o;
     o.memory_budget_bytes = 128 << 10;
-    o.tmpdir = dir.path.string();
+    o.tmpdir = dir.path().string();
     {
         // Input fails half-way (the caller's reader throws): the sorter unwinds.
         sort::ExternalSorter sorter(o);

@@ -92,7 +92,7 @@ TEST(CliBadInput, RandomBytesUnderEachExtensionExit1WithNoOutput) {
             CliRun r = run(std::string(cmd) + " " + in + " " + dir / "out.ply");
             EXPECT_EQ(r.code, 1) << cmd << " " << ext << ": " << r.err;
             EXPECT_EQ(r.err.rfind("meshstream: error: " + in, 0), 0u) << r.err;
-            EXPECT_EQ(listing(dir.path), std::vector<std::string>{fs::path(in).filename().string()}) << cmd << " " << ext;
+            EXPECT_EQ(listing(dir.path()), std::vector<std::string>{fs::path(in).filename().string()}) << cmd << " " << ext;
         }
         fs::remove(in);
     }
@@ -113,7 +113,7 @@ TEST(CliBadInput, TruncatedAndLyingFilesExit1WithNoOutput) {
             EXPECT_FALSE(fs::exists(dir / "out.obj"));
         }
     }
-    EXPECT_EQ(listing(dir.path).size(), 2u);
+    EXPECT_EQ(listing(dir.path()).size(), 2u);
 }
 
 // --report re-reads both files, so it cannot work with '-': refused before anything is read
@@ -124,7 +124,7 @@ TEST(CliBadInput, DecimateReportWithAPipeIsRefusedBeforeAnyOutput) {
     CliRun r = run("decimate --report -r 0.5 - " + dir / "out.stl" + " < " + dir / "in.stl");
     EXPECT_EQ(r.code, 2) << r.err;  // a command line that cannot work
     EXPECT_EQ(r.err.rfind("meshstream: error: <stdin>: --report needs to re-read both files", 0), 0u) << r.err;
-    EXPECT_EQ(listing(dir.path), std::vector<std::string>{"in.stl"});
+    EXPECT_EQ(listing(dir.path()), std::vector<std::string>{"in.stl"});
     CliRun w = run("decimate --report -r 0.5 --to stl " + dir / "in.stl" + " -");
     EXPECT_EQ(w.code, 2) << w.err;
     EXPECT_EQ(w.err.rfind("meshstream: error: <stdout>: --report", 0), 0u) << w.err;
@@ -139,7 +139,7 @@ TEST(CliBadInput, AnOutputThatIsAnInputIsRefusedBeforeAnythingIsWritten) {
     const std::string before = slurp(dir / "in.stl");
     fs::create_symlink(dir / "in.stl", dir / "link.stl");
     fs::create_hard_link(dir / "in.stl", dir / "hard.stl");
-    const std::vector<std::string> entries = listing(dir.path);
+    const std::vector<std::string> entries = listing(dir.path());
     for (const std::string cmd : {"convert", "sort --axis x", "decimate -r 0.5", "decimate --report -r 0.5",
                                   "convert --to stream"}) {
         for (const std::string out : {"in.stl", "link.stl", "hard.stl"}) {
@@ -149,7 +149,7 @@ TEST(CliBadInput, AnOutputThatIsAnInputIsRefusedBeforeAnythingIsWritten) {
                       0u) << r.err;
             EXPECT_EQ(r.err.find("through a link") != std::string::npos, out != "in.stl") << r.err;
             EXPECT_EQ(slurp(dir / "in.stl"), before) << cmd;
-            EXPECT_EQ(listing(dir.path), entries) << cmd;
+            EXPECT_EQ(listing(dir.path()), entries) << cmd;
         }
         if (cmd.find("--report") != std::string::npos || cmd.find("--to") != std::string::npos) continue;
         // stdout appended to the input: `meshstream ... - >> in.stl`.
@@ -240,7 +240,7 @@ void expect_refusals(const TempDir& dir, const std::string& command, std::initia
         CliRun r = run(command + " " + dir / "in.stl" + " " + dir / "out.stl " + c.option);
         EXPECT_EQ(r.code, c.code) << c.option << ": " << r.err;
         EXPECT_NE(r.err.find(c.message), std::string::npos) << c.option << ": " << r.err;
-        EXPECT_EQ(listing(dir.path), std::vector<std::string>{"in.stl"}) << c.option;
+        EXPECT_EQ(listing(dir.path()), std::vector<std::string>{"in.stl"}) << c.option;
     }
 }
 
@@ -291,7 +291,7 @@ TEST(CliBadInput, InfoCompareAndGenOptionValuesOutOfRangeAreRefusedClearly) {
     }
     const int gen = std::system((std::string(MESHSTREAM_GEN_BINARY) + " --seed -1 " + dir / "g.stl" + " 2>/dev/null").c_str());
     EXPECT_EQ(WEXITSTATUS(gen), 2);
-    EXPECT_EQ(listing(dir.path), std::vector<std::string>{"in.stl"});
+    EXPECT_EQ(listing(dir.path()), std::vector<std::string>{"in.stl"});
 }
 
 TEST(CliBadInput, MemoryBudgetsThatAreNotSizesOrTooSmallAreRefusedClearly) {
@@ -422,7 +422,7 @@ TEST(CliBadInput, WholeMeshOutputTooBigForTheBudgetIsRefusedUpFront) {
         EXPECT_NE(r.err.find("the 1152 triangles to be written need at least"), std::string::npos) << r.err;
         EXPECT_NE(r.err.find("over the memory budget of 100 KiB; give --memory 1M or more"), std::string::npos) << r.err;
         EXPECT_EQ(r.err.find("decimated "), std::string::npos) << "refused after the work: " << r.err;
-        EXPECT_EQ(listing(dir.path), std::vector<std::string>{"in.stl"}) << out;
+        EXPECT_EQ(listing(dir.path()), std::vector<std::string>{"in.stl"}) << out;
     }
     CliRun c = run("convert --memory 100K " + dir / "in.stl" + " " + dir / "out.drc");
     EXPECT_EQ(c.code, 1) << c.err;
@@ -449,7 +449,7 @@ TEST(CliBadInput, DracoBitCountsWhoseTablesPassTheBudgetAreRefusedUpFront) {
             EXPECT_EQ(r.code, 1) << flags << " " << out << ": " << r.err;
             EXPECT_NE(r.err.find(dir / out + ": " + (message[0] == 'D' ? message : "")), std::string::npos) << r.err;
             EXPECT_NE(r.err.find(message), std::string::npos) << r.err;
-            EXPECT_EQ(listing(dir.path), std::vector<std::string>{"in.stl"}) << out;
+            EXPECT_EQ(listing(dir.path()), std::vector<std::string>{"in.stl"}) << out;
         }
         CliRun ok = run("convert --draco-qp 24 " + dir / "in.stl" + " " + dir / out);
         EXPECT_EQ(ok.code, 0) << ok.err;
@@ -567,7 +567,7 @@ TEST(CliBadInput, CommandLinesThatCannotWorkExit2BeforeAnyWork) {
         CliRun r = run(c.args);
         EXPECT_EQ(r.code, 2) << c.args << ": " << r.err;
         EXPECT_NE(r.err.find(c.message), std::string::npos) << c.args << ": " << r.err;
-        EXPECT_EQ(listing(dir.path), (std::vector<std::string>{"in.obj", "in.stl"})) << c.args;
+        EXPECT_EQ(listing(dir.path()), (std::vector<std::string>{"in.obj", "in.stl"})) << c.args;
     }
 }
 
@@ -611,7 +611,7 @@ TEST(CliBadInput, ABufferTheSystemCannotReserveIsNamedWithItsSize) {
     EXPECT_NE(r.err.find("meshstream: error: --buffer 10000000 reserves 5."), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("which this system refused: give a smaller --buffer (the default 400000 reserves 208.2 MB)"),
               std::string::npos) << r.err;
-    EXPECT_EQ(listing(dir.path), std::vector<std::string>{"in.stl"});
+    EXPECT_EQ(listing(dir.path()), std::vector<std::string>{"in.stl"});
 #endif
 }
 
@@ -738,7 +738,7 @@ TEST(CliBadInput, SigintDuringConvertSortDecimateLeavesNoFiles) {
     for (const char* args : {"convert --from stl - {OUT}/out.ply", "sort --from stl --axis x --memory 1M --tmpdir {OUT} - {OUT}/out.stl",
                              "decimate --from stl --ratio 0.2 - {OUT}/out.stl"}) {
         TempDir dir;
-        const std::string cmdline = expand(args, "{OUT}", dir.path.string());
+        const std::string cmdline = expand(args, "{OUT}", dir.path().string());
         int fds[2];
         ASSERT_EQ(::pipe(fds), 0);
         pid_t pid = ::fork();
@@ -762,15 +762,15 @@ TEST(CliBadInput, SigintDuringConvertSortDecimateLeavesNoFiles) {
             done += size_t(n);
         }
         const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
-        while (listing(dir.path).empty() && std::chrono::steady_clock::now() < deadline)
+        while (listing(dir.path()).empty() && std::chrono::steady_clock::now() < deadline)
             std::this_thread::sleep_for(std::chrono::milliseconds(10));
-        EXPECT_FALSE(listing(dir.path).empty()) << args << ": no temporary file appeared";
+        EXPECT_FALSE(listing(dir.path()).empty()) << args << ": no temporary file appeared";
         ::kill(pid, SIGINT);
         int status = 0;
         ::waitpid(pid, &status, 0);
         ::close(fds[1]);
         EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGINT) << args << ": status " << status;
-        EXPECT_EQ(listing(dir.path), std::vector<std::string>{}) << args;
+        EXPECT_EQ(listing(dir.path()), std::vector<std::string>{}) << args;
     }
 }
 

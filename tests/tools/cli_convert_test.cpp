@@ -48,7 +48,7 @@ TEST(CliConvert, PipeThroughAsciiOnStdoutIntoGzipKeepsCountAndBox) {
     EXPECT_EQ(b["bbox_max"], a["bbox_max"]);
     EXPECT_EQ(b["gzip"], true);
     EXPECT_EQ(b["decoded_bytes"], 84 + 50 * 69451);  // binary STL, by the extension
-    EXPECT_EQ(listing(dir.path), (std::vector<std::string>{"out.stl.gz"}));
+    EXPECT_EQ(listing(dir.path()), (std::vector<std::string>{"out.stl.gz"}));
 }
 
 TEST(CliInfo, ReportsDegenerateTrianglesAndFileSize) {
@@ -70,7 +70,7 @@ TEST(CliConvert, TruncatedBinaryStlNamesFileAndByteAndLeavesNothing) {
     EXPECT_NE(r.err.find("meshstream: error: " + in + ": byte 84: header promises 69451 triangles, file holds 1000"),
               std::string::npos)
         << r.err;
-    EXPECT_EQ(listing(dir.path), (std::vector<std::string>{"cut.stl"}));
+    EXPECT_EQ(listing(dir.path()), (std::vector<std::string>{"cut.stl"}));
 }
 
 TEST(CliConvert, AsciiStlMissingEndloopNamesLine) {
@@ -82,7 +82,7 @@ TEST(CliConvert, AsciiStlMissingEndloopNamesLine) {
     auto r = run("convert " + in + " " + (dir / "out.stl"));
     EXPECT_EQ(r.code, 1);
     EXPECT_NE(r.err.find(in + ":7: expected 'endloop', found 'endfacet'"), std::string::npos) << r.err;
-    EXPECT_EQ(listing(dir.path), (std::vector<std::string>{"bad.stl"}));
+    EXPECT_EQ(listing(dir.path()), (std::vector<std::string>{"bad.stl"}));
 }
 
 TEST(CliConvert, BadCommandLineExits2) {
@@ -108,7 +108,7 @@ TEST(CliConvert, UnknownOutputExtensionIsAnErrorNamingTheFile) {
         auto r = run(std::string(cmd) + " " + kBunny + " " + (dir / "out.xyz"));
         EXPECT_EQ(r.code, 2) << cmd;
         EXPECT_NE(r.err.find("out.xyz: cannot tell the output format"), std::string::npos) << r.err;
-        EXPECT_TRUE(listing(dir.path).empty());
+        EXPECT_TRUE(listing(dir.path()).empty());
     }
     auto r = run("convert " + kBunny + " /dev/null");
     EXPECT_EQ(r.code, 2);
@@ -236,7 +236,7 @@ TEST(CliPipe, SortIntoDecimateStreamsWithoutASpool) {
     EXPECT_NE(r.err.find("triangles in 69451, out 695"), std::string::npos) << r.err;
     nlohmann::json j = info_json(glb);
     EXPECT_EQ(j["triangles"], 695);
-    EXPECT_EQ(listing(dir.path), (std::vector<std::string>{"out.glb"}));
+    EXPECT_EQ(listing(dir.path()), (std::vector<std::string>{"out.glb"}));
     // Into a file, stdout gets the format its --to says; without --to a file is refused.
     cli_test::CliRun to_file = run("convert " + kBunny + " - > " + dir / "x");
     EXPECT_EQ(to_file.code, 2) << to_file.err;

@@ -3,6 +3,8 @@
 // the exit status and stderr.
 #pragma once
 
+#include "test_util.hpp"
+
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -17,27 +19,14 @@
 namespace cli_test {
 
 namespace fs = std::filesystem;
-
-struct TempDir {
-    fs::path path;
-    TempDir() {
-        std::string pattern = (fs::temp_directory_path() / "meshstream_cli-XXXXXX").string();
-        path = ::mkdtemp(pattern.data());
-    }
-    ~TempDir() { fs::remove_all(path); }
-    std::string operator/(const std::string& name) const { return (path / name).string(); }
-};
+using meshstream::test::slurp;
+using meshstream::test::TempDir;
 
 inline std::vector<std::string> listing(const fs::path& dir) {
     std::vector<std::string> names;
     for (const auto& e : fs::directory_iterator(dir)) names.push_back(e.path().filename().string());
     std::sort(names.begin(), names.end());
     return names;
-}
-
-inline std::string slurp(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
 struct CliRun {

@@ -6,6 +6,8 @@
 #include "io/format.hpp"
 #include "compare/metro.hpp"
 
+#include "test_util.hpp"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -20,25 +22,10 @@
 namespace fs = std::filesystem;
 using namespace meshstream;
 
+using meshstream::test::slurp;
+using meshstream::test::TempDir;
+
 namespace {
-
-struct TempDir {
-    fs::path path;
-    TempDir() {
-        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-        path = fs::temp_directory_path() / (std::string("gen_mesh_test_") + info->name() + "_" + std::to_string(::getpid()));
-        fs::remove_all(path);
-        fs::create_directories(path);
-    }
-    ~TempDir() { fs::remove_all(path); }
-};
-
-std::string slurp(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
 
 struct GenRun {
     int exit_code;
@@ -46,9 +33,9 @@ struct GenRun {
 };
 
 GenRun gen(const TempDir& dir, const std::string& args) {
-    std::string cmd = std::string(MESHSTREAM_GEN_BINARY) + " " + args + " 2> " + (dir.path / "stderr.txt").string();
+    std::string cmd = std::string(MESHSTREAM_GEN_BINARY) + " " + args + " 2> " + (dir.path() / "stderr.txt").string();
     int status = std::system(cmd.c_str());
-    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(dir.path / "stderr.txt")};
+    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(dir.path() / "stderr.txt")};
 }
 
 std::vector<std::array<float, 9>> read_all(const fs::path& p) {
@@ -98,7 +85,7 @@ TEST(GenMesh, CountWithinFivePercentAndSortedAlongZ) {
     for (uint64_t target : {5'000ull, 40'000ull}) {
         std::string name = "g";  // appended, not "g" + ...: GCC 12 warns falsely (-Wrestrict) on that
         name += std::to_string(target);
-        fs::path out = dir.path / (name + ".stl");
+        fs::path out = dir.path() / (name + ".stl");
         GenRun r = gen(dir, "--triangles " + std::to_string(target) + " " + out.string());
         ASSERT_EQ(r.exit_code, 0) << r.err;
         auto tris = read_all(out);
@@ -119,9 +106,9 @@ TEST(GenMesh, CountWithinFivePercentAndSortedAlongZ) {
 
 TEST(GenMesh, HolesOpenTheSurface) {
     TempDir dir;
-    GenRun r = gen(dir, "-q --holes -n 40000 " + (dir.path / "h.stl").string());
+    GenRun r = gen(dir, "-q --holes -n 40000 " + (dir.path() / "h.stl").string());
     ASSERT_EQ(r.exit_code, 0) << r.err;
-    auto tris = read_all(dir.path / "h.stl");
+    auto tris = read_all(dir.path() / "h.stl");
     compare::EdgeCounts e = edges_of(tris);
     EXPECT_GT(e.boundary_edges, 50u);
     EXPECT_EQ(e.non_manifold_edges, 0u);
@@ -130,11 +117,11 @@ TEST(GenMesh, HolesOpenTheSurface) {
 
 TEST(GenMesh, ShuffleKeepsTheTrianglesInRandomOrder) {
     TempDir dir;
-    ASSERT_EQ(gen(dir, "-q -n 20000 --seed 3 " + (dir.path / "s.stl").string()).exit_code, 0);
-    ASSERT_EQ(gen(dir, "-q -n 20000 --seed 3 --shuffle --tmpdir " + dir.path.string() + " " + (dir.path / "r.stl").string())
+    ASSERT_EQ(gen(dir, "-q -n 20000 --seed 3 " + (dir.path() / "s.stl").string()).exit_code, 0);
+    ASSERT_EQ(gen(dir, "-q -n 20000 --seed 3 --shuffle --tmpdir " + dir.path().string() + " " + (dir.path() / "r.stl").string())
                   .exit_code,
               0);
-    auto sorted = read_all(dir.path / "s.stl"), shuffled = read_all(dir.path / "r.stl");
+    auto sorted = read_all(dir.path() / "s.stl"), shuffled = read_all(dir.path() / "r.stl");
     EXPECT_GT(disorder(shuffled).second, 0.4);
     EXPECT_LT(disorder(sorted).second, disorder(shuffled).second);
     std::sort(sorted.begin(), sorted.end());
@@ -142,25 +129,25 @@ TEST(GenMesh, ShuffleKeepsTheTrianglesInRandomOrder) {
     EXPECT_EQ(sorted, shuffled);
     // The bucket files are gone.
     size_t left = 0;
-    for (const auto& entry : fs::directory_iterator(dir.path)) left += entry.path().filename().string().starts_with("meshstream-gen");
+    for (const auto& entry : fs::directory_iterator(dir.path())) left += entry.path().filename().string().starts_with("meshstream-gen");
     EXPECT_EQ(left, 0u);
 }
 
 TEST(GenMesh, SameSeedSameBytesAcrossThreadCounts) {
     TempDir dir;
-    ASSERT_EQ(gen(dir, "-q -n 20000 --threads 1 " + (dir.path / "a.stl").string()).exit_code, 0);
-    ASSERT_EQ(gen(dir, "-q -n 20000 --threads 3 " + (dir.path / "b.stl").string()).exit_code, 0);
-    ASSERT_EQ(gen(dir, "-q -n 20000 --seed 2 " + (dir.path / "c.stl").string()).exit_code, 0);
-    EXPECT_EQ(slurp(dir.path / "a.stl"), slurp(dir.path / "b.stl"));
-    EXPECT_NE(slurp(dir.path / "a.stl"), slurp(dir.path / "c.stl"));
+    ASSERT_EQ(gen(dir, "-q -n 20000 --threads 1 " + (dir.path() / "a.stl").string()).exit_code, 0);
+    ASSERT_EQ(gen(dir, "-q -n 20000 --threads 3 " + (dir.path() / "b.stl").string()).exit_code, 0);
+    ASSERT_EQ(gen(dir, "-q -n 20000 --seed 2 " + (dir.path() / "c.stl").string()).exit_code, 0);
+    EXPECT_EQ(slurp(dir.path() / "a.stl"), slurp(dir.path() / "b.stl"));
+    EXPECT_NE(slurp(dir.path() / "a.stl"), slurp(dir.path() / "c.stl"));
 }
 
 TEST(GenMesh, ExitCodes) {
     TempDir dir;
     EXPECT_EQ(gen(dir, "-n 1000").exit_code, 2);                                      // no output
-    EXPECT_EQ(gen(dir, "-n 5 " + (dir.path / "x.stl").string()).exit_code, 2);         // below 100
-    GenRun r = gen(dir, "-n 1000 " + (dir.path / "x.unknown").string());
+    EXPECT_EQ(gen(dir, "-n 5 " + (dir.path() / "x.stl").string()).exit_code, 2);         // below 100
+    GenRun r = gen(dir, "-n 1000 " + (dir.path() / "x.unknown").string());
     EXPECT_EQ(r.exit_code, 1);
     EXPECT_NE(r.err.find("x.unknown"), std::string::npos) << r.err;
-    EXPECT_FALSE(fs::exists(dir.path / "x.unknown"));
+    EXPECT_FALSE(fs::exists(dir.path() / "x.unknown"));
 }

@@ -162,7 +162,7 @@ TEST(SortCommand, AutoAxisIsTheLongestExtent) {
     EXPECT_EQ(m.sorted_axis, 1);
     expect_sorted_permutation(m.tris, tris, 1);
     // Default temporary directory: next to the output, and emptied.
-    EXPECT_EQ(file_count(dir.path.string()), 2u);
+    EXPECT_EQ(file_count(dir.path().string()), 2u);
 }
 
 TEST(SortCommand, StdinToStdout) {
@@ -202,7 +202,7 @@ TEST(SortCommand, MultiPassMergeUnderOneMebibyte) {
     ASSERT_EQ(r.code, 0) << r.err;
     EXPECT_NE(r.err.find("2 merge passes"), std::string::npos) << r.err;
     expect_sorted_permutation(read_mesh(dir / "out.stl").tris, tris, 2);
-    EXPECT_EQ(file_count(dir.path.string()), 2u);  // in.stl and out.stl only
+    EXPECT_EQ(file_count(dir.path().string()), 2u);  // in.stl and out.stl only
     // Within the budget nothing is written to disk: said so (it used to say "0 runs of up to N").
     r = run("sort --stats --axis z " + dir / "in.stl" + " " + dir / "out.stl", dir);
     ASSERT_EQ(r.code, 0) << r.err;
@@ -247,7 +247,7 @@ TEST(SortCommand, TruncatedInputLeavesNoOutputAndNoTemporaryFiles) {
     EXPECT_NE(r.err.find("in.stl"), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(dir / "out.stl"));
     EXPECT_EQ(file_count(dir / "tmp"), 0u);
-    EXPECT_EQ(file_count(dir.path.string()), 2u);  // in.stl and tmp/
+    EXPECT_EQ(file_count(dir.path().string()), 2u);  // in.stl and tmp/
 }
 
 TEST(SortCommand, MissingOutputDirectoryFailsBeforeSorting) {
