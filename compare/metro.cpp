@@ -6,6 +6,7 @@
 
 #include "io/byte_stream.hpp"
 #include "io/error.hpp"
+#include "io/random.hpp"
 
 #include <algorithm>
 #include <array>
@@ -19,18 +20,9 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-// splitmix64: a counter-based generator, so each triangle's random numbers depend only on the
-// seed and the triangle's index, not on chunk sizes.
-struct Rng {
-    uint64_t state;
-    uint64_t next() {
-        uint64_t z = (state += 0x9E3779B97F4A7C15ull);
-        z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-        z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-        return z ^ (z >> 31);
-    }
-    double uniform() { return double(next() >> 11) * 0x1.0p-53; }  // [0, 1)
-};
+// splitmix64: each triangle's random numbers depend only on the seed and the triangle's
+// index, not on chunk sizes.
+using Rng = io::SplitMix64;
 
 Rng triangle_rng(uint64_t seed, uint64_t salt, uint64_t index) {
     Rng r{seed * 0xD1B54A32D192ED03ull ^ salt};

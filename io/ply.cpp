@@ -9,6 +9,7 @@
 // (s, t), PCL (normal_x), CGAL and Open3D (nx, red).
 #include "io/ply.hpp"
 
+#include "io/endian.hpp"
 #include "io/error.hpp"
 #include "io/text_number.hpp"
 #include "io/vertex_table.hpp"
@@ -435,12 +436,7 @@ private:
     U load(const std::byte* p) const {
         U v;
         std::memcpy(&v, p, sizeof v);
-        if (swap_) {
-            if constexpr (sizeof(U) == 2) v = std::bit_cast<U>(__builtin_bswap16(std::bit_cast<uint16_t>(v)));
-            if constexpr (sizeof(U) == 4) v = std::bit_cast<U>(__builtin_bswap32(std::bit_cast<uint32_t>(v)));
-            if constexpr (sizeof(U) == 8) v = std::bit_cast<U>(__builtin_bswap64(std::bit_cast<uint64_t>(v)));
-        }
-        return v;
+        return swap_ ? byteswap(v) : v;
     }
 
     double decode(const std::byte* p, ScalarType t) const {
@@ -941,13 +937,6 @@ private:
 
 // ---------------- writer ----------------
 
-void store_le(std::string& out, const void* value, size_t n) {
-    char buf[8];
-    std::memcpy(buf, value, n);
-    if constexpr (std::endian::native == std::endian::big) std::reverse(buf, buf + n);
-    out.append(buf, n);
-}
-
 // A value as an integer type T stores it: rounded to nearest, clamped to T's range; NaN is 0.
 template <class T>
 T to_integer(double v) {
@@ -960,8 +949,11 @@ template <class T>
 void put_value(std::string& out, T v, bool ascii) {
     if (ascii)
         append_number(out, v);
-    else
-        store_le(out, &v, sizeof v);
+    else {
+        char bytes[sizeof v];
+        store_le(bytes, v);
+        out.append(bytes, sizeof v);
+    }
 }
 
 // Appends `v` as PLY type `type`: a decimal number (ascii) or little-endian bytes.
@@ -1037,7 +1029,7 @@ public:
                 const float* p = &xyz[3 * i];
                 if (rec == 0 && !ascii_) {  // positions only: the common case, kept short
                     char buf[12];
-                    for (int a = 0; a < 3; ++a) store_le32(buf + 4 * a, std::bit_cast<uint32_t>(p[a]));
+                    for (int a = 0; a < 3; ++a) store_le(buf + 4 * a, p[a]);
                     out.append(buf, 12);
                     continue;
                 }
@@ -1086,7 +1078,7 @@ public:
                 } else {
                     char buf[13];
                     buf[0] = 3;
-                    for (int k = 0; k < 3; ++k) store_le32(buf + 1 + 4 * k, idx[t + k]);
+                    for (int k = 0; k < 3; ++k) store_le(buf + 1 + 4 * k, idx[t + k]);
                     out.append(buf, 13);
                 }
                 for (size_t c = 0; c < nf; ++c) {
@@ -1152,9 +1144,6 @@ private:
         return h;
     }
 
-    static void store_le32(char* p, uint32_t v) {
-        for (int i = 0; i < 4; ++i) p[i] = static_cast<char>((v >> (8 * i)) & 0xff);
-    }
     // A float field: shortest round-trip text after a space (none before the first), or 4 bytes.
     void put_field(std::string& out, float v, bool first = false) const {
         if (ascii_ && !first) out += ' ';

@@ -8,6 +8,7 @@
 // binary -> ASCII -> binary is bit-exact.
 #include "io/stl.hpp"
 
+#include "io/endian.hpp"
 #include "io/error.hpp"
 #include "io/triangulate.hpp"
 
@@ -31,34 +32,6 @@ constexpr size_t kFacetXyzOffset = 12;
 constexpr uint64_t kMaxBinaryTriangles = 0xFFFFFFFFu;
 constexpr std::string_view kSortMarker = "meshstream sorted-axis=";
 constexpr std::string_view kWriterName = "meshstream";
-
-// ---- little-endian helpers: binary STL is little-endian whatever the host ----
-
-uint32_t load_le_u32(const std::byte* p) {
-    return static_cast<uint32_t>(p[0]) | static_cast<uint32_t>(p[1]) << 8 | static_cast<uint32_t>(p[2]) << 16 |
-           static_cast<uint32_t>(p[3]) << 24;
-}
-
-void store_le_u32(std::byte* p, uint32_t v) {
-    for (int i = 0; i < 4; ++i) p[i] = static_cast<std::byte>(v >> (8 * i));
-}
-
-// Copies n little-endian floats from p to dst.
-void load_le_floats(const std::byte* p, float* dst, size_t n) {
-    if constexpr (std::endian::native == std::endian::little) {
-        std::memcpy(dst, p, n * sizeof(float));
-    } else {
-        for (size_t i = 0; i < n; ++i) dst[i] = std::bit_cast<float>(load_le_u32(p + 4 * i));
-    }
-}
-
-void store_le_floats(const float* src, std::byte* p, size_t n) {
-    if constexpr (std::endian::native == std::endian::little) {
-        std::memcpy(p, src, n * sizeof(float));
-    } else {
-        for (size_t i = 0; i < n; ++i) store_le_u32(p + 4 * i, std::bit_cast<uint32_t>(src[i]));
-    }
-}
 
 // ---- text classification ----
 
@@ -156,7 +129,7 @@ public:
         if (preamble.size() < kPreambleBytes)
             throw Error(source_.name(), source_.offset() + preamble.size(), 0,
                         "file ends inside the 84-byte binary STL header (neither binary nor ASCII STL)");
-        count_ = load_le_u32(preamble.data() + kHeaderBytes);
+        count_ = load_le<uint32_t>(preamble.data() + kHeaderBytes);
         std::string text = header_text(preamble.first(kHeaderBytes));
         header_.triangle_count = count_;
         header_.variant = "binary";
@@ -196,10 +169,10 @@ public:
             const std::byte* facet = window.data() + kFacetXyzOffset;  // the normal is ignored
             if (plain) {
                 float* dst = chunk.xyz_storage() + 9 * chunk.size();
-                for (size_t i = 0; i < facets; ++i, facet += kFacetBytes, dst += 9) load_le_floats(facet, dst, 9);
+                for (size_t i = 0; i < facets; ++i, facet += kFacetBytes, dst += 9) load_le_array(facet, dst, 9);
                 chunk.resize(chunk.size() + facets);
             } else {
-                for (size_t i = 0; i < facets; ++i, facet += kFacetBytes) load_le_floats(facet, chunk.push_slot(), 9);
+                for (size_t i = 0; i < facets; ++i, facet += kFacetBytes) load_le_array(facet, chunk.push_slot(), 9);
             }
             source_.consume(facets * kFacetBytes);
             read_ += facets;
@@ -478,7 +451,7 @@ public:
         if (options.sorted_axis) text = sort_marker(*options.sorted_axis);
         std::memset(preamble_, ' ', kHeaderBytes);
         std::memcpy(preamble_, text.data(), std::min(text.size(), kHeaderBytes));
-        store_le_u32(preamble_ + kHeaderBytes, static_cast<uint32_t>(expected_.value_or(0)));
+        store_le(preamble_ + kHeaderBytes, static_cast<uint32_t>(expected_.value_or(0)));
         // The count goes first when known or patchable; otherwise the body is spooled until
         // finish() knows it (stdout, gzip).
         if (expected_ || sink_.patchable()) {
@@ -503,8 +476,8 @@ public:
             for (size_t i = 0; i < facets; ++i, xyz += 9, out += kFacetBytes) {
                 float normal[3];
                 facet_normal(xyz, normal);
-                store_le_floats(normal, out, 3);
-                store_le_floats(xyz, out + kFacetXyzOffset, 9);
+                store_le_array(out, normal, 3);
+                store_le_array(out + kFacetXyzOffset, xyz, 9);
                 out[48] = out[49] = std::byte{0};  // attribute byte count
             }
             if (spool_) {
@@ -524,7 +497,7 @@ public:
                                               std::to_string(written_) + " were written");
             return;
         }
-        store_le_u32(preamble_ + kHeaderBytes, static_cast<uint32_t>(written_));
+        store_le(preamble_ + kHeaderBytes, static_cast<uint32_t>(written_));
         if (!spool_) {
             sink_.patch(header_offset_ + kHeaderBytes, preamble_ + kHeaderBytes, 4);
             return;
@@ -647,7 +620,7 @@ bool probe_stl_binary(std::span<const std::byte> head, std::optional<uint64_t> s
     if (head.size() < kPreambleBytes) return false;
     if (size) {
         // Binary STL headers may begin with "solid": trust 84 + 50·n.
-        return *size == kPreambleBytes + kFacetBytes * uint64_t{load_le_u32(head.data() + kHeaderBytes)};
+        return *size == kPreambleBytes + kFacetBytes * uint64_t{load_le<uint32_t>(head.data() + kHeaderBytes)};
     }
     return !looks_like_ascii_stl(head) && has_binary_bytes(head);
 }

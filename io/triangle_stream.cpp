@@ -4,6 +4,7 @@
 // doubles, uint64 ids, a uint32 material), so a chunk goes through a pipe bit for bit.
 #include "io/triangle_stream.hpp"
 
+#include "io/endian.hpp"
 #include "io/error.hpp"
 
 #include <algorithm>
@@ -29,50 +30,6 @@ constexpr uint8_t kNoAxis = 0xFF;
 constexpr uint32_t kMaxScalarChannels = 64;
 // Corner flags of the header body.
 constexpr uint8_t kNormalFlag = 1, kColorFlag = 2, kVertexIdFlag = 4;
-
-// ---- little-endian helpers: the stream is little-endian whatever the host ----
-
-template <class T>
-void put_le(std::vector<std::byte>& out, T value) {
-    using U = std::conditional_t<
-        sizeof(T) == 8, uint64_t,
-        std::conditional_t<sizeof(T) == 4, uint32_t, std::conditional_t<sizeof(T) == 2, uint16_t, uint8_t>>>;
-    const U bits = std::bit_cast<U>(value);
-    for (size_t i = 0; i < sizeof(T); ++i) out.push_back(static_cast<std::byte>(bits >> (8 * i)));
-}
-
-template <class T>
-T get_le(const std::byte* p) {
-    using U = std::conditional_t<
-        sizeof(T) == 8, uint64_t,
-        std::conditional_t<sizeof(T) == 4, uint32_t, std::conditional_t<sizeof(T) == 2, uint16_t, uint8_t>>>;
-    U bits = 0;
-    for (size_t i = 0; i < sizeof(T); ++i) bits |= static_cast<U>(static_cast<U>(p[i]) << (8 * i));
-    return std::bit_cast<T>(bits);
-}
-
-// Appends n values (floats, doubles, uint64, uint32) in little-endian order.
-template <class T>
-std::byte* store_array(std::byte* dst, const T* src, size_t n) {
-    if constexpr (std::endian::native == std::endian::little) {
-        std::memcpy(dst, src, n * sizeof(T));
-    } else {
-        std::vector<std::byte> tmp;
-        for (size_t i = 0; i < n; ++i) put_le(tmp, src[i]);
-        std::memcpy(dst, tmp.data(), tmp.size());
-    }
-    return dst + n * sizeof(T);
-}
-
-template <class T>
-const std::byte* load_array(const std::byte* src, T* dst, size_t n) {
-    if constexpr (std::endian::native == std::endian::little) {
-        std::memcpy(dst, src, n * sizeof(T));
-    } else {
-        for (size_t i = 0; i < n; ++i) dst[i] = get_le<T>(src + i * sizeof(T));
-    }
-    return src + n * sizeof(T);
-}
 
 // Scalar type codes on the wire (fixed here, independent of the enum's order).
 uint8_t type_code(ScalarType type) {
@@ -108,15 +65,15 @@ size_t record_bytes(const Channels& c) {
 // ---- header body ----
 
 void put_string(std::vector<std::byte>& out, const std::string& s) {
-    put_le(out, static_cast<uint32_t>(s.size()));
+    append_le(out, static_cast<uint32_t>(s.size()));
     const auto* p = reinterpret_cast<const std::byte*>(s.data());
     out.insert(out.end(), p, p + s.size());
 }
 
 void put_scalars(std::vector<std::byte>& out, const std::vector<ScalarChannel>& scalars) {
-    put_le(out, static_cast<uint32_t>(scalars.size()));
+    append_le(out, static_cast<uint32_t>(scalars.size()));
     for (const ScalarChannel& s : scalars) {
-        put_le(out, type_code(s.type));
+        append_le(out, type_code(s.type));
         put_string(out, s.name);
     }
 }
@@ -124,28 +81,28 @@ void put_scalars(std::vector<std::byte>& out, const std::vector<ScalarChannel>& 
 std::vector<std::byte> header_body(const WriteOptions& o) {
     const Channels& c = o.channels;
     std::vector<std::byte> body;
-    put_le(body, o.triangle_count.value_or(kUnknownCount));
-    put_le(body, static_cast<uint8_t>(o.sorted_axis ? *o.sorted_axis : kNoAxis));
-    put_le(body, static_cast<uint8_t>((c.normal ? kNormalFlag : 0) | (c.color ? kColorFlag : 0) |
+    append_le(body, o.triangle_count.value_or(kUnknownCount));
+    append_le(body, static_cast<uint8_t>(o.sorted_axis ? *o.sorted_axis : kNoAxis));
+    append_le(body, static_cast<uint8_t>((c.normal ? kNormalFlag : 0) | (c.color ? kColorFlag : 0) |
                                       (c.vertex_id ? kVertexIdFlag : 0)));
-    put_le(body, static_cast<uint8_t>(c.color ? type_code(c.color->type) : 0));
-    put_le(body, static_cast<uint8_t>(c.color && c.color->alpha ? 1 : 0));
-    put_le(body, static_cast<uint8_t>(c.uv_sets));
-    put_le(body, static_cast<uint8_t>(c.material ? 1 : 0));
-    put_le(body, uint16_t{0});
+    append_le(body, static_cast<uint8_t>(c.color ? type_code(c.color->type) : 0));
+    append_le(body, static_cast<uint8_t>(c.color && c.color->alpha ? 1 : 0));
+    append_le(body, static_cast<uint8_t>(c.uv_sets));
+    append_le(body, static_cast<uint8_t>(c.material ? 1 : 0));
+    append_le(body, uint16_t{0});
     put_scalars(body, c.vertex_scalars);
     put_scalars(body, c.face_scalars);
     const std::vector<Material> none;
     const std::vector<Material>& materials = c.material ? o.materials : none;
-    put_le(body, static_cast<uint32_t>(materials.size()));
+    append_le(body, static_cast<uint32_t>(materials.size()));
     for (const Material& m : materials) {
         put_string(body, m.name);
-        for (float v : m.base_color) put_le(body, v);
-        put_le(body, static_cast<uint8_t>(m.texture ? 1 : 0));
+        for (float v : m.base_color) append_le(body, v);
+        append_le(body, static_cast<uint8_t>(m.texture ? 1 : 0));
         if (m.texture) {
             put_string(body, m.texture->uri);
             put_string(body, m.texture->mime_type);
-            put_le(body, static_cast<uint64_t>(m.texture->bytes.size()));
+            append_le(body, static_cast<uint64_t>(m.texture->bytes.size()));
             body.insert(body.end(), m.texture->bytes.begin(), m.texture->bytes.end());
         }
     }
@@ -161,7 +118,7 @@ public:
     T get(const char* what) {
         field_ = pos_;
         need(sizeof(T), what);
-        T v = get_le<T>(body_.data() + pos_);
+        T v = load_le<T>(body_.data() + pos_);
         pos_ += sizeof(T);
         return v;
     }
@@ -227,11 +184,11 @@ public:
             throw Error(source_.name(), source_.offset(), 0, "stream ends inside its 20-byte preamble");
         if (std::memcmp(preamble, kMagic, sizeof kMagic) != 0)
             throw Error(source_.name(), 0, 0, "not a meshstream triangle stream (bad magic bytes)");
-        const uint32_t version = get_le<uint32_t>(preamble + 8);
+        const uint32_t version = load_le<uint32_t>(preamble + 8);
         if (version != kVersion)
             throw Error(source_.name(), 8, 0,
                         "triangle stream version " + std::to_string(version) + " (this meshstream reads version 1)");
-        const uint64_t body_bytes = get_le<uint64_t>(preamble + 12);
+        const uint64_t body_bytes = load_le<uint64_t>(preamble + 12);
         // The header holds the material table, textures and all: within the memory budget.
         if (body_bytes > options.memory_budget_bytes)
             throw Error(source_.name(), 12, 0,
@@ -325,7 +282,7 @@ private:
         std::byte n_bytes[4];
         const size_t got = source_.read(n_bytes, 4);
         if (got != 4) truncated(got == 0 ? "before its end marker" : "inside a chunk's triangle count");
-        const uint32_t n = get_le<uint32_t>(n_bytes);
+        const uint32_t n = load_le<uint32_t>(n_bytes);
         if (n > kMaxChunkTriangles)
             throw Error(source_.name(), source_.offset() - 4, 0,
                         "chunk of " + std::to_string(n) + " triangles (at most 16777216: a corrupt stream?)");
@@ -335,7 +292,7 @@ private:
         }
         std::byte end[12];
         if (source_.read(end, sizeof end) != sizeof end) truncated("inside its end marker");
-        const uint64_t count = get_le<uint64_t>(end);
+        const uint64_t count = load_le<uint64_t>(end);
         if (std::memcmp(end + 8, kEndTag, sizeof kEndTag) != 0)
             throw Error(source_.name(), source_.offset() - 4, 0, "bad end marker (expected 'MSHE')");
         if (count != read_)
@@ -361,37 +318,37 @@ private:
         const Channels& want = chunk.channels();
         float* xyz = chunk.push_slot();
         const size_t i = chunk.size() - 1;
-        p = load_array(p, xyz, 9);
+        p = load_le_array(p, xyz, 9);
         if (c.normal) {
-            if (want.normal) load_array(p, chunk.normal_at(i), 9);
+            if (want.normal) load_le_array(p, chunk.normal_at(i), 9);
             p += 9 * sizeof(float);
         }
         if (c.color) {
-            if (want.color) load_array(p, chunk.color_at(i), 12);
+            if (want.color) load_le_array(p, chunk.color_at(i), 12);
             p += 12 * sizeof(float);
         }
         for (int s = 0; s < c.uv_sets; ++s) {
-            if (s < want.uv_sets) load_array(p, chunk.uv_at(i, s), 6);
+            if (s < want.uv_sets) load_le_array(p, chunk.uv_at(i, s), 6);
             p += 6 * sizeof(float);
         }
         for (const ScalarChannel& sc : c.vertex_scalars) {
             const auto it = std::find(want.vertex_scalars.begin(), want.vertex_scalars.end(), sc);
             if (it != want.vertex_scalars.end())
-                load_array(p, chunk.vertex_scalar_at(i, size_t(it - want.vertex_scalars.begin())), 3);
+                load_le_array(p, chunk.vertex_scalar_at(i, size_t(it - want.vertex_scalars.begin())), 3);
             p += 3 * sizeof(double);
         }
         if (c.vertex_id) {
-            if (want.vertex_id) load_array(p, chunk.id_at(i), 3);
+            if (want.vertex_id) load_le_array(p, chunk.id_at(i), 3);
             p += 3 * sizeof(uint64_t);
         }
         if (c.material) {
-            if (want.material) load_array(p, chunk.material_at(i), 1);
+            if (want.material) load_le_array(p, chunk.material_at(i), 1);
             p += sizeof(uint32_t);
         }
         for (const ScalarChannel& sc : c.face_scalars) {
             const auto it = std::find(want.face_scalars.begin(), want.face_scalars.end(), sc);
             if (it != want.face_scalars.end())
-                load_array(p, chunk.face_scalar_at(i, size_t(it - want.face_scalars.begin())), 1);
+                load_le_array(p, chunk.face_scalar_at(i, size_t(it - want.face_scalars.begin())), 1);
             p += sizeof(double);
         }
         ++read_;
@@ -416,8 +373,8 @@ public:
           record_bytes_(record_bytes(options.channels)) {
         std::vector<std::byte> out(kMagic, kMagic + sizeof kMagic);
         const std::vector<std::byte> body = header_body(options);
-        put_le(out, kVersion);
-        put_le(out, static_cast<uint64_t>(body.size()));
+        append_le(out, kVersion);
+        append_le(out, static_cast<uint64_t>(body.size()));
         sink_.write(out.data(), out.size());
         sink_.write(body.data(), body.size());
     }
@@ -431,7 +388,7 @@ private:
             buffer_.resize(4 + n * record_bytes_);
             std::byte* p = buffer_.data();
             const uint32_t n32 = static_cast<uint32_t>(n);
-            p = store_array(p, &n32, 1);
+            p = store_le_array(p, &n32, 1);
             for (size_t i = first; i < first + n; ++i) p = encode(chunk, i, p);
             sink_.write(buffer_.data(), buffer_.size());
         }
@@ -443,8 +400,8 @@ private:
             throw Error(sink_.name(),
                         "promised " + std::to_string(*expected_) + " triangles, wrote " + std::to_string(written_));
         std::vector<std::byte> end;
-        put_le(end, uint32_t{0});
-        put_le(end, written_);
+        append_le(end, uint32_t{0});
+        append_le(end, written_);
         end.insert(end.end(), kEndTag, kEndTag + sizeof kEndTag);
         sink_.write(end.data(), end.size());
     }
@@ -455,18 +412,18 @@ private:
         const Channels& c = channels_;
         const Channels& has = chunk.channels();
         auto floats = [&](const float* src, size_t n) {
-            if (src) return store_array(p, src, n);
+            if (src) return store_le_array(p, src, n);
             std::memset(p, 0, n * sizeof(float));
             return p + n * sizeof(float);
         };
-        p = store_array(p, &chunk.xyz()[9 * i], 9);
+        p = store_le_array(p, &chunk.xyz()[9 * i], 9);
         if (c.normal) p = floats(has.normal ? chunk.normal_at(i) : nullptr, 9);
         if (c.color) p = floats(has.color ? chunk.color_at(i) : nullptr, 12);
         for (int s = 0; s < c.uv_sets; ++s) p = floats(s < has.uv_sets ? chunk.uv_at(i, s) : nullptr, 6);
         for (const ScalarChannel& sc : c.vertex_scalars) {
             const auto it = std::find(has.vertex_scalars.begin(), has.vertex_scalars.end(), sc);
             const double zeros[3] = {0, 0, 0};
-            p = store_array(p,
+            p = store_le_array(p,
                             it != has.vertex_scalars.end()
                                 ? chunk.vertex_scalar_at(i, size_t(it - has.vertex_scalars.begin()))
                                 : zeros,
@@ -474,16 +431,16 @@ private:
         }
         if (c.vertex_id) {
             const uint64_t zeros[3] = {0, 0, 0};
-            p = store_array(p, has.vertex_id ? chunk.id_at(i) : zeros, 3);
+            p = store_le_array(p, has.vertex_id ? chunk.id_at(i) : zeros, 3);
         }
         if (c.material) {
             const uint32_t zero = 0;
-            p = store_array(p, has.material ? chunk.material_at(i) : &zero, 1);
+            p = store_le_array(p, has.material ? chunk.material_at(i) : &zero, 1);
         }
         for (const ScalarChannel& sc : c.face_scalars) {
             const auto it = std::find(has.face_scalars.begin(), has.face_scalars.end(), sc);
             const double zero = 0;
-            p = store_array(
+            p = store_le_array(
                 p,
                 it != has.face_scalars.end() ? chunk.face_scalar_at(i, size_t(it - has.face_scalars.begin())) : &zero,
                 1);

@@ -5,6 +5,7 @@
 #include "io/byte_stream.hpp"
 #include "io/error.hpp"
 #include "io/hash.hpp"
+#include "io/position_key.hpp"
 #include "io/record_sort.hpp"
 
 #include <algorithm>
@@ -26,11 +27,6 @@ uint64_t hash_bytes(const std::byte* p, size_t n) {
         h = mix64(h ^ w);
     }
     return h;
-}
-
-uint32_t position_bits(float f) {
-    uint32_t b = std::bit_cast<uint32_t>(f);
-    return b == 0x80000000u ? 0u : b;  // -0.0 welds with +0.0
 }
 
 // Key = bit pattern of the position, then the corner's attribute record (N bytes, zero padded

@@ -21,6 +21,7 @@
 #include "io/byte_stream.hpp"
 #include "io/error.hpp"
 #include "io/format.hpp"
+#include "io/random.hpp"
 #include "tools/cli_checks.hpp"
 
 #include <CLI/CLI.hpp>
@@ -41,17 +42,7 @@
 namespace meshstream::tools {
 namespace {
 
-// splitmix64, seeded and passed in.
-struct Rng {
-    uint64_t state;
-    uint64_t next() {
-        uint64_t z = (state += 0x9E3779B97F4A7C15ull);
-        z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-        z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-        return z ^ (z >> 31);
-    }
-    double uniform() { return double(next() >> 11) * 0x1.0p-53; }
-};
+using Rng = io::SplitMix64;  // seeded and passed in
 
 // ---- The case table -------------------------------------------------------------------------
 
