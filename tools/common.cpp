@@ -186,7 +186,54 @@ io::ReadOptions ReadFlags::options() const {
                                                    "): give a smaller budget");
     o.tmpdir = tmpdir;
     o.strict = strict;
+    o.channels = kept_channel_kinds(drop);
     return o;
+}
+
+namespace {
+
+// --drop's list into `kinds`; the error text for an unknown name, else empty.
+std::string parse_drop_list(const std::string& drop_list, io::ChannelKinds& kinds) {
+    const std::pair<std::string_view, bool io::ChannelKinds::*> names[] = {
+        {"normals", &io::ChannelKinds::normals}, {"colors", &io::ChannelKinds::colors},
+        {"uvs", &io::ChannelKinds::uvs},         {"extra", &io::ChannelKinds::extras},
+        {"materials", &io::ChannelKinds::materials}};
+    size_t at = 0;
+    while (at < drop_list.size()) {
+        size_t end = drop_list.find(',', at);
+        if (end == std::string::npos) end = drop_list.size();
+        const std::string_view name = std::string_view(drop_list).substr(at, end - at);
+        at = end + 1;
+        if (name.empty()) continue;  // "normals," or "a,,b"
+        bool known = false;
+        for (const auto& [known_name, member] : names)
+            if (name == known_name) kinds.*member = false, known = true;
+        if (!known)
+            return "unknown channel '" + std::string(name) + "' (one of: normals, colors, uvs, extra, materials)";
+    }
+    return {};
+}
+
+}  // namespace
+
+io::ChannelKinds kept_channel_kinds(const std::string& drop_list) {
+    io::ChannelKinds kinds;
+    if (std::string error = parse_drop_list(drop_list, kinds); !error.empty())
+        throw CLI::ValidationError("--drop", error);
+    return kinds;
+}
+
+void add_drop_flag(CLI::App* cmd, ReadFlags& flags) {
+    cmd->add_option("--drop", flags.drop,
+                    "Channels not to read or write, comma separated: normals, colors, uvs, extra (named vertex and "
+                    "face properties), materials; dropped without a warning")
+        ->type_name("LIST")
+        ->check(CLI::Validator(
+            [](const std::string& text) -> std::string {
+                io::ChannelKinds kinds;
+                return parse_drop_list(text, kinds);
+            },
+            ""));
 }
 
 void add_read_flags(CLI::App* cmd, ReadFlags& flags) {

@@ -33,9 +33,17 @@ struct ReadFlags {
     std::string memory = "256M";
     std::string tmpdir;
     bool strict = false;
+    std::string drop;  // --drop (convert, sort): channel kinds not read
     io::ReadOptions options() const;
 };
 void add_read_flags(CLI::App* cmd, ReadFlags& flags);
+// --drop's list, "normals,colors,uvs,extra,materials" (any of them, comma separated): the
+// channel kinds to read, all but those named. Throws CLI::ValidationError naming an unknown
+// name.
+io::ChannelKinds kept_channel_kinds(const std::string& drop_list);
+// --drop for convert and sort: the kinds named are not read, so not written, and their loss
+// is not warned about.
+void add_drop_flag(CLI::App* cmd, ReadFlags& flags);
 // For commands that measure the input as it is (info, compare): --strict's help says that it
 // makes bad triangles errors, without the skipping that convert, sort and decimate do.
 void strict_reports_bad_triangles(CLI::App* cmd);

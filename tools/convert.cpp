@@ -30,9 +30,11 @@ void run_convert(const ConvertOptions& opt) {
     if (!opt.clean) wo.triangle_count = header.triangle_count;
     wo.expected_triangle_count = header.triangle_count;
     wo.sorted_axis = header.sorted_axis;
-    wo.channels = io::writable_channels(out_format, header.channels, wo);
+    // --drop's channels are not read: their loss is asked for, so it goes unsaid.
+    const io::Channels wanted = opt.read.options().channels.of(header.channels);
+    wo.channels = io::writable_channels(out_format, wanted, wo);
     if (wo.channels.material) wo.materials = header.materials;
-    const std::string dropped = io::describe_missing(header.channels, wo.channels);
+    const std::string dropped = io::describe_missing(wanted, wo.channels);
     refuse_output_over_inputs(opt.output, out_format, wo, {input_files(opt.input, header)});
     io::Output out = io::open_output(opt.output, out_format.name, wo, opt.write.gzip_level);
 
@@ -71,6 +73,7 @@ void add_convert(CLI::App& app) {
     cmd->add_option("output", opt->output, "Output mesh ('-' = stdout: a pipe gets meshstream's triangle stream, anything else needs --to)")->required();
     add_clean_flag(cmd, opt->clean);
     add_read_flags(cmd, opt->read);
+    add_drop_flag(cmd, opt->read);
     add_write_flags(cmd, opt->write);
     cmd->callback([opt] { run_convert(*opt); });
 }

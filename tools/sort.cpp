@@ -199,8 +199,10 @@ void run_sort(const SortOptions& opt) {
     so.axis = axis;
     so.tmpdir = tmpdir;
     // Only the channels the output keeps are carried through the runs.
-    so.channels = io::writable_channels(out_format, header.channels, opt.write.options(opt.read));
-    const std::string dropped = io::describe_missing(header.channels, so.channels);
+    // --drop's channels are not read: their loss is asked for, so it goes unsaid.
+    const io::Channels wanted = ro.channels.of(header.channels);
+    so.channels = io::writable_channels(out_format, wanted, opt.write.options(opt.read));
+    const std::string dropped = io::describe_missing(wanted, so.channels);
     const size_t record_bytes = sort::ExternalSorter::record_bytes_for(so.channels);
     // The pipe's chunks are part of the sorter's share: each at most 1/64 of the budget.
     const size_t chunk_capacity =
@@ -329,6 +331,7 @@ void add_sort(CLI::App& app) {
     cmd->add_flag("--stats", opt->stats, "Print runs, merge passes, temporary disk, time and peak RSS on stderr");
     add_clean_flag(cmd, opt->clean);
     add_read_flags(cmd, opt->read);
+    add_drop_flag(cmd, opt->read);
     cmd->get_option("--tmpdir")->description("Directory for sort runs and spills (default: the output's directory; $TMPDIR "
                                              "or /tmp when writing to stdout, a pipe or a device)");
     add_write_flags(cmd, opt->write);

@@ -8,6 +8,8 @@
 #include <nlohmann/json.hpp>
 
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <string>
 
 namespace {
@@ -257,4 +259,47 @@ TEST(CliPipe, TheStreamCarriesEveryChannel) {
     ASSERT_EQ(direct.code, 0) << direct.err;
     EXPECT_EQ(slurp(dir / "c.ply"), slurp(dir / "d.ply"));
     EXPECT_NE(slurp(dir / "c.ply").find("property uchar red"), std::string::npos);
+}
+
+// --drop: the channels named are not read and their loss goes unsaid; the others are kept, and
+// what the output cannot hold is still named.
+TEST(CliConvert, DropIsSilentAndKeepsTheRest) {
+    TempDir dir;
+    const std::string in = dir / "nc.ply";
+    {
+        std::ofstream f(in);
+        f << "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+             "property float nx\nproperty float ny\nproperty float nz\n"
+             "property uchar red\nproperty uchar green\nproperty uchar blue\n"
+             "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+             "0 0 0 0 0 1 255 0 0\n1 0 0 0 0 1 0 255 0\n0 1 0 0 0 1 0 0 255\n3 0 1 2\n";
+    }
+    for (const char* cmd : {"convert", "sort"}) {
+        SCOPED_TRACE(cmd);
+        const std::string out = dir / (std::string(cmd) + ".ply");
+        const cli_test::CliRun kept = run(std::string(cmd) + " --drop colors " + in + " " + out);
+        EXPECT_EQ(kept.code, 0) << kept.err;
+        EXPECT_EQ(kept.err, "");
+        const std::string text = slurp(out);
+        EXPECT_NE(text.find("property float nx\nproperty float ny\nproperty float nz\n"), std::string::npos) << text;
+        EXPECT_EQ(text.find("red"), std::string::npos) << text;
+
+        // Without --drop, STL names what it loses; with it, only what was not dropped.
+        const cli_test::CliRun stl = run(std::string(cmd) + " " + in + " " + dir / "a.stl");
+        EXPECT_EQ(stl.code, 0) << stl.err;
+        EXPECT_NE(stl.err.find("warning: normals, colours dropped: stl output carries positions only"),
+                  std::string::npos)
+            << stl.err;
+        const cli_test::CliRun some = run(std::string(cmd) + " --drop colors " + in + " " + dir / "b.stl");
+        EXPECT_NE(some.err.find("warning: normals dropped: stl output carries positions only"), std::string::npos)
+            << some.err;
+        const cli_test::CliRun none = run(std::string(cmd) + " --drop normals,colors " + in + " " + dir / "c.stl");
+        EXPECT_EQ(none.code, 0) << none.err;
+        EXPECT_EQ(none.err, "");
+
+        const cli_test::CliRun bad = run(std::string(cmd) + " --drop normals,colours " + in + " " + dir / "d.stl");
+        EXPECT_EQ(bad.code, 2);
+        EXPECT_NE(bad.err.find("unknown channel 'colours'"), std::string::npos) << bad.err;
+        EXPECT_FALSE(std::filesystem::exists(dir / "d.stl"));
+    }
 }
