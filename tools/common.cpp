@@ -63,25 +63,25 @@ std::string dropped_channels_text(const std::string& dropped, const io::Format& 
 void note_input_changes(const io::MeshHeader& header, const std::string& input_name, Warnings& warnings) {
     for (const auto& [key, text] : header.notes)
         if (key == io::kLastLineNote)
-            warnings.note(input_name + ": the last line " + text + " (a truncated download or pipe?): check its last face");
+            warnings.note("input_last_line_unterminated", input_name + ": the last line " + text + " (a truncated download or pipe?): check its last face");
         else if (key == io::kPrecisionNote && header.coordinate_rounding.value_or(0) > 0)
-            warnings.note(input_name + ": coordinates are " + text + "; meshstream works in float (32-bit)");
-    for (const io::ReaderWarning& w : header.warnings) warnings.add(io::describe_warning(input_name, w), w.count);
+            warnings.note("input_coordinates_rounded", input_name + ": coordinates are " + text + "; meshstream works in float (32-bit)");
+    for (const io::ReaderWarning& w : header.warnings) warnings.add("reader_warning", io::describe_warning(input_name, w), w.count);
 }
 
 void note_unused_write_flags(const WriteFlags& flags, const io::Format& output, const std::string& output_path,
                              Warnings& warnings) {
     if (flags.gzip_level != WriteFlags{}.gzip_level && (output_path == "-" || !io::wants_gzip(output_path)))
-        warnings.note("--gzip-level applies to outputs named *.gz: ignored for " +
+        warnings.note("unused_option", "--gzip-level applies to outputs named *.gz: ignored for " +
                       (output_path == "-" ? std::string("<stdout> (pipe it through gzip)") : output_path));
     if (output.traits & (io::Format::kAlwaysDraco | io::Format::kDracoUnlessOff)) {
         if ((output.traits & io::Format::kAlwaysDraco) && !flags.draco)
-            warnings.note("--no-draco applies to glTF outputs; a .drc is Draco");
+            warnings.note("unused_option", "--no-draco applies to glTF outputs; a .drc is Draco");
         const WriteFlags defaults;
         if ((output.traits & io::Format::kDracoUnlessOff) && !flags.draco &&
             (flags.draco_qp != defaults.draco_qp || flags.draco_qn != defaults.draco_qn ||
              flags.draco_cl != defaults.draco_cl))
-            warnings.note("--draco-qp, --draco-qn and --draco-cl apply to Draco compression: ignored with --no-draco");
+            warnings.note("unused_option", "--draco-qp, --draco-qn and --draco-cl apply to Draco compression: ignored with --no-draco");
         return;
     }
     const WriteFlags defaults;
@@ -95,7 +95,7 @@ void note_unused_write_flags(const WriteFlags& flags, const io::Format& output, 
     add(flags.draco_qn != defaults.draco_qn, "--draco-qn");
     add(flags.draco_cl != defaults.draco_cl, "--draco-cl");
     if (!given.empty())
-        warnings.note(given + (given.find(',') == std::string::npos ? " applies" : " apply") +
+        warnings.note("unused_option", given + (given.find(',') == std::string::npos ? " applies" : " apply") +
                       " to Draco and glTF outputs only: ignored for " + std::string(output.name));
 }
 
@@ -365,9 +365,16 @@ void Progress::done() {
     drawn_ = false;
 }
 
+std::vector<Warnings::Line> Warnings::all() const {
+    std::vector<Line> out;
+    for (const auto& [text, entry] : entries_) out.push_back({entry.code, text, entry.count});
+    return out;
+}
+
 std::vector<std::string> Warnings::lines() const {
     std::vector<std::string> out;
-    for (const auto& [kind, count] : counts_) out.push_back(count == 0 ? kind : kind + " (" + std::to_string(count) + ")");
+    for (const auto& [text, entry] : entries_)
+        out.push_back(entry.count == 0 ? text : text + " (" + std::to_string(entry.count) + ")");
     return out;
 }
 

@@ -132,20 +132,35 @@ private:
     std::chrono::steady_clock::time_point start_, last_;
 };
 
-// Counted warnings, summarised once at the end of a command on stderr ("warning: ...").
+// Counted warnings, summarised once at the end of a command on stderr ("warning: ..."). Each
+// has a stable code for --json (docs/cli.md lists them): the text may change, the code not.
 class Warnings {
 public:
     // A kind of event that can happen many times: printed with its count.
-    void add(const std::string& kind, uint64_t count = 1) { counts_[kind] += count; }
+    void add(std::string_view code, const std::string& kind, uint64_t count = 1) {
+        Entry& e = entries_[kind];
+        e.code = code;
+        e.count += count;
+    }
     // A one-off finding: printed as it is.
-    void note(const std::string& text) { counts_.emplace(text, 0); }
-    bool empty() const { return counts_.empty(); }
+    void note(std::string_view code, const std::string& text) { entries_.emplace(text, Entry{std::string(code), 0}); }
+    bool empty() const { return entries_.empty(); }
+    struct Line {
+        std::string code, text;
+        uint64_t count = 0;  // 0 for a one-off finding
+    };
+    // In the order print() writes them; text without the count.
+    std::vector<Line> all() const;
     // The lines print() writes, without the "meshstream: warning: " prefix.
     std::vector<std::string> lines() const;
     void print() const;
 
 private:
-    std::map<std::string, uint64_t> counts_;
+    struct Entry {
+        std::string code;
+        uint64_t count = 0;
+    };
+    std::map<std::string, Entry> entries_;
 };
 
 // "1.23 M" style numbers and "12.3 MB" sizes for summaries. human_count prints n below 10^4

@@ -123,7 +123,7 @@ void run_compare(const CompareCliOptions& opt) {
     Warnings warnings;
     const bool none = r.a_to_b.samples == 0 && r.b_to_a.samples == 0;
     auto unsampled = [&](const MeshSummary& from, const char* direction) {
-        warnings.note(std::string("no samples on ") + from.name + " (" +
+        warnings.note("no_samples", std::string("no samples on ") + from.name + " (" +
                       (from.area > 0 ? "too few asked for: raise --samples" : "its triangles have no area") + "): " +
                       direction + " is not measured" +
                       (none ? std::string() : ", and the symmetric figures are the other direction's alone"));

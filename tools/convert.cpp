@@ -4,7 +4,9 @@
 #include "tools/commands.hpp"
 #include "tools/common.hpp"
 #include "tools/input_filter.hpp"
+#include "tools/run_report.hpp"
 
+#include <chrono>
 #include <cstdio>
 #include <memory>
 
@@ -14,11 +16,14 @@ namespace {
 struct ConvertOptions {
     std::string input, output;
     bool clean = false;
+    bool json = false;
     ReadFlags read;
     WriteFlags write;
 };
 
 void run_convert(const ConvertOptions& opt) {
+    const auto start = std::chrono::steady_clock::now();
+    if (opt.json) refuse_json_with_stdout_output(opt.output);
     const io::Format& out_format = resolve_output_format(opt.output, opt.write);
     io::TriangleInput in = open_triangle_input(opt.input, opt.read, Command::kConvert, opt.clean);
     const io::MeshHeader& header = in.header();
@@ -55,11 +60,22 @@ void run_convert(const ConvertOptions& opt) {
     progress.done();
     Warnings warnings;
     note_unused_write_flags(opt.write, *out.format, opt.output, warnings);
-    for (const std::string& note : out.writer->notes()) warnings.note(note);
-    if (!dropped.empty()) warnings.note(dropped_channels_text(dropped, *out.format, wo.channels));
+    for (const std::string& note : out.writer->notes()) warnings.note("output_note", note);
+    if (!dropped.empty()) warnings.note("channels_dropped", dropped_channels_text(dropped, *out.format, wo.channels));
     note_dropped_triangles(dropped_triangles(in), "removed (--clean)", warnings);
     note_input_changes(in.header(), in.name(), warnings);
     warnings.print();
+    if (opt.json) {
+        RunReport report;
+        report.command = "convert";
+        report.inputs = {{opt.input, std::string(in.format().name), in.source().gzip()}};
+        report.outputs = {{opt.output, std::string(out.format->name), opt.output != "-" && io::wants_gzip(opt.output)}};
+        report.triangles_in = in.count().read;
+        report.triangles_out = in.count().passed();
+        report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        report.peak_rss_bytes = peak_rss_bytes();
+        print_json(run_report_json(report, warnings));
+    }
 }
 
 }  // namespace
@@ -72,6 +88,7 @@ void add_convert(CLI::App& app) {
     cmd->add_option("input", opt->input, "Input mesh ('-' = stdin)")->required();
     cmd->add_option("output", opt->output, "Output mesh ('-' = stdout: a pipe gets meshstream's triangle stream, anything else needs --to)")->required();
     add_clean_flag(cmd, opt->clean);
+    add_json_flag(cmd, opt->json);
     add_read_flags(cmd, opt->read);
     add_drop_flag(cmd, opt->read);
     add_write_flags(cmd, opt->write);

@@ -18,6 +18,7 @@
 #include "tools/common.hpp"
 #include "tools/decimate_report.hpp"
 #include "tools/input_filter.hpp"
+#include "tools/run_report.hpp"
 #include "compare/metro.hpp"
 
 #include <chrono>
@@ -49,6 +50,7 @@ struct DecimateOptions {
     std::optional<int> sorted_axis;
     std::string sort = "auto";  // --sort auto|always|never
     bool report = false;
+    bool json = false;
     ReadFlags read;
     WriteFlags write;
 };
@@ -310,8 +312,38 @@ SortedInput sort_spooled(io::TriangleInput& in, PositionSpool& spool, uint64_t s
     return s;
 }
 
+// --report: the output compared against the input, printed on stderr (unless --json); the
+// figures for --json (null when not measured).
+nlohmann::ordered_json report_error(const DecimateOptions& opt, const DecimateFacts& facts) {
+    // An output without triangles (or only zero-area ones) has nothing to compare: that is
+    // said, and the written output stands (compare itself refuses such a mesh).
+    if (facts.stats.triangles_out == 0) {
+        if (!opt.json) std::fprintf(stderr, "  error vs input: not measured (the output has no triangles)\n");
+        return nullptr;
+    }
+    CompareOptions co;
+    co.memory_budget_bytes = opt.read.options().memory_budget_bytes;
+    co.tmpdir = opt.read.tmpdir;
+    const CompareResult r = compare_meshes(file_source(opt.input, opt.read.from, opt.read.options()),
+                                           file_source(opt.output, {}, opt.read.options()), co);
+    if (r.a_to_b.samples == 0 && r.b_to_a.samples == 0) {
+        if (!opt.json)
+            std::fprintf(stderr, "  error vs input: not measured (no samples: the triangles have no area)\n");
+        return nullptr;
+    }
+    const double diag = r.diagonal > 0 ? r.diagonal : 1;
+    if (!opt.json)
+        std::fprintf(stderr,
+                     "  error vs input (%% of bbox diagonal %.6g): Hausdorff %.6g (%.4f %%), mean %.6g (%.4f %%), "
+                     "rms %.6g (%.4f %%)\n",
+                     r.diagonal, r.hausdorff(), 100 * r.hausdorff() / diag, r.mean(), 100 * r.mean() / diag, r.rms(),
+                     100 * r.rms() / diag);
+    return {{"bbox_diagonal", r.diagonal}, {"hausdorff", r.hausdorff()}, {"mean", r.mean()}, {"rms", r.rms()}};
+}
+
 void run_decimate(const DecimateOptions& opt) {
     const auto start = std::chrono::steady_clock::now();
+    if (opt.json) refuse_json_with_stdout_output(opt.output);
     // Checked before any work: the comparison re-reads both files once the output is done.
     const io::Format& out_format = resolve_output_format(opt.output, opt.write);
     if (opt.report) {
@@ -329,6 +361,7 @@ void run_decimate(const DecimateOptions& opt) {
     io::TriangleInput in = open_triangle_input(opt.input, opt.read, read, Command::kDecimate);
     const io::MeshHeader header = in.header();
     const std::string input_name = in.name();
+    const RunFile input_file{opt.input, std::string(in.format().name), in.source().gzip()};
     const decimate::Options options = decimation_options(opt, header, input_name);
 
     io::WriteOptions wo = opt.write.options(opt.read);
@@ -462,41 +495,29 @@ void run_decimate(const DecimateOptions& opt) {
     facts.skipped = sorted ? sorted->count.dropped : in.count().dropped;
     facts.input_name = input_name;
     facts.sort = outcome;
-    print_decimate_summary(facts, opt.output, seconds);
+    if (!opt.json) print_decimate_summary(facts, opt.output, seconds);
 
     Warnings warnings;
     if (const std::string dropped = io::describe_missing(header.channels, io::Channels{}); !dropped.empty())
-        warnings.note(dropped + " dropped: decimate keeps positions only");
+        warnings.note("channels_dropped", dropped + " dropped: decimate keeps positions only");
     note_unused_write_flags(opt.write, *out->format, opt.output, warnings);
-    for (const std::string& note : out->writer->notes()) warnings.note(note);
+    for (const std::string& note : out->writer->notes()) warnings.note("output_note", note);
     note_dropped_triangles(sorted ? sorted->dropped : dropped_triangles(in), "skipped", warnings);
     note_input_changes(sorted ? sorted->end_header : in.header(), input_name, warnings);
     note_decimate_warnings(facts, warnings);
     warnings.print();
 
-    if (opt.report) {
-        // An output without triangles (or only zero-area ones) has nothing to compare: that is
-        // said, and the written output stands (compare itself refuses such a mesh).
-        if (facts.stats.triangles_out == 0) {
-            std::fprintf(stderr, "  error vs input: not measured (the output has no triangles)\n");
-            return;
-        }
-        CompareOptions co;
-        co.memory_budget_bytes = opt.read.options().memory_budget_bytes;
-        co.tmpdir = opt.read.tmpdir;
-        const CompareResult r = compare_meshes(file_source(opt.input, opt.read.from, opt.read.options()),
-                                               file_source(opt.output, {}, opt.read.options()), co);
-        if (r.a_to_b.samples == 0 && r.b_to_a.samples == 0) {
-            std::fprintf(stderr, "  error vs input: not measured (no samples: the triangles have no area)\n");
-            return;
-        }
-        const double diag = r.diagonal > 0 ? r.diagonal : 1;
-        std::fprintf(stderr,
-                     "  error vs input (%% of bbox diagonal %.6g): Hausdorff %.6g (%.4f %%), mean %.6g (%.4f %%), "
-                     "rms %.6g (%.4f %%)\n",
-                     r.diagonal, r.hausdorff(), 100 * r.hausdorff() / diag, r.mean(), 100 * r.mean() / diag, r.rms(),
-                     100 * r.rms() / diag);
-    }
+    RunReport report;
+    report.command = "decimate";
+    report.inputs = {input_file};
+    report.outputs = {{opt.output, std::string(out->format->name), opt.output != "-" && io::wants_gzip(opt.output)}};
+    report.triangles_in = sorted ? sorted->count.read : in.count().read;
+    report.triangles_out = facts.stats.triangles_out;
+    report.seconds = seconds;
+    report.peak_rss_bytes = peak_rss_bytes();
+    report.details = decimate_details_json(facts);
+    if (opt.report) report.details["error"] = report_error(opt, facts);
+    if (opt.json) print_json(run_report_json(report, warnings));
 }
 
 }  // namespace
@@ -541,6 +562,7 @@ void add_decimate(CLI::App& app) {
                     "always: sort first; never: decimate as read")
         ->check(CLI::IsMember({"auto", "always", "never"}));
     cmd->add_flag("--report", opt->report, "Compare the output against the input (Hausdorff, mean, RMS) at the end");
+    add_json_flag(cmd, opt->json);
     add_read_flags(cmd, opt->read);
     strict_refuses_dropped_triangles(cmd);
     add_write_flags(cmd, opt->write);

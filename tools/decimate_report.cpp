@@ -41,11 +41,11 @@ void note_decimate_warnings(const DecimateFacts& f, Warnings& warnings) {
                                       (f.default_buffer ? "" : " --buffer " + std::to_string(f.buffer)) + "`";
     const bool axis_conflict = f.given_axis && f.file_axis && *f.given_axis != *f.file_axis;
     if (axis_conflict)
-        warnings.note(std::string("--sorted-axis ") + axis_name(*f.given_axis) + " was given, but " + f.input_name +
+        warnings.note("sorted_axis_conflict", std::string("--sorted-axis ") + axis_name(*f.given_axis) + " was given, but " + f.input_name +
                       " says it is sorted along " + axis_name(*f.file_axis) + ": the sweep used " +
                       axis_name(*f.given_axis) + ", as given");
     if (s.forced_writes > 0)
-        warnings.note("buffer full of undecimatable triangles: " + std::to_string(s.forced_writes) +
+        warnings.note("forced_writes", "buffer full of undecimatable triangles: " + std::to_string(s.forced_writes) +
                       " triangles force-written at full resolution (" + std::to_string(s.premature_writes) +
                       " written before reaching the target resolution; near them a few triangles may come out twice, "
                       "back to back)" +
@@ -56,21 +56,21 @@ void note_decimate_warnings(const DecimateFacts& f, Warnings& warnings) {
                            : std::string()) +
                       forced_write_remedy(f, axis_conflict, order_command));
     if (s.sort_violations > 0)
-        warnings.note(std::string("the input is not sorted along ") + axis_name(*f.used_axis) + " as stated: " +
+        warnings.note("not_sorted_as_stated", std::string("the input is not sorted along ") + axis_name(*f.used_axis) + " as stated: " +
                       std::to_string(s.sort_violations) + (s.sort_violations == 1 ? " triangle" : " triangles") +
                       " reached behind the sweep, which was switched off at the first (boundary finalized before it "
                       "may show as cracks); " +
                       (axis_conflict ? std::string("leave out --sorted-axis to use the file's own axis")
                                      : std::string("run `meshstream sort` on it first")));
     if (s.nonmanifold_edges > 0)
-        warnings.add("non-manifold, duplicate or mis-oriented edges frozen and passed through", s.nonmanifold_edges);
+        warnings.add("nonmanifold_edges_frozen", "non-manifold, duplicate or mis-oriented edges frozen and passed through", s.nonmanifold_edges);
     if (s.degenerate_passed > 0)
-        warnings.add("degenerate triangles (repeated corners) passed through", s.degenerate_passed);
-    if (s.weld_dropped > 0) warnings.add("triangles dropped because --weld merged their corners", s.weld_dropped);
+        warnings.add("degenerate_triangles_passed", "degenerate triangles (repeated corners) passed through", s.degenerate_passed);
+    if (s.weld_dropped > 0) warnings.add("weld_dropped_triangles", "triangles dropped because --weld merged their corners", s.weld_dropped);
     // Welding that collapses many triangles is coarser than the mesh: it removes surface
     // detail the decimation would have kept.
     if (f.weld_eps > 0 && s.weld_dropped * 100 > s.triangles_in)
-        warnings.note("--weld " + f.weld_text + " welded the corners of " +
+        warnings.note("weld_too_coarse", "--weld " + f.weld_text + " welded the corners of " +
                       std::to_string(s.weld_dropped * 100 / s.triangles_in) +
                       " % of the triangles together: it is coarser than the mesh; weld on a smaller size");
     // Triangles that share no corners exactly (cracks from float round-off, a soup written
@@ -79,7 +79,7 @@ void note_decimate_warnings(const DecimateFacts& f, Warnings& warnings) {
     // strip one triangle wide about one per triangle); a soup has three. (A few loose triangles
     // are no surface to warn about; an input without triangles: the read loop's note says so.)
     if (s.triangles_in >= 100 && s.boundary_edges * 2 > s.triangles_in * 3)
-        warnings.note(std::to_string(s.boundary_edges) + " edges had no partner, " +
+        warnings.note("unwelded_surface", std::to_string(s.boundary_edges) + " edges had no partner, " +
                       std::to_string(s.boundary_edges / s.triangles_in) + "." +
                       std::to_string(s.boundary_edges * 10 / s.triangles_in % 10) +
                       " per triangle: the triangles share few corners exactly (an unwelded surface?), and "
@@ -93,29 +93,29 @@ void note_decimate_warnings(const DecimateFacts& f, Warnings& warnings) {
                                      "them had been decimated for the larger input the header promised; `meshstream "
                                      "convert --clean` drops them into a copy that lands on the target";
     if (s.triangles_in > 0 && s.target_triangles > s.triangles_in)
-        warnings.note("the target " + std::to_string(s.target_triangles) + " is more than the " +
+        warnings.note("target_exceeds_input", "the target " + std::to_string(s.target_triangles) + " is more than the " +
                       std::to_string(s.triangles_in) + " usable input triangles: " +
                       (s.collapses == 0 ? std::string("nothing was decimated") : missed + "; " + skipped_late));
     else if (f.target_given && s.triangles_in > 0 && s.triangles_out < s.target_triangles && f.skipped > 0)
-        warnings.note(missed + " (" + skipped_late + ")");
+        warnings.note("target_missed", missed + " (" + skipped_late + ")");
     else if (s.triangles_in > 0 && s.triangles_out == s.target_triangles + 1)
         warnings.note(
-            missed +
+            "target_missed", missed +
             " (a collapse removes two triangles, and no boundary edge could be collapsed to remove the odd one)");
     else if (s.triangles_in > 0 && s.triangles_out != s.target_triangles && s.forced_writes > 0)
-        warnings.note(missed + " (the triangles force-written at full resolution, above, count against it)");
+        warnings.note("target_missed", missed + " (the triangles force-written at full resolution, above, count against it)");
     else if (s.triangles_in > 0 && s.triangles_out != s.target_triangles && s.no_valid_collapse_left)
-        warnings.note(missed +
+        warnings.note("target_missed", missed +
                       " (no allowed collapse is left: each would fold a face over or change the topology, "
                       "or move a vertex that must stay, as on a non-manifold edge)");
     else if (s.triangles_in > 0 && s.triangles_out > s.target_triangles && s.nonmanifold_edges > 0)
-        warnings.note(missed + " (the " + std::to_string(s.nonmanifold_edges) +
+        warnings.note("target_missed", missed + " (the " + std::to_string(s.nonmanifold_edges) +
                       " non-manifold, duplicate or mis-oriented edges above are frozen with their vertices: "
                       "faces wound against their neighbours join none of them)");
     else if (s.triangles_in > 0 && s.triangles_out != s.target_triangles)
-        warnings.note(missed + " (too little left that could be decimated)");
+        warnings.note("target_missed", missed + " (too little left that could be decimated)");
     else if (s.triangles_in > 0 && s.target_triangles == 0)
-        warnings.note("the target rounds to 0 triangles (" + std::to_string(s.triangles_in) +
+        warnings.note("target_rounds_to_zero", "the target rounds to 0 triangles (" + std::to_string(s.triangles_in) +
                       " in): the output is empty; give a larger --ratio or --target");
 }
 
@@ -138,6 +138,27 @@ std::string sort_notice(const SortOutcome& sort) {
     }
     return text + ", " +
            (sort.temp_bytes > 0 ? human_bytes(double(sort.temp_bytes)) + " of temporary disk" : "in memory");
+}
+
+nlohmann::ordered_json decimate_details_json(const DecimateFacts& f) {
+    const decimate::Stats& s = f.stats;
+    nlohmann::ordered_json j;
+    j["target"] = s.target_triangles;
+    j["ratio"] = f.ratio;
+    j["buffer"] = s.buffer_capacity;
+    j["peak_buffer_fill"] = s.peak_buffer_triangles;
+    j["collapses"] = s.collapses;
+    j["forced_writes"] = s.forced_writes;
+    j["skipped_triangles"] = f.skipped;
+    j["sorted_axis"] = f.used_axis ? nlohmann::ordered_json(std::string(1, axis_name(*f.used_axis)))
+                                   : nlohmann::ordered_json(nullptr);
+    if (f.weld_eps > 0) j["weld"] = {{"size", f.weld_eps}, {"vertices_merged", s.vertices_merged}};
+    if (f.sort.kind == SortOutcome::Kind::kSorted)
+        j["sorted_first"] = {{"axis", std::string(1, axis_name(f.sort.axis))},
+                             {"requested", f.sort.requested},
+                             {"seconds", f.sort.attempt_seconds + f.sort.sort_seconds},
+                             {"temp_bytes", f.sort.temp_bytes}};
+    return j;
 }
 
 void print_decimate_summary(const DecimateFacts& f, const std::string& output, double seconds) {

@@ -7,6 +7,8 @@
 #include "decimate/stream_decimator.hpp"
 #include "tools/common.hpp"
 
+#include <nlohmann/json.hpp>
+
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -51,6 +53,10 @@ void note_decimate_warnings(const DecimateFacts& facts, Warnings& warnings);
 
 // "sorted along x first (...): 1.23 s, 36.0 MB of temporary disk"; empty unless kSorted.
 std::string sort_notice(const SortOutcome& sort);
+
+// The decimation's own figures for --json (run_report.hpp): target, ratio, buffer and its peak
+// fill, collapses, forced writes, the sweep axis, the weld and a sort done first.
+nlohmann::ordered_json decimate_details_json(const DecimateFacts& facts);
 
 // The summary lines on stderr after a run (triangles, time, buffer, weld, sweep, sort).
 void print_decimate_summary(const DecimateFacts& facts, const std::string& output, double seconds);

@@ -9,6 +9,7 @@
 #include "tools/commands.hpp"
 #include "tools/common.hpp"
 #include "tools/input_filter.hpp"
+#include "tools/run_report.hpp"
 
 #include <unistd.h>
 
@@ -33,6 +34,7 @@ struct SortOptions {
     std::string axis = "auto";
     bool stats = false;
     bool clean = false;
+    bool json = false;
     ReadFlags read;
     WriteFlags write;
 };
@@ -158,6 +160,7 @@ std::string sort_stats_line(const sort::SortStats& s, int axis, double seconds, 
 
 void run_sort(const SortOptions& opt) {
     const auto t0 = std::chrono::steady_clock::now();
+    if (opt.json) refuse_json_with_stdout_output(opt.output);
     const io::Format& out_format = resolve_output_format(opt.output, opt.write);
     // Draco's connectivity coder reorders the triangles: the sorted order would be lost.
     if ((out_format.traits & io::Format::kAlwaysDraco) ||
@@ -191,6 +194,7 @@ void run_sort(const SortOptions& opt) {
     io::TriangleInput in = open_triangle_input(opt.input, opt.read, ro, Command::kSort, opt.clean);
     const io::MeshHeader header = in.header();
     const std::string input_name = in.name();  // the reader is released before the merge
+    const RunFile input_file{opt.input, std::string(in.format().name), in.source().gzip()};
     refuse_output_over_inputs(opt.output, out_format, opt.write.options(opt.read), {input_files(opt.input, header)});
     const int axis = opt.axis == "auto" ? longest_axis(input_bounds(opt.input, opt.read.from, ro))
                                         : static_cast<int>(std::find(std::begin(kAxisNames), std::end(kAxisNames), opt.axis) -
@@ -300,10 +304,10 @@ void run_sort(const SortOptions& opt) {
     progress.done();
     Warnings warnings;
     note_unused_write_flags(opt.write, *out.format, opt.output, warnings);
-    if (!dropped.empty()) warnings.note(dropped_channels_text(dropped, *out.format, so.channels));
+    if (!dropped.empty()) warnings.note("channels_dropped", dropped_channels_text(dropped, *out.format, so.channels));
     // Only STL, PLY and OBJ have a place for the axis (a header or a comment).
     if (out.format->traits & io::Format::kDracoUnlessOff)
-        warnings.note(std::string(opt.output == "-" ? "<stdout>" : opt.output) +
+        warnings.note("sorted_axis_not_recorded", std::string(opt.output == "-" ? "<stdout>" : opt.output) +
                       ": glTF has no place for the sorted axis: decimate it with --sorted-axis " + "xyz"[axis] +
                       ", or sort to STL, PLY or OBJ, which record it");
     note_dropped_triangles(dropped_triangles(in), "removed (--clean)", warnings);
@@ -315,6 +319,23 @@ void run_sort(const SortOptions& opt) {
                      sort_stats_line(sorter.stats(), axis, seconds_since(t0), input_seconds, sort_seconds,
                                      peak_rss_bytes())
                          .c_str());
+    if (opt.json) {
+        RunReport report;
+        report.command = "sort";
+        report.inputs = {input_file};
+        report.outputs = {{opt.output, std::string(out.format->name), opt.output != "-" && io::wants_gzip(opt.output)}};
+        report.triangles_in = in.count().read;
+        report.triangles_out = total;
+        report.seconds = seconds_since(t0);
+        report.peak_rss_bytes = peak_rss_bytes();
+        const sort::SortStats& s = sorter.stats();
+        report.details = {{"axis", kAxisNames[axis]},
+                          {"runs", s.runs},
+                          {"merge_passes", s.merge_passes},
+                          {"temp_bytes_written", s.temp_bytes_written},
+                          {"peak_temp_bytes", s.peak_temp_bytes}};
+        print_json(run_report_json(report, warnings));
+    }
 }
 
 }  // namespace
@@ -330,6 +351,7 @@ void add_sort(CLI::App& app) {
         ->check(CLI::IsMember({"x", "y", "z", "auto"}));
     cmd->add_flag("--stats", opt->stats, "Print runs, merge passes, temporary disk, time and peak RSS on stderr");
     add_clean_flag(cmd, opt->clean);
+    add_json_flag(cmd, opt->json);
     add_read_flags(cmd, opt->read);
     add_drop_flag(cmd, opt->read);
     cmd->get_option("--tmpdir")->description("Directory for sort runs and spills (default: the output's directory; $TMPDIR "
