@@ -6,7 +6,10 @@
 #   - the Hausdorff error quantization adds: `meshstream compare M.ply M.glb` (symmetric max,
 #     absolute and % of the bounding-box diagonal) next to the bound qp implies (half a step);
 #   - Debian's draco_encoder on the same PLY at the same settings (-qp 14 -cl 7), in the same
-#     run: size ratio (target: within 2 %) and time ratio (target: within 1.5x).
+#     run: size ratio (target: within 2 %) and time ratio (target: within 1.5x);
+#   - `--compress meshopt` against gltfpack -cc (npm gltfpack 0.18, the same libmeshoptimizer
+#     version as Debian's, same 14-bit position quantization) on the same mesh as a plain GLB:
+#     size ratio (target: within 10 %) and time ratio, on the full bunny and each decimated mesh.
 # Times are wall clock of the whole process (read + index + encode + write), best of 3.
 #
 # Usage: bench/web.sh [build dir (default: build)] [work dir (default: $TMPDIR or /tmp)]
@@ -24,6 +27,8 @@ cl=7
 command -v draco_encoder >/dev/null || { echo "needs Debian's draco_encoder (package 'draco')" >&2; exit 2; }
 command -v node >/dev/null || { echo "needs node (JSON parsing of compare's report)" >&2; exit 2; }
 command -v /usr/bin/time >/dev/null || { echo "needs GNU time (/usr/bin/time)" >&2; exit 2; }
+gltfpack=${MESHSTREAM_TOOLS_DIR:-/opt/meshstream-tools}/node_modules/gltfpack/cli.js
+[ -f "$gltfpack" ] || { echo "needs npm gltfpack in \$MESHSTREAM_TOOLS_DIR (tools/bootstrap.sh installs it)" >&2; exit 2; }
 
 # best_of3 CMD...: prints the fastest wall time of 3 runs, in seconds.
 best_of3() {
@@ -41,6 +46,22 @@ ratio() { awk "BEGIN{printf \"%.3f\", $1 / $2}"; }
 
 decimate_ok=1
 "$ms" decimate --help >/dev/null 2>&1 || decimate_ok=0
+
+# meshopt_vs_gltfpack LABEL PLY: meshstream --compress meshopt against gltfpack -cc from the same
+# mesh written as a plain GLB (gltfpack reads glTF, OBJ only).
+meshopt_vs_gltfpack() {
+    local label=$1 m=$work/$1.mo
+    "$ms" -q convert --compress none "$2" "$m.plain.glb"
+    local t_ms t_gp
+    t_ms=$(best_of3 "$ms" -q convert --memory 4G --compress meshopt "$m.plain.glb" "$m.glb")
+    t_gp=$(best_of3 node "$gltfpack" -i "$m.plain.glb" -o "$m.gltfpack.glb" -cc)
+    echo "== $label: --compress meshopt against gltfpack 0.18 -cc (14-bit positions)"
+    printf "  %-26s %12s bytes\n" "GLB (--compress meshopt)" "$(size "$m.glb")"
+    printf "  %-26s %12s bytes  (ours / theirs: %s)\n" "GLB (gltfpack -cc)" "$(size "$m.gltfpack.glb")" \
+        "$(ratio "$(size "$m.glb")" "$(size "$m.gltfpack.glb")")"
+    printf "  %-26s %8s s  (ours / theirs: %s; gltfpack runs as WebAssembly in node)\n" "encode" "$t_ms" \
+        "$(ratio "$t_ms" "$t_gp")"
+}
 
 run_mesh() {
     local label=$1 input=$2 m=$work/$1
@@ -82,8 +103,10 @@ run_mesh() {
     printf "  %-26s %8s s\n" "encode PLY -> .drc" "$t_drc"
     printf "  %-26s %8s s  (ours / theirs: %s)\n" "draco_encoder PLY -> .drc" "$t_ref" "$(ratio "$t_drc" "$t_ref")"
     echo "  Hausdorff(decimated, GLB): $err"
+    meshopt_vs_gltfpack "$label" "$m.ply"
 }
 
+meshopt_vs_gltfpack bunny_full "$here/../fixtures/bunny_from_draco.bin.stl"
 run_mesh bunny "$here/../fixtures/bunny_from_draco.bin.stl"
 if [ -x "$gen" ]; then
     "$gen" -q -n 1000000 "$work/gen1m.stl"

@@ -16,22 +16,72 @@
 #include <draco/core/encoder_buffer.h>
 #include <draco/core/quantization_utils.h>
 #include <draco/mesh/mesh.h>
+#include <draco/metadata/geometry_metadata.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <numeric>
 
 namespace meshstream::io {
 namespace {
 
 constexpr char kMagic[5] = {'D', 'R', 'A', 'C', 'O'};
 
-// Adds a float32 × 3 per-vertex attribute with identity mapping and copies `values` into it.
-int add_float3_attribute(draco::Mesh& mesh, draco::GeometryAttribute::Type type, const std::vector<float>& values) {
+draco::DataType draco_type(ScalarType type) {
+    switch (type) {
+        case ScalarType::kInt8: return draco::DT_INT8;
+        case ScalarType::kUInt8: return draco::DT_UINT8;
+        case ScalarType::kInt16: return draco::DT_INT16;
+        case ScalarType::kUInt16: return draco::DT_UINT16;
+        case ScalarType::kInt32: return draco::DT_INT32;
+        case ScalarType::kUInt32: return draco::DT_UINT32;
+        case ScalarType::kFloat32:
+        case ScalarType::kFloat64: return draco::DT_FLOAT32;  // Draco quantizes float32 only
+    }
+    return draco::DT_FLOAT32;
+}
+
+// A value converted to `T`, rounded and clamped to its range (integers) or as it is (float).
+template <class T>
+T to_component(double v) {
+    if constexpr (std::is_floating_point_v<T>) {
+        return static_cast<T>(v);
+    } else {
+        const double r = std::nearbyint(v);
+        if (!(r >= double(std::numeric_limits<T>::min()))) return std::numeric_limits<T>::min();
+        if (r >= double(std::numeric_limits<T>::max())) return std::numeric_limits<T>::max();
+        return static_cast<T>(r);
+    }
+}
+
+// Adds a per-vertex attribute (identity mapping) of `components` values of `type` per vertex,
+// from `values` (components per vertex, each times `scale`). Returns its attribute id.
+template <class V>
+int add_attribute(draco::Mesh& mesh, draco::GeometryAttribute::Type kind, int components, draco::DataType type,
+                  bool normalized, std::span<const V> values, double scale = 1.0) {
+    const size_t bytes = draco::DataTypeLength(type);
     draco::GeometryAttribute ga;
-    ga.Init(type, nullptr, 3, draco::DT_FLOAT32, false, sizeof(float) * 3, 0);
-    int id = mesh.AddAttribute(ga, true, static_cast<uint32_t>(values.size() / 3));
-    mesh.attribute(id)->buffer()->Write(0, values.data(), values.size() * sizeof(float));
+    ga.Init(kind, nullptr, static_cast<uint8_t>(components), type, normalized, int64_t(bytes * components), 0);
+    const uint32_t n = static_cast<uint32_t>(values.size() / size_t(components));
+    const int id = mesh.AddAttribute(ga, true, n);
+    std::vector<uint8_t> raw(size_t(components) * bytes);
+    for (uint32_t v = 0; v < n; ++v) {
+        for (int c = 0; c < components; ++c) {
+            const double x = double(values[size_t{v} * components + c]) * scale;
+            uint8_t* dst = &raw[size_t(c) * bytes];
+            switch (type) {
+                case draco::DT_INT8: { int8_t y = to_component<int8_t>(x); std::memcpy(dst, &y, 1); break; }
+                case draco::DT_UINT8: { uint8_t y = to_component<uint8_t>(x); std::memcpy(dst, &y, 1); break; }
+                case draco::DT_INT16: { int16_t y = to_component<int16_t>(x); std::memcpy(dst, &y, 2); break; }
+                case draco::DT_UINT16: { uint16_t y = to_component<uint16_t>(x); std::memcpy(dst, &y, 2); break; }
+                case draco::DT_INT32: { int32_t y = to_component<int32_t>(x); std::memcpy(dst, &y, 4); break; }
+                case draco::DT_UINT32: { uint32_t y = to_component<uint32_t>(x); std::memcpy(dst, &y, 4); break; }
+                default: { float y = to_component<float>(x); std::memcpy(dst, &y, 4); break; }
+            }
+        }
+        mesh.attribute(id)->SetAttributeValue(draco::AttributeValueIndex(v), raw.data());
+    }
     return id;
 }
 
@@ -52,7 +102,7 @@ class DracoWriter final : public Writer {
 
 public:
     DracoWriter(ByteSink& sink, const WriteOptions& options)
-        : sink_(sink), options_(options), indexer_(sink.name()) {
+        : sink_(sink), options_(options), indexer_(sink.name(), "Draco", options.channels, options.strict) {
         check_draco_settings(sink.name(), options);
         budget_check_up_front(sink.name(), options, kWhy, draco_encode_estimate_bytes);
     }
@@ -65,27 +115,53 @@ public:
 
     void finish_output() override {
         IndexedMesh mesh = indexer_.take();
-        std::vector<float> normals;
-        if (options_.normals) normals = mesh.smooth_normals();
-        DracoEncoded encoded = encode_draco(mesh, options_.normals ? &normals : nullptr, options_, sink_.name());
+        if (options_.strict)
+            if (const int64_t t = first_repeated_vertex(mesh.indices); t >= 0)
+                throw Error(sink_.name(), "triangle " + std::to_string(t) + " has two corners at one vertex, which "
+                                              "Draco's encoder drops (--strict)");
+        std::vector<uint32_t> all(mesh.vertex_count());
+        std::iota(all.begin(), all.end(), 0u);
+        VertexValues values = mesh.values(all);
+        all = std::vector<uint32_t>();
+        Channels channels = mesh.channels;
+        if (options_.normals && !channels.normal && mesh.triangle_count() > 0) {
+            std::vector<float> normals = mesh.smooth_normals();
+            values.normals = std::move(normals);
+            channels.normal = true;
+        }
+        DracoEncoded encoded = encode_draco(mesh.positions, mesh.indices, values, channels, options_, sink_.name());
         sink_.write(encoded.bytes.data(), encoded.bytes.size());
-        note_ = draco_flattened_note(encoded, mesh.triangle_count(), options_);
+        notes_ = indexer_.notes();
+        for (std::string& note : draco_notes(encoded, mesh.triangle_count(), options_)) notes_.push_back(std::move(note));
     }
     std::vector<std::string> notes() const override {
-        return note_.empty() ? std::vector<std::string>{} : std::vector<std::string>{sink_.name() + ": " + note_};
+        std::vector<std::string> out;
+        for (const std::string& note : notes_) out.push_back(sink_.name() + ": " + note);
+        return out;
     }
 
 private:
-    std::string note_;
+    std::vector<std::string> notes_;
     ByteSink& sink_;
     WriteOptions options_;
     MeshIndexer indexer_;
 };
 
+const char* kind_name(DracoAttribute::Kind kind) {
+    switch (kind) {
+        case DracoAttribute::kNormal: return "normal";
+        case DracoAttribute::kColor: return "color";
+        case DracoAttribute::kTexCoord: return "texcoord";
+        case DracoAttribute::kGeneric: return "generic";
+        case DracoAttribute::kOther: return "other";
+    }
+    return "?";
+}
+
 // Reader: decodes the whole file at open, then hands out chunks.
 class DracoReader final : public Reader {
 public:
-    DracoReader(ByteSource& source, const ReadOptions& options) : source_(source) {
+    DracoReader(ByteSource& source, const ReadOptions& options) {
         std::vector<std::byte> bytes;
         std::byte buf[1 << 16];
         while (size_t n = source.read(buf, sizeof buf)) {
@@ -103,28 +179,90 @@ public:
                                                 " connectivity");
         header_.notes.emplace_back("draco_qp", mesh_.position_bits ? std::to_string(mesh_.position_bits) + " bits"
                                                                    : std::string("not quantized"));
-        std::string attrs = "position";
-        if (mesh_.normals) attrs += ", normal";
-        if (mesh_.colors) attrs += ", color";
-        if (mesh_.texcoords) attrs += ", texcoord";
+        // The channels: the first normal and colour attribute, up to kMaxUvSets texture
+        // coordinate sets, every component of every generic attribute as a scalar.
+        Channels& ch = header_.channels;
+        ch.vertex_id = true;
+        std::string attrs = "position", ignored;
+        for (size_t a = 0; a < mesh_.attributes.size(); ++a) {
+            const DracoAttribute& att = mesh_.attributes[a];
+            std::string label = kind_name(att.kind);
+            if (!att.name.empty()) label += " '" + att.name + "'";
+            attrs += ", " + label;
+            if (att.kind == DracoAttribute::kNormal && normal_ < 0 && att.components == 3) {
+                normal_ = int(a);
+                ch.normal = true;
+            } else if (att.kind == DracoAttribute::kColor && color_ < 0 && (att.components == 3 || att.components == 4)) {
+                color_ = int(a);
+                ColorFormat f;
+                f.type = att.type == ScalarType::kUInt8 ? ScalarType::kUInt8
+                         : att.type == ScalarType::kUInt16 ? ScalarType::kUInt16
+                                                           : ScalarType::kFloat32;
+                f.alpha = att.components == 4;
+                ch.color = f;
+            } else if (att.kind == DracoAttribute::kTexCoord && ch.uv_sets < kMaxUvSets && att.components == 2) {
+                uvs_.push_back(int(a));
+                ch.uv_sets++;
+            } else if (att.kind == DracoAttribute::kGeneric) {
+                const std::string base = att.name.empty() ? "generic" + std::to_string(att.unique_id) : att.name;
+                for (int c = 0; c < att.components; ++c) {
+                    ch.vertex_scalars.push_back(
+                        {att.components == 1 ? base : base + "_" + std::to_string(c), att.type});
+                    scalars_.push_back({int(a), c});
+                }
+            } else {
+                ignored += (ignored.empty() ? "" : ", ") + label;
+            }
+        }
         header_.notes.emplace_back("attributes", attrs);
+        if (!ignored.empty()) header_.notes.emplace_back("not read", ignored);
     }
 
     bool next(TriangleChunk& chunk) override {
         chunk.clear();
+        const Channels& want = chunk.channels();
         const size_t count = mesh_.indices.size() / 3;
+        // The chunk's scalar channels, by name, among this file's (-1: not here).
+        std::vector<int> scalar_map;
+        for (const ScalarChannel& s : want.vertex_scalars) {
+            const auto& have = header_.channels.vertex_scalars;
+            auto it = std::find_if(have.begin(), have.end(), [&](const ScalarChannel& h) { return h.name == s.name; });
+            scalar_map.push_back(it == have.end() ? -1 : int(it - have.begin()));
+        }
         while (next_ < count && !chunk.full()) {
+            const size_t i = chunk.size();
             float* dst = chunk.push_slot();
-            for (int k = 0; k < 3; ++k)
-                std::memcpy(dst + 3 * k, &mesh_.positions[3 * size_t{mesh_.indices[3 * next_ + k]}], 3 * sizeof(float));
+            for (int k = 0; k < 3; ++k) {
+                const uint32_t p = mesh_.indices[3 * next_ + k];
+                std::memcpy(dst + 3 * k, &mesh_.positions[3 * size_t{p}], 3 * sizeof(float));
+                if (want.vertex_id) chunk.id_at(i)[k] = p;
+                if (want.normal && normal_ >= 0)
+                    for (int c = 0; c < 3; ++c) chunk.normal_at(i)[3 * k + c] = float(value(normal_, p, c));
+                if (want.color && color_ >= 0) {
+                    const DracoAttribute& att = mesh_.attributes[color_];
+                    for (int c = 0; c < att.components; ++c) chunk.color_at(i)[4 * k + c] = float(value(color_, p, c));
+                }
+                for (int s = 0; s < std::min<int>(want.uv_sets, int(uvs_.size())); ++s)
+                    for (int c = 0; c < 2; ++c) chunk.uv_at(i, s)[2 * k + c] = float(value(uvs_[s], p, c));
+                for (size_t c = 0; c < scalar_map.size(); ++c)
+                    if (scalar_map[c] >= 0)
+                        chunk.vertex_scalar_at(i, c)[k] = value(scalars_[scalar_map[c]].first, p, scalars_[scalar_map[c]].second);
+            }
             ++next_;
         }
         return !chunk.empty();
     }
 
 private:
-    ByteSource& source_;
+    double value(int attribute, uint32_t point, int component) const {
+        const DracoAttribute& att = mesh_.attributes[attribute];
+        return att.values[size_t{point} * att.components + component];
+    }
+
     DracoDecoded mesh_;
+    int normal_ = -1, color_ = -1;
+    std::vector<int> uvs_;
+    std::vector<std::pair<int, int>> scalars_;  // (attribute, component) per vertex scalar channel
     size_t next_ = 0;
 };
 
@@ -140,11 +278,21 @@ std::unique_ptr<Writer> open_draco_writer(ByteSink& sink, const WriteOptions& op
 
 const Format kDracoFormat = {
     "draco", "drc", "Draco compressed mesh (whole mesh in memory)", &probe_draco, &open_draco_reader, &open_draco_writer,
-    Format::kAlwaysDraco,
+    Format::kAlwaysDraco, nullptr, nullptr,
 };
 
 bool probe_draco(std::span<const std::byte> head, std::optional<uint64_t>) {
     return head.size() >= 5 && std::memcmp(head.data(), kMagic, 5) == 0;
+}
+
+Channels draco_keep_channels(const Channels& in, const WriteOptions&, bool gltf) {
+    Channels out;
+    out.normal = in.normal;
+    out.color = in.color;
+    out.uv_sets = in.uv_sets;
+    if (!gltf) out.vertex_scalars = in.vertex_scalars;
+    out.vertex_id = in.vertex_id;
+    return out;
 }
 
 namespace {
@@ -152,10 +300,18 @@ namespace {
 // Peak RSS of Draco 1.5.5's entropy coding tables, measured (bench/web.sh's inputs, qp and qn
 // 22-29): about 4 bytes per quantized value of positions (levels 0-8; 11 at levels 9 and 10,
 // more than twice that at 30 bits) and of normals, for meshes past a few thousand vertices.
+// Texture coordinates, float colours and generic attributes are quantized the same way.
 uint64_t draco_table_bytes(const WriteOptions& options) {
     const uint64_t per_value = options.draco_level < 9 ? 4 : options.draco_position_bits < 30 ? 12 : 24;
+    const Channels& ch = options.channels;
+    const bool float_colors = ch.color && ch.color->type == ScalarType::kFloat32;
+    const bool float_scalars = std::any_of(ch.vertex_scalars.begin(), ch.vertex_scalars.end(), [](const ScalarChannel& s) {
+        return s.type == ScalarType::kFloat32 || s.type == ScalarType::kFloat64;
+    });
     return per_value * (uint64_t{1} << options.draco_position_bits) +
-           (options.normals ? 4 * (uint64_t{1} << options.draco_normal_bits) : 0);
+           (options.normals || ch.normal ? 4 * (uint64_t{1} << options.draco_normal_bits) : 0) +
+           (ch.uv_sets > 0 ? 4 * (uint64_t{1} << options.draco_texcoord_bits) : 0) +
+           (float_colors || float_scalars ? 4 * (uint64_t{1} << options.draco_color_bits) : 0);
 }
 
 }  // namespace
@@ -165,7 +321,11 @@ uint64_t draco_encode_estimate_bytes(uint64_t vertex_count, uint64_t triangle_co
     // closed 1 M and 2 M-triangle meshes (half as many vertices), Draco 1.5.5, level 7, fitted
     // and rounded up: the index tables and Draco's mesh copy and corner table per vertex and
     // per triangle; smooth normals add the area-weighted sums and Draco's normal attribute.
-    return vertex_count * (96 + (options.normals ? 88 : 0)) + triangle_count * 76 + draco_table_bytes(options);
+    // Other attributes: the indexer's record, the unpacked values (up to twice the record, as
+    // float or double) and Draco's copy of them, so about four records a vertex.
+    const bool normals = options.normals || options.channels.normal;
+    return vertex_count * (96 + (normals ? 88 : 0) + 4 * uint64_t(CornerLayout(options.channels).bytes())) +
+           triangle_count * (76 + (options.channels.material ? 4 : 0)) + draco_table_bytes(options);
 }
 
 void check_draco_settings(const std::string& file, const WriteOptions& options) {
@@ -173,12 +333,18 @@ void check_draco_settings(const std::string& file, const WriteOptions& options) 
         throw Error(file, "--draco-qp must be 1-30, got " + std::to_string(options.draco_position_bits));
     if (options.draco_normal_bits < 2 || options.draco_normal_bits > 30)
         throw Error(file, "--draco-qn must be 2-30, got " + std::to_string(options.draco_normal_bits));
+    if (options.draco_texcoord_bits < 1 || options.draco_texcoord_bits > 30)
+        throw Error(file, "--draco-qt must be 1-30, got " + std::to_string(options.draco_texcoord_bits));
+    if (options.draco_color_bits < 1 || options.draco_color_bits > 30)
+        throw Error(file, "--draco-qc must be 1-30, got " + std::to_string(options.draco_color_bits));
     if (options.draco_level < 0 || options.draco_level > 10)
         throw Error(file, "--draco-cl must be 0-10, got " + std::to_string(options.draco_level));
     const uint64_t tables = draco_table_bytes(options);
     if (tables <= options.memory_budget_bytes) return;
     throw Error(file, "Draco's coding tables for --draco-qp " + std::to_string(options.draco_position_bits) +
-                          (options.normals ? " and --draco-qn " + std::to_string(options.draco_normal_bits) : "") +
+                          (options.normals || options.channels.normal
+                               ? " and --draco-qn " + std::to_string(options.draco_normal_bits)
+                               : "") +
                           " at --draco-cl " + std::to_string(options.draco_level) + " take about " +
                           binary_size(tables) + " (they double with each bit), over the memory budget of " +
                           binary_size(options.memory_budget_bytes) +
@@ -186,22 +352,45 @@ void check_draco_settings(const std::string& file, const WriteOptions& options) 
                           std::to_string((tables >> 20) + 1) + "M or more");
 }
 
-DracoEncoded encode_draco(const IndexedMesh& mesh, const std::vector<float>* normals, const WriteOptions& options,
-                          const std::string& file_name) {
-    if (mesh.triangle_count() == 0)
-        throw Error(file_name, "no triangles to write: Draco cannot encode an empty mesh");
+int64_t first_repeated_vertex(const std::vector<uint32_t>& indices) {
+    for (size_t t = 0; t + 2 < indices.size(); t += 3)
+        if (indices[t] == indices[t + 1] || indices[t + 1] == indices[t + 2] || indices[t] == indices[t + 2])
+            return int64_t(t / 3);
+    return -1;
+}
+
+DracoEncoded encode_draco(const std::vector<float>& positions, const std::vector<uint32_t>& indices,
+                          const VertexValues& values, const Channels& channels, const WriteOptions& options,
+                          const std::string& file_name, bool flip_v) {
+    // Draco's encoder drops triangles with a repeated vertex: left out here, so they are counted.
+    std::vector<uint32_t> kept;
+    kept.reserve(indices.size());
+    for (size_t t = 0; t + 2 < indices.size(); t += 3)
+        if (indices[t] != indices[t + 1] && indices[t + 1] != indices[t + 2] && indices[t] != indices[t + 2])
+            kept.insert(kept.end(), &indices[t], &indices[t] + 3);
+    if (indices.empty()) throw Error(file_name, "no triangles to write: Draco cannot encode an empty mesh");
+    if (kept.empty())
+        throw Error(file_name, "every one of the " + std::to_string(indices.size() / 3) +
+                                   " triangles has two corners at one vertex, which Draco's encoder drops: nothing to "
+                                   "write (write it without Draco)");
+    Bounds box;
+    for (int a = 0; a < 3; ++a) box.min[a] = box.max[a] = positions[a];
+    for (size_t i = 0; i < positions.size(); i += 3)
+        for (int a = 0; a < 3; ++a) {
+            box.min[a] = std::min(box.min[a], positions[i + a]);
+            box.max[a] = std::max(box.max[a], positions[i + a]);
+        }
     {
         // Draco quantizes positions with a float step of range / (2^bits − 1), the range being
         // the largest extent in float; it overflows for boxes wider than the largest float
         // (libdraco then crashed) and its inverse overflows for tiny boxes (every vertex then
         // decoded to one point far away). Refused, as Draco's own encoder cannot do them.
-        const Bounds box = mesh.bounds();
         float range = 0;
         for (int a = 0; a < 3; ++a) range = std::max(range, box.max[a] - box.min[a]);
         const float max_q = float((uint32_t{1} << options.draco_position_bits) - 1);
         if (!std::isfinite(range))
             throw Error(file_name, "the mesh is wider along an axis than a float can hold (3.4e38): Draco cannot "
-                                   "quantize it; write it without Draco (--no-draco for glTF, or another format)");
+                                   "quantize it; write it without Draco (--compress none for glTF, or another format)");
         if (range > 0 && !std::isfinite(max_q / range)) {
             std::string extent;
             append_number(extent, range);
@@ -210,21 +399,61 @@ DracoEncoded encode_draco(const IndexedMesh& mesh, const std::vector<float>* nor
                                        "): write it with fewer --draco-qp bits, or without Draco");
         }
     }
+    const size_t n = positions.size() / 3;
     draco::Mesh dm;
-    dm.set_num_points(static_cast<uint32_t>(mesh.vertex_count()));
-    int pos_att = add_float3_attribute(dm, draco::GeometryAttribute::POSITION, mesh.positions);
-    int nrm_att = -1;
-    if (normals) nrm_att = add_float3_attribute(dm, draco::GeometryAttribute::NORMAL, *normals);
-    dm.SetNumFaces(mesh.triangle_count());
-    for (size_t f = 0; f < mesh.triangle_count(); ++f) {
-        draco::Mesh::Face face = {draco::PointIndex(mesh.indices[3 * f]), draco::PointIndex(mesh.indices[3 * f + 1]),
-                                  draco::PointIndex(mesh.indices[3 * f + 2])};
+    dm.set_num_points(static_cast<uint32_t>(n));
+    const int pos_att =
+        add_attribute(dm, draco::GeometryAttribute::POSITION, 3, draco::DT_FLOAT32, false, std::span<const float>(positions));
+    DracoEncoded out;
+    std::vector<int> atts;  // attribute ids of what follows, to read back their unique ids
+    int nrm_att = -1, col_att = -1;
+    if (channels.normal)
+        nrm_att = add_attribute(dm, draco::GeometryAttribute::NORMAL, 3, draco::DT_FLOAT32, false,
+                                std::span<const float>(values.normals));
+    if (channels.color) {
+        const int comps = channels.color->alpha ? 4 : 3;
+        const ScalarType t = channels.color->type;
+        const double scale = t == ScalarType::kUInt8 ? 255.0 : t == ScalarType::kUInt16 ? 65535.0 : 1.0;
+        std::vector<float> c(n * size_t(comps));  // RGBA to RGB or RGBA
+        for (size_t v = 0; v < n; ++v)
+            for (int k = 0; k < comps; ++k) c[v * comps + k] = values.colors[4 * v + k];
+        col_att = add_attribute(dm, draco::GeometryAttribute::COLOR, comps, draco_type(t), t != ScalarType::kFloat32,
+                                std::span<const float>(c), scale);
+    }
+    std::vector<int> uv_atts;
+    for (int s = 0; s < channels.uv_sets; ++s) {
+        std::vector<float> uv(values.uvs[s]);
+        if (flip_v)
+            for (size_t v = 0; v < n; ++v) uv[2 * v + 1] = 1.0f - uv[2 * v + 1];
+        uv_atts.push_back(
+            add_attribute(dm, draco::GeometryAttribute::TEX_COORD, 2, draco::DT_FLOAT32, false, std::span<const float>(uv)));
+    }
+    std::vector<int> generic_atts;
+    for (size_t c = 0; c < channels.vertex_scalars.size(); ++c) {
+        const int id = add_attribute(dm, draco::GeometryAttribute::GENERIC, 1, draco_type(channels.vertex_scalars[c].type),
+                                     false, std::span<const double>(values.scalars[c]));
+        // Draco's tools name generic attributes by a "name" metadata entry.
+        auto metadata = std::make_unique<draco::AttributeMetadata>();
+        metadata->AddEntryString("name", channels.vertex_scalars[c].name);
+        dm.AddAttributeMetadata(id, std::move(metadata));
+        generic_atts.push_back(id);
+    }
+    dm.SetNumFaces(kept.size() / 3);
+    for (size_t f = 0; f < kept.size() / 3; ++f) {
+        draco::Mesh::Face face = {draco::PointIndex(kept[3 * f]), draco::PointIndex(kept[3 * f + 1]),
+                                  draco::PointIndex(kept[3 * f + 2])};
         dm.SetFace(draco::FaceIndex(static_cast<uint32_t>(f)), face);
     }
 
     draco::Encoder encoder;
     encoder.SetAttributeQuantization(draco::GeometryAttribute::POSITION, options.draco_position_bits);
-    if (normals) encoder.SetAttributeQuantization(draco::GeometryAttribute::NORMAL, options.draco_normal_bits);
+    if (channels.normal) encoder.SetAttributeQuantization(draco::GeometryAttribute::NORMAL, options.draco_normal_bits);
+    if (channels.uv_sets > 0)
+        encoder.SetAttributeQuantization(draco::GeometryAttribute::TEX_COORD, options.draco_texcoord_bits);
+    // Quantization applies to float attributes only: integer colours and scalars stay exact.
+    if (channels.color) encoder.SetAttributeQuantization(draco::GeometryAttribute::COLOR, options.draco_color_bits);
+    if (!channels.vertex_scalars.empty())
+        encoder.SetAttributeQuantization(draco::GeometryAttribute::GENERIC, options.draco_color_bits);
     const int speed = 10 - options.draco_level;
     encoder.SetSpeedOptions(speed, speed);
     encoder.SetTrackEncodedProperties(true);
@@ -232,26 +461,28 @@ DracoEncoded encode_draco(const IndexedMesh& mesh, const std::vector<float>* nor
     draco::Status status = encoder.EncodeMeshToBuffer(dm, &buffer);
     if (!status.ok()) throw Error(file_name, "Draco encoding failed: " + status.error_msg_string());
 
-    DracoEncoded out;
     out.bytes = std::move(*buffer.buffer());
     out.point_count = encoder.num_encoded_points();
     out.face_count = encoder.num_encoded_faces();
+    out.dropped = indices.size() / 3 - out.face_count;
     out.position_id = static_cast<int>(dm.attribute(pos_att)->unique_id());
     if (nrm_att >= 0) out.normal_id = static_cast<int>(dm.attribute(nrm_att)->unique_id());
+    if (col_att >= 0) out.color_id = static_cast<int>(dm.attribute(col_att)->unique_id());
+    for (int id : uv_atts) out.texcoord_ids.push_back(static_cast<int>(dm.attribute(id)->unique_id()));
+    for (int id : generic_atts) out.generic_ids.push_back(static_cast<int>(dm.attribute(id)->unique_id()));
     // The decoded positions' bounds, computed with Draco's own quantizer on the input bounds.
     draco::AttributeQuantizationTransform q;
     if (!q.ComputeParameters(*dm.attribute(pos_att), options.draco_position_bits))
         throw Error(file_name, "Draco rejected the position quantization settings");
-    Bounds in = mesh.bounds();
     for (int a = 0; a < 3; ++a) {
-        out.decoded_bounds.min[a] = draco_roundtrip(in.min[a], q, a);
-        out.decoded_bounds.max[a] = draco_roundtrip(in.max[a], q, a);
+        out.decoded_bounds.min[a] = draco_roundtrip(box.min[a], q, a);
+        out.decoded_bounds.max[a] = draco_roundtrip(box.max[a], q, a);
     }
     // Triangles the quantization flattens: a part thinner than the step (a 2 cm cable in a 1 km
     // box at 14 bits) decodes to zero-area triangles and renders as nothing, within the
     // documented error bound but worth saying.
-    std::vector<float> decoded(mesh.positions.size());
-    for (size_t i = 0; i < decoded.size(); ++i) decoded[i] = draco_roundtrip(mesh.positions[i], q, int(i % 3));
+    std::vector<float> decoded(positions.size());
+    for (size_t i = 0; i < decoded.size(); ++i) decoded[i] = draco_roundtrip(positions[i], q, int(i % 3));
     auto zero_area = [](const std::vector<float>& p, const uint32_t* t) {
         double e1[3], e2[3];
         for (int a = 0; a < 3; ++a) {
@@ -261,18 +492,57 @@ DracoEncoded encode_draco(const IndexedMesh& mesh, const std::vector<float>* nor
         return e1[1] * e2[2] - e1[2] * e2[1] == 0 && e1[2] * e2[0] - e1[0] * e2[2] == 0 &&
                e1[0] * e2[1] - e1[1] * e2[0] == 0;
     };
-    for (size_t f = 0; f < mesh.triangle_count(); ++f)
-        out.flattened += zero_area(decoded, &mesh.indices[3 * f]) && !zero_area(mesh.positions, &mesh.indices[3 * f]);
+    for (size_t f = 0; f < kept.size() / 3; ++f)
+        out.flattened += zero_area(decoded, &kept[3 * f]) && !zero_area(positions, &kept[3 * f]);
     return out;
 }
 
-std::string draco_flattened_note(const DracoEncoded& encoded, uint64_t triangles, const WriteOptions& options) {
-    if (encoded.flattened == 0) return {};
-    return std::to_string(encoded.flattened) + " of the " + std::to_string(triangles) +
-           " triangles have zero area once decoded: thinner than Draco's " +
-           std::to_string(options.draco_position_bits) +
-           "-bit quantization step (the largest extent / (2^bits - 1)); raise --draco-qp, or write without Draco";
+std::vector<std::string> draco_notes(const DracoEncoded& encoded, uint64_t triangles, const WriteOptions& options) {
+    std::vector<std::string> out;
+    if (encoded.dropped)
+        out.push_back(std::to_string(encoded.dropped) + " of the " + std::to_string(triangles) +
+                      " triangles have two corners at one vertex (degenerate), which Draco's encoder drops: left out "
+                      "(write without Draco to keep them; --strict makes this an error)");
+    if (encoded.flattened)
+        out.push_back(std::to_string(encoded.flattened) + " of the " + std::to_string(triangles) +
+                      " triangles have zero area once decoded: thinner than Draco's " +
+                      std::to_string(options.draco_position_bits) +
+                      "-bit quantization step (the largest extent / (2^bits - 1)); raise --draco-qp, or write without "
+                      "Draco");
+    return out;
 }
+
+namespace {
+
+ScalarType scalar_type_of(draco::DataType type) {
+    switch (type) {
+        case draco::DT_INT8: return ScalarType::kInt8;
+        case draco::DT_UINT8: return ScalarType::kUInt8;
+        case draco::DT_INT16: return ScalarType::kInt16;
+        case draco::DT_UINT16: return ScalarType::kUInt16;
+        case draco::DT_INT32: return ScalarType::kInt32;
+        case draco::DT_UINT32: return ScalarType::kUInt32;
+        case draco::DT_FLOAT64: return ScalarType::kFloat64;
+        default: return ScalarType::kFloat32;
+    }
+}
+
+// One stored component of type `type` at `p`, as a double.
+double component_value(const uint8_t* p, draco::DataType type) {
+    switch (type) {
+        case draco::DT_INT8: return double(int8_t(p[0]));
+        case draco::DT_UINT8: return double(p[0]);
+        case draco::DT_INT16: { int16_t v; std::memcpy(&v, p, 2); return v; }
+        case draco::DT_UINT16: { uint16_t v; std::memcpy(&v, p, 2); return v; }
+        case draco::DT_INT32: { int32_t v; std::memcpy(&v, p, 4); return v; }
+        case draco::DT_UINT32: { uint32_t v; std::memcpy(&v, p, 4); return v; }
+        case draco::DT_FLOAT32: { float v; std::memcpy(&v, p, 4); return v; }
+        case draco::DT_FLOAT64: { double v; std::memcpy(&v, p, 8); return v; }
+        default: return 0;
+    }
+}
+
+}  // namespace
 
 DracoDecoded decode_draco(std::span<const std::byte> bytes, const std::string& file_name, uint64_t base_offset,
                           int position_id) {
@@ -320,9 +590,6 @@ DracoDecoded decode_draco(std::span<const std::byte> bytes, const std::string& f
     if (pos->num_components() < 3)
         throw Error(file_name, base_offset, 0,
                     "Draco positions have " + std::to_string(int(pos->num_components())) + " components, need 3");
-    out.normals = mesh->GetNamedAttribute(draco::GeometryAttribute::NORMAL) != nullptr;
-    out.colors = mesh->GetNamedAttribute(draco::GeometryAttribute::COLOR) != nullptr;
-    out.texcoords = mesh->GetNamedAttribute(draco::GeometryAttribute::TEX_COORD) != nullptr;
 
     // Dequantize into `values` (one float3 per attribute value) when positions are quantized.
     std::unique_ptr<draco::PointAttribute> dequantized;
@@ -348,6 +615,46 @@ DracoDecoded decode_draco(std::span<const std::byte> bytes, const std::string& f
             throw Error(file_name, base_offset, 0, "Draco position of point " + std::to_string(p) + " is unreadable");
         std::memcpy(&out.positions[3 * size_t{p}], v, 3 * sizeof(float));
     }
+
+    // Every other attribute, per point. Integer colours are normalised (0..1) whether or not
+    // the file flags them so: colours are fractions of their type's range by convention.
+    for (int32_t a = 0; a < mesh->num_attributes(); ++a) {
+        const draco::PointAttribute* att = mesh->attribute(a);
+        if (att == pos) continue;
+        DracoAttribute d;
+        switch (att->attribute_type()) {
+            case draco::GeometryAttribute::NORMAL: d.kind = DracoAttribute::kNormal; break;
+            case draco::GeometryAttribute::COLOR: d.kind = DracoAttribute::kColor; break;
+            case draco::GeometryAttribute::TEX_COORD: d.kind = DracoAttribute::kTexCoord; break;
+            case draco::GeometryAttribute::GENERIC: d.kind = DracoAttribute::kGeneric; break;
+            default: d.kind = DracoAttribute::kOther; break;
+        }
+        d.unique_id = static_cast<int>(att->unique_id());
+        d.components = att->num_components();
+        d.type = scalar_type_of(att->data_type());
+        if (const draco::AttributeMetadata* md = mesh->GetAttributeMetadataByAttributeId(a)) md->GetEntryString("name", &d.name);
+        const size_t bytes_per = draco::DataTypeLength(att->data_type());
+        if (d.components < 1 || bytes_per == 0 || d.kind == DracoAttribute::kOther) {
+            out.attributes.push_back(std::move(d));
+            continue;
+        }
+        const double scale = d.kind == DracoAttribute::kColor && d.type == ScalarType::kUInt8    ? 255.0
+                             : d.kind == DracoAttribute::kColor && d.type == ScalarType::kUInt16 ? 65535.0
+                                                                                                 : 1.0;
+        d.values.resize(size_t{points} * d.components);
+        std::vector<uint8_t> raw(bytes_per * d.components);
+        for (uint32_t p = 0; p < points; ++p) {
+            const draco::AttributeValueIndex avi = att->mapped_index(draco::PointIndex(p));
+            if (avi.value() >= att->size())
+                throw Error(file_name, base_offset, 0, "Draco " + std::string(kind_name(d.kind)) + " attribute of point " +
+                                                           std::to_string(p) + " is unreadable");
+            att->GetValue(avi, raw.data());
+            for (int c = 0; c < d.components; ++c)
+                d.values[size_t{p} * d.components + c] = component_value(&raw[c * bytes_per], att->data_type()) / scale;
+        }
+        out.attributes.push_back(std::move(d));
+    }
+
     out.indices.resize(size_t{mesh->num_faces()} * 3);
     for (uint32_t f = 0; f < mesh->num_faces(); ++f) {
         const auto& face = mesh->face(draco::FaceIndex(f));

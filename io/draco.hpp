@@ -1,17 +1,24 @@
 // Draco `.drc` meshes, read and written with Google's Draco library (Debian libdraco-dev).
 // Memory class: whole mesh. The writer indexes the soup in memory (io/mesh_index.hpp: the
-// decimator's vertex ids, or exact position welding) and encodes at finish(); the reader holds
-// the whole file and the decoded mesh. The writer refuses cleanly as soon as its estimate
-// (draco_encode_estimate_bytes) passes the --memory budget; the reader refuses files larger
-// than the budget (the decoded mesh, ~50 bytes per triangle, comes on top).
-// Writer settings: position quantization --draco-qp (default 14 bits), compression level
-// --draco-cl 0–10 (default 7; Draco speed = 10 - level, as draco_encoder does), optional
-// area-weighted smooth normals (--normals) quantized with --draco-qn bits.
-// Reader: triangles in Draco's decoded order; MeshHeader::notes gets the bitstream version,
-// the connectivity method (edgebreaker/sequential), the position quantization bits and the
-// attributes present. Draco point clouds (no faces) are refused with a clear io::Error rather
-// than read as zero triangles, so a point cloud never turns silently into an empty mesh.
-// The encode/decode helpers are shared with the glTF reader and writer (KHR_draco_mesh_compression).
+// vertex ids readers and the decimator give, or exact position welding, each with its
+// attribute record) and encodes at finish(); the reader holds the whole file and the decoded
+// mesh. The writer refuses cleanly as soon as its estimate (draco_encode_estimate_bytes) passes
+// the --memory budget; the reader refuses files larger than the budget (the decoded mesh,
+// ~50 bytes per triangle plus its attributes, comes on top).
+// Attributes, read and written: normal, color (uint8, uint16 or float; 3 or 4 components),
+// tex_coord (each set one attribute, up to 4) and generic (each vertex scalar channel one
+// 1-component attribute named by its "name" metadata entry, as Draco's own tools do).
+// Writer settings: position quantization --draco-qp (default 14 bits), normals --draco-qn
+// (10), texture coordinates --draco-qt (12), float colours and generic attributes --draco-qc
+// (10; integer ones are stored exactly), compression level --draco-cl 0–10 (default 7; Draco
+// speed = 10 - level, as draco_encoder does); --normals adds area-weighted smooth normals to a
+// mesh without them. Draco's encoder drops triangles with a repeated vertex and no quantization
+// holds a NaN: both are counted in the writer's notes (errors under --strict).
+// Reader: triangles in Draco's decoded order, the point number as vertex id; MeshHeader::notes
+// gets the bitstream version, the connectivity method (edgebreaker/sequential), the position
+// quantization bits and the attributes present. Draco point clouds (no faces) are refused
+// with a clear io::Error rather than read as zero triangles.
+// The encode/decode helpers are shared with the glTF reader and writer.
 #pragma once
 
 #include "io/format.hpp"
@@ -35,33 +42,61 @@ bool probe_draco(std::span<const std::byte> head, std::optional<uint64_t> file_s
 // its entropy coder's tables, which double with each quantization bit).
 uint64_t draco_encode_estimate_bytes(uint64_t vertex_count, uint64_t triangle_count, const WriteOptions& options);
 
-// Refuses --draco-qp/-qn/-cl out of range, and bit counts whose tables alone pass --memory.
+// Refuses --draco-qp/-qn/-qt/-qc/-cl out of range, and bit counts whose tables alone pass --memory.
 void check_draco_settings(const std::string& file, const WriteOptions& options);
+
+// The channels a Draco bitstream written with `options` keeps of `in` (per corner: normal,
+// colour, texture coordinates, scalars; `gltf`: no scalars, which glTF names differently).
+Channels draco_keep_channels(const Channels& in, const WriteOptions& options, bool gltf);
 
 struct DracoEncoded {
     std::vector<char> bytes;       // the Draco bitstream
     uint64_t point_count = 0;      // vertices the decoder will produce (Draco may split some)
     uint64_t face_count = 0;       // triangles the decoder will produce
     int position_id = -1;          // attribute unique ids (for KHR_draco_mesh_compression)
-    int normal_id = -1;            // -1 without normals
+    int normal_id = -1;            // -1 when absent
+    int color_id = -1;
+    std::vector<int> texcoord_ids;  // per uv set
+    std::vector<int> generic_ids;   // per vertex scalar channel
     Bounds decoded_bounds;         // exact min/max of the dequantized positions
     uint64_t flattened = 0;        // triangles of nonzero area whose dequantized corners have none
+    uint64_t dropped = 0;          // triangles the encoder left out (a repeated vertex)
 };
-// The note a writer gives when quantization flattened triangles (empty when none did).
-std::string draco_flattened_note(const DracoEncoded& encoded, uint64_t triangles, const WriteOptions& options);
+// The notes a writer gives for what the encoding lost (flattened or dropped triangles), each
+// a sentence; empty when nothing was.
+std::vector<std::string> draco_notes(const DracoEncoded& encoded, uint64_t triangles, const WriteOptions& options);
 
-// Encodes `mesh` (and `normals`, 3 floats per vertex, when non-null) with the Draco settings
-// of `options`. Throws io::Error naming `file_name` when Draco refuses (e.g. an empty mesh).
-DracoEncoded encode_draco(const IndexedMesh& mesh, const std::vector<float>* normals, const WriteOptions& options,
-                          const std::string& file_name);
+// Encodes a mesh: `positions` (3 per vertex), `indices` (3 per triangle), the per-vertex
+// `values` of the channels `channels` names (normal, colour in its source type, uv sets,
+// scalars), with the Draco settings of `options`. `flip_v`: texture coordinates are written
+// as v' = 1 - v (glTF's convention; the chunk's v points up). Triangles with a repeated vertex
+// are left out (Draco's encoder drops them) and counted in `dropped` (a writer under --strict
+// refuses them before, with first_repeated_vertex). Throws io::Error naming `file_name` when
+// Draco refuses (e.g. an empty mesh).
+DracoEncoded encode_draco(const std::vector<float>& positions, const std::vector<uint32_t>& indices,
+                          const VertexValues& values, const Channels& channels, const WriteOptions& options,
+                          const std::string& file_name, bool flip_v = false);
+
+// The first triangle of `indices` (3 per triangle) with a repeated vertex, or -1.
+int64_t first_repeated_vertex(const std::vector<uint32_t>& indices);
+
+// One decoded non-position attribute, per point (point p's values at p × components).
+struct DracoAttribute {
+    enum Kind : uint8_t { kNormal, kColor, kTexCoord, kGeneric, kOther } kind = kOther;
+    int unique_id = -1;
+    int components = 0;
+    ScalarType type = ScalarType::kFloat32;  // as stored (float for quantized attributes)
+    std::string name;                        // the "name" metadata entry, if any
+    std::vector<double> values;              // integer colours normalised to 0..1
+};
 
 struct DracoDecoded {
     std::vector<float> positions;   // xyz per point, dequantized exactly as Draco does
     std::vector<uint32_t> indices;  // 3 per face
+    std::vector<DracoAttribute> attributes;  // in the bitstream's order
     int version_major = 0, version_minor = 0;
     bool edgebreaker = false;
     int position_bits = 0;          // 0: positions not quantized
-    bool normals = false, colors = false, texcoords = false;
 };
 
 // Decodes a Draco mesh bitstream. `position_id` selects the position attribute by unique id

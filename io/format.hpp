@@ -190,9 +190,14 @@ struct WriteOptions {
     // Draco / glTF
     int draco_position_bits = 14;  // --draco-qp
     int draco_normal_bits = 10;    // --draco-qn
+    int draco_texcoord_bits = 12;  // --draco-qt
+    int draco_color_bits = 10;     // --draco-qc: float colours and generic attributes
     int draco_level = 7;           // --draco-cl, 0–10
     bool normals = false;          // --normals: write smooth vertex normals where supported
-    bool draco = true;             // glTF: KHR_draco_mesh_compression (--no-draco turns off)
+    // glTF (--compress): KHR_draco_mesh_compression, EXT_meshopt_compression with
+    // KHR_mesh_quantization, or plain accessors.
+    enum class Compression : uint8_t { kDraco, kMeshopt, kNone };
+    Compression compression = Compression::kDraco;
 };
 
 struct Format {
@@ -209,7 +214,7 @@ struct Format {
     // What the writer keeps or does beyond positions, for the commands' checks and warnings.
     enum Trait : uint8_t {
         kAlwaysDraco = 2,      // Draco-compressed (reorders triangles; takes --draco-* and --normals)
-        kDracoUnlessOff = 4,   // the same unless --no-draco (glTF)
+        kDracoUnlessOff = 4,   // the same unless --compress meshopt|none (glTF; takes --compress)
     };
     uint8_t traits = 0;
     // For formats without magic bytes: a weaker test, tried only when no probe and no

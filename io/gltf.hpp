@@ -1,18 +1,31 @@
-// glTF 2.0: binary `.glb` and JSON `.gltf` (+ `.bin` side file), through tinygltf (Debian
-// libtinygltf-dev, the compiled library) and, for KHR_draco_mesh_compression, Draco.
+// glTF 2.0: binary `.glb` and JSON `.gltf` (+ `.bin` side file). Reading through tinygltf
+// (Debian libtinygltf-dev, the compiled library); KHR_draco_mesh_compression through Draco and
+// EXT_meshopt_compression through libmeshoptimizer (Debian libmeshoptimizer-dev), both ways.
 // Memory class: whole document. The writer indexes the soup in memory (io/mesh_index.hpp) and
 // serialises at finish(); it refuses cleanly once its estimate passes --memory. The reader
 // reads the whole document (and its external buffers) into memory, because tinygltf parses
 // from memory, and refuses documents larger than --memory.
 //
-// Writer: one mesh, one TRIANGLES primitive on one node of the default scene; POSITION with
-// exact min/max, optional NORMAL (--normals: area-weighted smooth normals), indices of the
-// smallest component type that fits (restart values excluded), asset.generator
-// "meshstream <version>". With Draco (the default; --no-draco off) the primitive carries
-// KHR_draco_mesh_compression, listed in extensionsUsed and extensionsRequired, and its
-// accessors have no bufferView but the decoded count, min and max. `.gltf` writes its buffer
-// to `<stem>.bin` beside it (committed atomically with it); to stdout the buffer is embedded
-// as a base64 data URI. An empty mesh becomes a valid document with an empty scene.
+// Writer: one mesh on one node of the default scene, one TRIANGLES primitive per material
+// (one in all without materials), each with its own vertices; asset.generator
+// "meshstream <version>". Every triangle is kept, degenerate ones too, except with Draco,
+// whose encoder drops those with a repeated vertex, and those with a NaN or infinite
+// coordinate, which no accessor may hold: both are counted in notes() (errors under --strict).
+// --compress (WriteOptions::compression) chooses the encoding:
+// - draco (the default): each primitive carries KHR_draco_mesh_compression (in extensionsUsed
+//   and extensionsRequired); its accessors have no bufferView but the decoded count, min and max;
+// - meshopt: as gltfpack -cc: positions quantized to 14-bit unsigned integers
+//   (KHR_mesh_quantization) over the mesh's bounding cube, the node's translation and uniform
+//   scale undoing it; triangles reordered for the vertex cache (meshopt_optimizeVertexCacheStrip,
+//   unless the stream is sorted: WriteOptions::sorted_axis keeps the order) and vertices by first
+//   use; every vertex and index stream compressed with meshoptimizer's codecs (index codec
+//   version 1) in buffer 0, the views in a data-less fallback buffer (EXT_meshopt_compression
+//   and KHR_mesh_quantization required); normals 8-bit octahedral (OCTAHEDRAL filter);
+// - none: float POSITION with exact min/max, indices of the smallest type that fits (restart
+//   values excluded).
+// --normals adds area-weighted smooth normals to a mesh without its own. `.gltf` writes its
+// buffer to `<stem>.bin` beside it (committed atomically with it); to stdout the buffer is
+// embedded as a base64 data URI. An empty mesh becomes a valid document with an empty scene.
 //
 // Reader: the default scene's node tree (or, without scenes, every mesh once) with node
 // transforms applied, so the soup is in world space; winding is flipped under mirroring

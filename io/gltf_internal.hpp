@@ -31,7 +31,10 @@ std::unique_ptr<Reader> open_gltf_reader(ByteSource& source, const ReadOptions& 
 // io/gltf_writer.cpp.
 std::unique_ptr<Writer> open_glb_writer(ByteSink& sink, const WriteOptions& options);
 std::unique_ptr<Writer> open_gltf_writer(ByteSink& sink, const WriteOptions& options);
-// The .bin a .gltf output at `path` writes beside it (none when written in place).
+// The files a .gltf output at `path` writes beside it: its .bin and its materials' texture
+// images (none when written in place).
 std::vector<std::string> gltf_side_files(const std::string& path, const WriteOptions& options);
+// The channels a glTF writer keeps (the same with every --compress).
+Channels gltf_keep_channels(const Channels& in, const WriteOptions& options);
 
 }  // namespace meshstream::io::gltf_detail

@@ -311,8 +311,8 @@ public:
         if (glb) {
             // Where the BIN chunk's data starts in the file (buffer 0), for error positions;
             // taken before the JSON is rewritten below.
-            const uint64_t json_end = 20 + uint64_t{get_u32(&bytes[12])};
-            if (bytes.size() >= 20 && json_end + 8 <= bytes.size() && get_u32(&bytes[json_end + 4]) == kChunkBin)
+            const uint64_t json_end = bytes.size() >= 20 ? 20 + uint64_t{get_u32(&bytes[12])} : 0;
+            if (json_end != 0 && json_end + 8 <= bytes.size() && get_u32(&bytes[json_end + 4]) == kChunkBin)
                 bin_offset_ = json_end + 8;
         }
         rewrite_for_tinygltf(bytes, glb);

@@ -1,8 +1,14 @@
 // Turns a triangle soup into an indexed mesh in memory, for the whole-mesh writers (Draco and
-// glTF). Vertices are the decimator's vertex ids when the chunks carry the vertex_id channel,
-// otherwise exact position welding (bit-equal floats, with -0 == +0), through an
-// open-addressing hash table of 32-bit vertex indices (linear probing, load <= 1/2).
-// Memory class: whole mesh, about 36 bytes per vertex plus 12 per triangle while indexing.
+// glTF). A vertex is a position (or, when the chunks carry the vertex_id channel, a vertex id)
+// together with its per-corner attributes (io::CornerLayout's record: normal, colour, texture
+// coordinates, scalars): corners that agree on both are one vertex, so a UV or normal seam stays
+// two vertices. Positions weld when bit-equal (-0 == +0). An open-addressing hash table of
+// 32-bit vertex indices (linear probing, load <= 1/2) finds them.
+// Every triangle is kept in input order (degenerate ones too: the writers decide what their
+// format can hold), except those with a NaN or infinite coordinate, which no writer here can
+// store: they are dropped and counted, or refused under `strict`.
+// Memory class: whole mesh: per vertex 12 bytes of position, the record, 8 bytes of id in id
+// mode and about 8 bytes of hash table; per triangle 12 bytes of indices (+4 with materials).
 #pragma once
 
 #include "io/chunk.hpp"
@@ -10,23 +16,57 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
 namespace meshstream::io {
 
+// The triangles of one material, with their own vertices: what one glTF primitive (or one
+// Draco bitstream) holds.
+struct MeshPart {
+    uint32_t material = 0;           // index into the material table (0 without materials)
+    std::vector<uint32_t> vertices;  // the mesh vertex of each part vertex, in first-use order
+    std::vector<uint32_t> indices;   // 3 per triangle, into `vertices`, in the mesh's order
+    size_t vertex_count() const { return vertices.size(); }
+    size_t triangle_count() const { return indices.size() / 3; }
+};
+
+// A set of vertices' attribute values, unpacked from their records, channel by channel (each
+// array empty when its channel is absent).
+struct VertexValues {
+    std::vector<float> normals;                // 3 per vertex
+    std::vector<float> colors;                 // 4 per vertex: RGBA, 0..1 for integer sources
+    std::vector<std::vector<float>> uvs;       // per set: 2 per vertex (u, v; v up, as in the chunk)
+    std::vector<std::vector<double>> scalars;  // per Channels::vertex_scalars entry: 1 per vertex
+};
+
 struct IndexedMesh {
-    std::vector<float> positions;   // xyz per vertex
-    std::vector<uint32_t> indices;  // 3 per triangle, counter-clockwise as in the soup
+    Channels channels;                  // per vertex: those of `attributes`; per triangle: material
+    std::vector<float> positions;       // xyz per vertex
+    std::vector<std::byte> attributes;  // CornerLayout(channels).bytes() per vertex
+    std::vector<uint32_t> indices;      // 3 per triangle, counter-clockwise as in the soup
+    std::vector<uint32_t> materials;    // per triangle, when channels.material
+
     size_t vertex_count() const { return positions.size() / 3; }
     size_t triangle_count() const { return indices.size() / 3; }
     // Per-axis min/max of the positions (all zero for an empty mesh).
     Bounds bounds() const;
-    // Area-weighted smooth vertex normals: the sum of the incident faces' unnormalised
-    // cross products, normalised. A vertex whose faces all have zero area gets (0, 0, 1).
-    // Returns 3 floats per vertex, each of unit length.
+    // Area-weighted smooth vertex normals: for each position, the sum of the cross products of
+    // the triangles at it (every vertex there: a UV seam does not split the normal), normalised.
+    // A position whose triangles all have zero area gets (0, 0, 1). 3 floats per vertex.
     std::vector<float> smooth_normals() const;
+    // The triangles split by material (one part when there is no material channel), in material
+    // order, parts without triangles left out. Costs about the indices and vertices again.
+    std::vector<MeshPart> parts() const;
+    // The attribute values of `vertices` (mesh vertex indices), in that order.
+    VertexValues values(std::span<const uint32_t> vertices) const;
 };
+
+// Bytes an IndexedMesh of this size holds with these channels (the indexer's tables included),
+// for the writers' --memory estimates.
+uint64_t indexed_mesh_bytes(uint64_t vertices, uint64_t triangles, const Channels& channels);
 
 // For the whole-mesh writers' --memory checks. `need(vertices, triangles)` is a writer's
 // estimate of the bytes it holds for a mesh of that size; `why` says why it holds the whole mesh
@@ -41,39 +81,49 @@ void budget_check(const std::string& file, const WriteOptions& options, const ch
 
 class MeshIndexer {
 public:
-    // `file_name` names the output in error messages.
-    explicit MeshIndexer(std::string file_name);
+    // `file_name` names the output in error messages, `format` the format in them ("Draco",
+    // "glTF"). `channels`: those of the chunks to come (vertex ids are decided by the first
+    // non-empty chunk); the record of each vertex keeps the per-corner ones, `materials()` the
+    // per-triangle material. `strict`: a non-finite coordinate is an error instead of a drop.
+    MeshIndexer(std::string file_name, std::string format, const Channels& channels, bool strict);
 
-    // Adds a chunk's triangles. Triangles whose corners index the same vertex twice (zero area
-    // after welding) are dropped and counted in dropped_triangle_count(): Draco's edgebreaker
-    // drops them anyway, and glTF viewers gain nothing from them. Throws io::Error for a
-    // non-finite coordinate (naming the triangle's index in the stream), when the index count
-    // would pass 2^32 - 1 (32-bit glTF/Draco indices), or when the vertex_id channel appears
-    // or disappears mid-stream.
+    // Adds a chunk's triangles. Throws io::Error when the index count would pass 2^32 - 1
+    // (32-bit glTF/Draco indices), when the vertex_id channel appears or disappears mid-stream,
+    // and under `strict` for a triangle with a NaN or infinite coordinate (naming its index in
+    // the stream), which is otherwise dropped and counted.
     void add(const TriangleChunk& chunk);
 
     uint64_t input_triangle_count() const { return input_triangles_; }
-    uint64_t dropped_triangle_count() const { return dropped_; }
+    // Triangles dropped for a NaN or infinite coordinate.
+    uint64_t non_finite_count() const { return non_finite_; }
+    // Attribute values (normal, colour, uv, scalar) that were NaN or infinite, written as 0.
+    uint64_t non_finite_attribute_count() const { return non_finite_attributes_; }
     size_t vertex_count() const { return mesh_.vertex_count(); }
     size_t triangle_count() const { return mesh_.triangle_count(); }
-    // Bytes held by the tables now (positions, ids, hash slots, indices), for budget checks.
+    // What a writer says of the two counts above, a sentence each (none when both are 0).
+    std::vector<std::string> notes() const;
+    // Bytes held by the tables now (positions, records, ids, hash slots, indices), for budget checks.
     uint64_t memory_bytes() const;
 
     // Releases the mesh; the indexer is empty afterwards.
     IndexedMesh take();
 
 private:
-    uint32_t vertex_for_position(const float* p);
-    uint32_t vertex_for_id(uint64_t id, const float* p);
+    uint32_t vertex_for(const float* p, uint64_t id, const std::byte* record);
+    uint64_t hash_of(uint32_t v) const;
     void grow();
 
     std::string file_name_;
+    std::string format_;
+    bool strict_;
+    CornerLayout layout_;
     IndexedMesh mesh_;
-    std::vector<uint64_t> ids_;      // per vertex, in id mode
-    std::vector<uint32_t> slots_;    // hash table of vertex indices; kEmpty = free
-    int id_mode_ = -1;               // -1 undecided, 0 positions, 1 vertex ids
+    std::vector<uint64_t> ids_;    // per vertex, in id mode
+    std::vector<uint32_t> slots_;  // hash table of vertex indices; kEmpty = free
+    std::vector<std::byte> record_;  // scratch: one corner's record
+    int id_mode_ = -1;             // -1 undecided, 0 positions, 1 vertex ids
     uint64_t input_triangles_ = 0;
-    uint64_t dropped_ = 0;
+    uint64_t non_finite_ = 0, non_finite_attributes_ = 0;
 };
 
 }  // namespace meshstream::io

@@ -74,29 +74,38 @@ void note_unused_write_flags(const WriteFlags& flags, const io::Format& output, 
     if (flags.gzip_level != WriteFlags{}.gzip_level && (output_path == "-" || !io::wants_gzip(output_path)))
         warnings.note("unused_option", "--gzip-level applies to outputs named *.gz: ignored for " +
                       (output_path == "-" ? std::string("<stdout> (pipe it through gzip)") : output_path));
-    if (output.traits & (io::Format::kAlwaysDraco | io::Format::kDracoUnlessOff)) {
-        if ((output.traits & io::Format::kAlwaysDraco) && !flags.draco)
-            warnings.note("unused_option", "--no-draco applies to glTF outputs; a .drc is Draco");
-        const WriteFlags defaults;
-        if ((output.traits & io::Format::kDracoUnlessOff) && !flags.draco &&
-            (flags.draco_qp != defaults.draco_qp || flags.draco_qn != defaults.draco_qn ||
-             flags.draco_cl != defaults.draco_cl))
-            warnings.note("unused_option", "--draco-qp, --draco-qn and --draco-cl apply to Draco compression: ignored with --no-draco");
+    const WriteFlags defaults;
+    std::string draco_given;  // the Draco settings given, which only a Draco encoding uses
+    auto add_to = [](std::string& list, bool set, const char* name) {
+        if (set) list += (list.empty() ? "" : ", ") + std::string(name);
+    };
+    add_to(draco_given, flags.draco_qp != defaults.draco_qp, "--draco-qp");
+    add_to(draco_given, flags.draco_qn != defaults.draco_qn, "--draco-qn");
+    add_to(draco_given, flags.draco_qt != defaults.draco_qt, "--draco-qt");
+    add_to(draco_given, flags.draco_qc != defaults.draco_qc, "--draco-qc");
+    add_to(draco_given, flags.draco_cl != defaults.draco_cl, "--draco-cl");
+    const bool compress_given = !flags.compress.empty() || flags.no_draco;
+    auto verb = [](const std::string& list) { return list.find(',') == std::string::npos ? " applies" : " apply"; };
+    if (output.traits & io::Format::kAlwaysDraco) {
+        if (compress_given && flags.compression() != io::WriteOptions::Compression::kDraco)
+            warnings.note("unused_option", std::string(flags.no_draco ? "--no-draco" : "--compress") +
+                          " applies to glTF outputs; a .drc is always Draco");
         return;
     }
-    const WriteFlags defaults;
+    if (output.traits & io::Format::kDracoUnlessOff) {
+        const auto c = flags.compression();
+        if (!draco_given.empty() && c != io::WriteOptions::Compression::kDraco)
+            warnings.note("unused_option", draco_given + verb(draco_given) + " to Draco compression: ignored with --compress " +
+                          (c == io::WriteOptions::Compression::kMeshopt ? "meshopt" : "none"));
+        return;
+    }
     std::string given;
-    auto add = [&](bool set, const char* name) {
-        if (set) given += (given.empty() ? "" : ", ") + std::string(name);
-    };
-    add(flags.normals, "--normals");
-    add(!flags.draco, "--no-draco");
-    add(flags.draco_qp != defaults.draco_qp, "--draco-qp");
-    add(flags.draco_qn != defaults.draco_qn, "--draco-qn");
-    add(flags.draco_cl != defaults.draco_cl, "--draco-cl");
+    add_to(given, flags.normals, "--normals");
+    add_to(given, compress_given, flags.no_draco ? "--no-draco" : "--compress");
+    if (!draco_given.empty()) given += (given.empty() ? "" : ", ") + draco_given;
     if (!given.empty())
-        warnings.note("unused_option", given + (given.find(',') == std::string::npos ? " applies" : " apply") +
-                      " to Draco and glTF outputs only: ignored for " + std::string(output.name));
+        warnings.note("unused_option",
+                      given + verb(given) + " to Draco and glTF outputs only: ignored for " + std::string(output.name));
 }
 
 bool names_a_pipe(const std::string& output) {
@@ -265,12 +274,20 @@ io::WriteOptions WriteFlags::options(const ReadFlags& read) const {
     o.memory_budget_bytes = parse_bytes(read.memory);
     o.tmpdir = read.tmpdir;
     o.strict = read.strict;
-    o.draco = draco;
+    o.compression = compression();
     o.normals = normals;
     o.draco_position_bits = draco_qp;
     o.draco_normal_bits = draco_qn;
+    o.draco_texcoord_bits = draco_qt;
+    o.draco_color_bits = draco_qc;
     o.draco_level = draco_cl;
     return o;
+}
+
+io::WriteOptions::Compression WriteFlags::compression() const {
+    if (compress == "meshopt") return io::WriteOptions::Compression::kMeshopt;
+    if (compress == "none" || (compress.empty() && no_draco)) return io::WriteOptions::Compression::kNone;
+    return io::WriteOptions::Compression::kDraco;
 }
 
 void add_write_flags(CLI::App* cmd, WriteFlags& flags) {
@@ -285,14 +302,26 @@ void add_write_flags(CLI::App* cmd, WriteFlags& flags) {
     auto* web = cmd->add_option_group("Draco / glTF output",
                                       ".drc, .glb and .gltf are written from the whole mesh in memory; past --memory "
                                       "they stop with an error asking for a larger --memory");
-    web->add_flag_callback("--no-draco", [&flags] { flags.draco = false; },
-                           "glTF: plain accessors instead of KHR_draco_mesh_compression (Draco is the default)");
-    web->add_flag("--normals", flags.normals, "Draco/glTF: write area-weighted smooth vertex normals");
+    auto* compress =
+        web->add_option("--compress", flags.compress,
+                        "glTF compression: draco (KHR_draco_mesh_compression, the default), meshopt "
+                        "(EXT_meshopt_compression with 14-bit quantized positions, like gltfpack -cc; needs a viewer "
+                        "with a meshopt decoder, e.g. three.js with MeshoptDecoder) or none (plain float accessors)")
+            ->check(CLI::IsMember({"draco", "meshopt", "none"}));
+    web->add_flag("--no-draco", flags.no_draco, "The same as --compress none (its older spelling)")->excludes(compress);
+    web->add_flag("--normals", flags.normals,
+                  "Draco/glTF: write area-weighted smooth vertex normals (when the input has no normals of its own)");
     web->add_option("--draco-qp", flags.draco_qp, "Draco position quantization bits, 1-30 (default 14)")
         ->check(CLI::Range(1, 30));
     // Draco's octahedral normal coder needs 2 bits or more (1 fails inside its encoder).
     web->add_option("--draco-qn", flags.draco_qn, "Draco normal quantization bits, 2-30 (default 10)")
         ->check(CLI::Range(2, 30));
+    web->add_option("--draco-qt", flags.draco_qt, "Draco texture coordinate quantization bits, 1-30 (default 12)")
+        ->check(CLI::Range(1, 30));
+    web->add_option("--draco-qc", flags.draco_qc,
+                    "Draco quantization bits of float colours and generic attributes (scalars), 1-30 (default 10; "
+                    "integer ones are kept exactly)")
+        ->check(CLI::Range(1, 30));
     web->add_option("--draco-cl", flags.draco_cl, "Draco compression level 0-10 (default 7; higher is slower, "
                                                   "usually smaller)")
         ->check(CLI::Range(0, 10));

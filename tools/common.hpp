@@ -54,9 +54,12 @@ void strict_refuses_dropped_triangles(CLI::App* cmd);
 struct WriteFlags {
     std::string to;  // --to: force the output format
     int gzip_level = 6;
-    bool draco = true;
+    std::string compress;   // --compress draco|meshopt|none (glTF); empty: not given (Draco)
+    bool no_draco = false;  // --no-draco: the old spelling of --compress none
     bool normals = false;
-    int draco_qp = 14, draco_qn = 10, draco_cl = 7;
+    int draco_qp = 14, draco_qn = 10, draco_qt = 12, draco_qc = 10, draco_cl = 7;
+    // The glTF compression asked for: --compress, --no-draco, else Draco.
+    io::WriteOptions::Compression compression() const;
     io::WriteOptions options(const ReadFlags& read) const;
 };
 // `with_memory`: false when add_read_flags already added --memory/--tmpdir to `cmd`.

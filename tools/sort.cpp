@@ -164,10 +164,11 @@ void run_sort(const SortOptions& opt) {
     const io::Format& out_format = resolve_output_format(opt.output, opt.write);
     // Draco's connectivity coder reorders the triangles: the sorted order would be lost.
     if ((out_format.traits & io::Format::kAlwaysDraco) ||
-        ((out_format.traits & io::Format::kDracoUnlessOff) && opt.write.draco))
+        ((out_format.traits & io::Format::kDracoUnlessOff) &&
+         opt.write.compression() == io::WriteOptions::Compression::kDraco))
         throw UsageError((opt.output == "-" ? std::string("<stdout>") : opt.output) +
                          ": Draco compression reorders triangles, so the sorted order would be lost: write STL, PLY "
-                         "or OBJ (or glTF with --no-draco)");
+                         "or OBJ (or glTF with --compress meshopt or none)");
     // Runs go beside a file output; a pipe or device (/dev/null, /dev/stdout) has no directory
     // of its own for them: /dev is memory.
     const bool output_stream = io::is_stream(opt.output);

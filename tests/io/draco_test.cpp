@@ -191,18 +191,30 @@ TEST(DracoWriter, RefusesPastMemoryBudgetAndLeavesNoFile) {
     EXPECT_TRUE(fs::is_empty(dir.path()));
 }
 
-TEST(DracoWriter, RefusesEmptyMeshAndNonFiniteCoordinates) {
+TEST(DracoWriter, RefusesEmptyMeshAndLeavesOutNonFiniteTriangles) {
+    // No quantization holds a NaN: such a triangle is left out and counted in a note, or, with
+    // --strict, refused by its number in the stream.
     TempDir dir;
     EXPECT_THROW(write_soup(Soup{}, dir / "empty.drc"), io::Error);
     Soup bad;
-    bad.xyz = {0, 0, 0, 1, 0, 0, 0, NAN, 0};
+    bad.xyz = {0, 0, 0, 1, 0, 0, 0, NAN, 0, 0, 0, 0, 1, 0, 0, 0, 1, 0};
+    const std::vector<std::string> notes = write_soup(bad, dir / "nan.drc");
+    ASSERT_EQ(notes.size(), 1u);
+    EXPECT_EQ(notes[0], dir / "nan.drc" + ": 1 of the 2 triangles have a NaN or infinite coordinate, which Draco cannot "
+                                          "store: left out (--strict makes this an error)");
+    EXPECT_EQ(read_soup(dir / "nan.drc").triangles(), 1u);
+    io::WriteOptions strict;
+    strict.strict = true;
     try {
-        write_soup(bad, dir / "nan.drc");
+        write_soup(bad, dir / "strict.drc", strict);
         FAIL();
     } catch (const io::Error& e) {
-        EXPECT_NE(std::string(e.what()).find("triangle 0 has a non-finite coordinate"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("triangle 0 has a NaN or infinite coordinate, which Draco cannot store "
+                                             "(--strict)"),
+                  std::string::npos)
+            << e.what();
     }
-    EXPECT_TRUE(fs::is_empty(dir.path()));
+    EXPECT_FALSE(fs::exists(dir / "strict.drc"));
 }
 
 TEST(DracoWriter, RefusesExtentsItsQuantizerCannotStepThrough) {

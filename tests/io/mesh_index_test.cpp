@@ -1,6 +1,7 @@
-// MeshIndexer tests: exact welding (-0 == +0), vertex-id mode, dropped index-degenerate
-// triangles, non-finite refusal with the triangle's index, growth past the initial table, and
-// unit-length area-weighted normals.
+// MeshIndexer tests: exact welding (-0 == +0), vertex-id mode, vertices keyed by their attribute
+// record too (seams stay apart), degenerate triangles kept, non-finite ones dropped and counted
+// (refused under strict, naming the triangle), parts by material, growth past the initial table,
+// and unit-length area-weighted normals shared across seams.
 #include "io/mesh_index.hpp"
 
 #include "io/error.hpp"
@@ -24,7 +25,7 @@ io::TriangleChunk chunk_of(std::initializer_list<std::array<float, 9>> tris, io:
 }
 
 TEST(MeshIndexer, WeldsExactPositionsTreatingMinusZeroAsZero) {
-    io::MeshIndexer ix("out.glb");
+    io::MeshIndexer ix("out.glb", "glTF", {}, false);
     ix.add(chunk_of({{0, 0, 0, 1, 0, 0, 1, 1, 0}, {-0.0f, 0, 0, 1, 1, 0, 0, 1, 0}}));
     EXPECT_EQ(ix.vertex_count(), 4u);
     io::IndexedMesh m = ix.take();
@@ -32,7 +33,7 @@ TEST(MeshIndexer, WeldsExactPositionsTreatingMinusZeroAsZero) {
 }
 
 TEST(MeshIndexer, UsesVertexIdsWhenPresent) {
-    io::MeshIndexer ix("out.glb");
+    io::MeshIndexer ix("out.glb", "glTF", io::Channels::ids_only(), false);
     io::TriangleChunk c = chunk_of({{0, 0, 0, 1, 0, 0, 1, 1, 0}, {0, 0, 0, 1, 1, 0, 0, 1, 0}}, io::Channels::ids_only());
     const uint64_t ids[6] = {7, 8, 9, 17, 9, 18};  // corner 1 of triangle 1 shares id 9
     for (int t = 0; t < 2; ++t)
@@ -42,29 +43,101 @@ TEST(MeshIndexer, UsesVertexIdsWhenPresent) {
     EXPECT_THROW(ix.add(chunk_of({{0, 0, 0, 1, 0, 0, 1, 1, 0}})), io::Error);  // channel vanished
 }
 
-TEST(MeshIndexer, DropsTrianglesThatWeldToAnEdge) {
-    io::MeshIndexer ix("out.glb");
-    ix.add(chunk_of({{0, 0, 0, 1, 0, 0, 0, 0, 0}, {0, 0, 0, 1, 0, 0, 1, 1, 0}}));
-    EXPECT_EQ(ix.input_triangle_count(), 2u);
-    EXPECT_EQ(ix.dropped_triangle_count(), 1u);
-    EXPECT_EQ(ix.triangle_count(), 1u);
+TEST(MeshIndexer, KeysVerticesOnTheirAttributesToo) {
+    // A quad whose two triangles meet along a seam: the shared corners have one position but
+    // different texture coordinates (and, in the second chunk, one uv but different normals).
+    io::Channels ch;
+    ch.uv_sets = 1;
+    ch.normal = true;
+    io::MeshIndexer ix("out.glb", "glTF", ch, false);
+    io::TriangleChunk c = chunk_of({{0, 0, 0, 1, 0, 0, 1, 1, 0}, {0, 0, 0, 1, 1, 0, 0, 1, 0}}, ch);
+    const float uv[2][6] = {{0, 0, 1, 0, 1, 1}, {0.5f, 0, 1, 1, 0, 1}};  // corner 0 differs, corner 1 (1,1,0) agrees
+    for (int t = 0; t < 2; ++t) {
+        std::copy(uv[t], uv[t] + 6, c.uv_at(t, 0));
+        for (int k = 0; k < 3; ++k) c.normal_at(t)[3 * k + 2] = 1;
+    }
+    ix.add(c);
+    EXPECT_EQ(ix.vertex_count(), 5u);  // (0,0,0) twice: its uv differs
+    io::IndexedMesh m = ix.take();
+    EXPECT_EQ(m.indices, (std::vector<uint32_t>{0, 1, 2, 3, 2, 4}));
+    ASSERT_EQ(m.attributes.size(), 5 * io::CornerLayout(ch).bytes());
+    io::VertexValues v = m.values(std::vector<uint32_t>{3});
+    EXPECT_EQ(v.uvs[0], (std::vector<float>{0.5f, 0}));
+    EXPECT_EQ(v.normals, (std::vector<float>{0, 0, 1}));
+    // Smooth normals are summed per position, across the seam: both (0,0,0) get the same.
+    const std::vector<float> n = m.smooth_normals();
+    EXPECT_EQ(std::vector<float>(n.begin(), n.begin() + 3), std::vector<float>(n.begin() + 9, n.begin() + 12));
 }
 
-TEST(MeshIndexer, RefusesNonFiniteNamingTheTriangle) {
-    io::MeshIndexer ix("out.glb");
-    ix.add(chunk_of({{0, 0, 0, 1, 0, 0, 1, 1, 0}}));
+TEST(MeshIndexer, KeepsDegenerateTrianglesInOrder) {
+    // glTF holds them; the Draco writer drops them itself (and says so).
+    io::MeshIndexer ix("out.glb", "glTF", {}, false);
+    ix.add(chunk_of({{0, 0, 0, 1, 0, 0, 0, 0, 0}, {0, 0, 0, 1, 0, 0, 1, 1, 0}, {2, 2, 2, 2, 2, 2, 2, 2, 2}}));
+    EXPECT_EQ(ix.input_triangle_count(), 3u);
+    EXPECT_EQ(ix.triangle_count(), 3u);
+    io::IndexedMesh m = ix.take();
+    EXPECT_EQ(m.indices, (std::vector<uint32_t>{0, 1, 0, 0, 1, 2, 3, 3, 3}));
+}
+
+TEST(MeshIndexer, DropsNonFiniteTrianglesOrRefusesThemUnderStrict) {
+    io::MeshIndexer ix("out.glb", "glTF", {}, false);
+    ix.add(chunk_of({{0, 0, 0, 1, 0, 0, 1, 1, 0}, {0, 0, 0, NAN, 0, 0, 1, 1, 0}, {0, 0, 1, 1, 0, 1, 1, 1, 1}}));
+    EXPECT_EQ(ix.input_triangle_count(), 3u);
+    EXPECT_EQ(ix.non_finite_count(), 1u);
+    EXPECT_EQ(ix.triangle_count(), 2u);
+    ASSERT_EQ(ix.notes().size(), 1u);
+    EXPECT_EQ(ix.notes()[0], "1 of the 3 triangles have a NaN or infinite coordinate, which glTF cannot store: left "
+                             "out (--strict makes this an error)");
+    io::MeshIndexer strict("out.drc", "Draco", {}, true);
+    strict.add(chunk_of({{0, 0, 0, 1, 0, 0, 1, 1, 0}}));
     try {
-        ix.add(chunk_of({{0, 0, 0, INFINITY, 0, 0, 1, 1, 0}}));
+        strict.add(chunk_of({{0, 0, 0, INFINITY, 0, 0, 1, 1, 0}}));
         FAIL();
     } catch (const io::Error& e) {
-        EXPECT_EQ(e.file(), "out.glb");
-        EXPECT_NE(std::string(e.what()).find("triangle 1 has a non-finite coordinate"), std::string::npos) << e.what();
+        EXPECT_EQ(e.file(), "out.drc");
+        EXPECT_NE(std::string(e.what()).find("triangle 1 has a NaN or infinite coordinate, which Draco cannot store "
+                                             "(--strict)"),
+                  std::string::npos)
+            << e.what();
     }
+}
+
+TEST(MeshIndexer, NonFiniteAttributeValuesAreWrittenAsZeroAndCounted) {
+    io::Channels ch;
+    ch.uv_sets = 1;
+    io::MeshIndexer ix("out.glb", "glTF", ch, false);
+    io::TriangleChunk c = chunk_of({{0, 0, 0, 1, 0, 0, 1, 1, 0}}, ch);
+    c.uv_at(0, 0)[3] = NAN;
+    ix.add(c);
+    io::IndexedMesh m = ix.take();
+    EXPECT_EQ(ix.non_finite_attribute_count(), 1u);
+    EXPECT_EQ(m.values(std::vector<uint32_t>{1}).uvs[0], (std::vector<float>{0, 0}));
+}
+
+TEST(MeshIndexer, PartsSplitTrianglesByMaterialWithTheirOwnVertices) {
+    io::Channels ch;
+    ch.material = true;
+    io::MeshIndexer ix("out.glb", "glTF", ch, false);
+    io::TriangleChunk c = chunk_of({{0, 0, 0, 1, 0, 0, 1, 1, 0}, {0, 0, 0, 1, 1, 0, 0, 1, 0}, {5, 5, 5, 6, 5, 5, 6, 6, 5}}, ch);
+    *c.material_at(0) = 2;
+    *c.material_at(1) = 0;
+    *c.material_at(2) = 2;
+    ix.add(c);
+    io::IndexedMesh m = ix.take();
+    EXPECT_EQ(m.materials, (std::vector<uint32_t>{2, 0, 2}));
+    const std::vector<io::MeshPart> parts = m.parts();
+    ASSERT_EQ(parts.size(), 2u);  // material 1 has no triangles
+    EXPECT_EQ(parts[0].material, 0u);
+    EXPECT_EQ(parts[0].vertices, (std::vector<uint32_t>{0, 2, 3}));
+    EXPECT_EQ(parts[0].indices, (std::vector<uint32_t>{0, 1, 2}));
+    EXPECT_EQ(parts[1].material, 2u);
+    EXPECT_EQ(parts[1].vertices, (std::vector<uint32_t>{0, 1, 2, 4, 5, 6}));
+    EXPECT_EQ(parts[1].indices, (std::vector<uint32_t>{0, 1, 2, 3, 4, 5}));
 }
 
 TEST(MeshIndexer, GrowsPastTheInitialTable) {
     // A 100 x 100 grid: 10201 distinct vertices, each shared by up to six triangles.
-    io::MeshIndexer ix("grid.drc");
+    io::MeshIndexer ix("grid.drc", "Draco", {}, false);
     io::TriangleChunk c(64);
     for (int y = 0; y < 100; ++y)
         for (int x = 0; x < 100; ++x) {

@@ -188,9 +188,24 @@ TEST(CliConvert, DracoOptionsForOtherOutputsAreSaidToDoNothing) {
     EXPECT_EQ(glb.err.find("warning"), std::string::npos) << glb.err;
     cli_test::CliRun plain = run("convert --no-draco --draco-cl 9 " + cube + " " + dir / "p.glb");
     EXPECT_EQ(plain.code, 0) << plain.err;
-    EXPECT_NE(plain.err.find("warning: --draco-qp, --draco-qn and --draco-cl apply to Draco compression: ignored "
-                             "with --no-draco"),
+    EXPECT_NE(plain.err.find("warning: --draco-cl applies to Draco compression: ignored with --compress none"),
               std::string::npos) << plain.err;
+    cli_test::CliRun packed = run("convert --compress meshopt --draco-qp 12 --draco-qt 9 " + cube + " " + dir / "m.glb");
+    EXPECT_EQ(packed.code, 0) << packed.err;
+    EXPECT_NE(packed.err.find("warning: --draco-qp, --draco-qt apply to Draco compression: ignored with --compress "
+                              "meshopt"),
+              std::string::npos) << packed.err;
+    cli_test::CliRun drc = run("convert --compress meshopt " + cube + " " + dir / "c.drc");
+    EXPECT_EQ(drc.code, 0) << drc.err;
+    EXPECT_NE(drc.err.find("warning: --compress applies to glTF outputs; a .drc is always Draco"), std::string::npos)
+        << drc.err;
+    cli_test::CliRun stl = run("convert --compress none " + cube + " " + dir / "c.stl");
+    EXPECT_NE(stl.err.find("warning: --compress applies to Draco and glTF outputs only: ignored for stl"),
+              std::string::npos) << stl.err;
+    // A compression that does not exist, or two ways of saying one, are command-line errors.
+    EXPECT_EQ(run("convert --compress zip " + cube + " " + dir / "z.glb").code, 2);
+    EXPECT_EQ(run("convert --no-draco --compress meshopt " + cube + " " + dir / "z.glb").code, 2);
+    EXPECT_FALSE(std::filesystem::exists(dir / "z.glb"));
 }
 
 // --to and --from take a format's extension as well as its name: "--to drc" was refused
