@@ -274,11 +274,15 @@ std::unique_ptr<Writer> open_draco_writer(ByteSink& sink, const WriteOptions& op
     return std::make_unique<DracoWriter>(sink, options);
 }
 
+Channels drc_keep_channels(const Channels& in, const WriteOptions& options) {
+    return draco_keep_channels(in, options, false);
+}
+
 }  // namespace
 
 const Format kDracoFormat = {
     "draco", "drc", "Draco compressed mesh (whole mesh in memory)", &probe_draco, &open_draco_reader, &open_draco_writer,
-    Format::kAlwaysDraco, nullptr, nullptr,
+    Format::kAlwaysDraco, nullptr, &drc_keep_channels,
 };
 
 bool probe_draco(std::span<const std::byte> head, std::optional<uint64_t>) {

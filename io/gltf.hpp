@@ -29,7 +29,12 @@
 //
 // Reader: the default scene's node tree (or, without scenes, every mesh once) with node
 // transforms applied, so the soup is in world space; winding is flipped under mirroring
-// transforms. TRIANGLES, TRIANGLE_STRIP and TRIANGLE_FAN are read (with or without indices,
+// transforms. Channels: NORMAL (turned by the transform's inverse transpose), COLOR_0,
+// TEXCOORD_0-3 (the material's KHR_texture_transform applied, v flipped to point up),
+// materials (name, base colour factor, base colour texture with its image bytes), and a
+// vertex id per (instance, primitive, vertex); a channel some primitives lack gets its default
+// there (normal 0, colour opaque white, uv 0; glTF's default material). Images are kept as bytes,
+// never decoded: the whole document is held anyway, external images on top. TRIANGLES, TRIANGLE_STRIP and TRIANGLE_FAN are read (with or without indices,
 // Draco or plain accessors, KHR_mesh_quantization's integer positions, EXT_meshopt_compression
 // bufferViews decoded with libmeshoptimizer and its filters); points and lines, sparse
 // accessors and other required extensions are refused with an io::Error naming the file and

@@ -29,8 +29,16 @@
 namespace meshstream::io::gltf_detail {
 namespace {
 
-bool skip_image(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int, void*) {
-    return true;  // geometry only: images are never decoded
+// Image bytes by image index, kept as they are (never decoded): a texture is carried to the
+// output, not looked at. Images in a bufferView are read later from their buffer, with bounds
+// checks (tinygltf hands them over without any).
+using ImageBytes = std::map<int, std::vector<std::byte>>;
+bool keep_image(tinygltf::Image* image, const int index, std::string*, std::string*, int, int,
+                const unsigned char* bytes, int size, void* user) {
+    if (image->bufferView >= 0 || size <= 0) return true;
+    auto* p = reinterpret_cast<const std::byte*>(bytes);
+    (*static_cast<ImageBytes*>(user))[index].assign(p, p + size);
+    return true;
 }
 
 // Required extensions that do not change geometry, or that this reader implements.
@@ -108,10 +116,14 @@ struct AccessorView {
     }
 };
 
-// A primitive in its local space: positions and triangles (strips and fans already unrolled).
+// A primitive in its local space: positions and triangles (strips and fans already unrolled),
+// and per vertex the channels the stream carries (each empty when this primitive lacks it).
 struct PrimitiveGeometry {
     std::vector<float> positions;
     std::vector<uint32_t> triangles;
+    std::vector<float> normals;               // 3 per vertex
+    std::vector<float> colors;                // 4 per vertex, RGBA 0..1
+    std::vector<std::vector<float>> uvs;      // per set: 2 per vertex, glTF's (v down)
 };
 
 struct Instance {
@@ -279,6 +291,9 @@ class GltfReader final : public Reader {
 public:
     GltfReader(ByteSource& source, const ReadOptions& options)
         : name_(source.name()), budget_bytes_(options.memory_budget_bytes) {
+        want_.normals = options.channels.normals;
+        want_.colors = options.channels.colors;
+        want_.uvs = options.channels.uvs;
         std::vector<unsigned char> bytes;
         unsigned char buf[1 << 16];
         while (size_t n = source.read(buf, sizeof buf)) {
@@ -323,7 +338,8 @@ public:
                                binary_size(options.memory_budget_bytes) + "; raise --memory");
 
         tinygltf::TinyGLTF gltf;
-        gltf.SetImageLoader(&skip_image, nullptr);
+        ImageBytes images;
+        gltf.SetImageLoader(&keep_image, &images);
         std::string err, warn;
         const std::string base_dir = parent_dir(source.name());  // "." for stdin: the current directory
         DocumentDir files{base_dir.ends_with('/') ? base_dir : base_dir + "/", {}, {}};
@@ -356,6 +372,7 @@ public:
             for (size_t p = 0; p < model_.meshes[inst.mesh].primitives.size(); ++p)
                 triangles += primitive_triangle_count(inst.mesh, static_cast<int>(p));
         header_.triangle_count = triangles;
+        describe_channels(images);
         header_.notes.emplace_back("instances", std::to_string(instances_.size()) + " mesh instance(s) of " +
                                                     std::to_string(model_.meshes.size()) + " mesh(es)");
         if (!model_.asset.generator.empty()) header_.notes.emplace_back("generator", model_.asset.generator);
@@ -406,6 +423,18 @@ private:
     uint64_t primitive_triangle_count(int mesh, int prim) const;
     AccessorView view(int accessor, const std::string& what) const;
     std::shared_ptr<const PrimitiveGeometry> geometry(int mesh, int prim);
+    // Reads vertex attribute `semantic` of a plain primitive into `out` (`per` values a vertex:
+    // the accessor's components, then `fill` up to `per`), checking its type and count.
+    void read_attribute(const tinygltf::Primitive& p, const std::string& semantic, const std::string& at,
+                        size_t vertices, int per, std::vector<float>& out) const;
+    void describe_channels(const ImageBytes& images);
+    // Whether the vertex attribute `semantic` is decoded: the kinds of channel the caller wants.
+    bool wanted(const tinygltf::Primitive&, const std::string& semantic) const {
+        if (semantic == "NORMAL") return want_.normals;
+        if (semantic == "COLOR_0") return want_.colors;
+        return want_.uvs;
+    }
+    std::optional<Texture> texture_of(const tinygltf::TextureInfo& info, const ImageBytes& images) const;
     void load_current();
 
     std::string name_;
@@ -426,6 +455,21 @@ private:
     bool flip_ = false;
     std::shared_ptr<const PrimitiveGeometry> current_;
     std::vector<float> world_;
+    std::vector<float> world_normals_;           // the current primitive's normals in world space
+    std::vector<std::vector<float>> chunk_uvs_;  // its texture coordinates, transformed, v up
+    uint32_t material_ = 0;                      // its index in header_.materials
+    uint64_t id_base_ = 0, next_id_ = 0;         // vertex ids: its first, the next primitive's
+    // Per glTF material: its base colour texture's KHR_texture_transform (uv' = m · (u, v, 1)),
+    // applied to the texture coordinate set the texture reads.
+    struct UvTransform {
+        int set = 0;
+        double m[6] = {1, 0, 0, 0, 1, 0};  // rows (a, b, c), (d, e, f)
+    };
+    std::vector<std::optional<UvTransform>> uv_transforms_;
+    uint32_t default_material_ = 0;  // header_.materials index of glTF's default material
+    struct {
+        bool normals = true, colors = true, uvs = true;
+    } want_;
 };
 
 // Rewrites what tinygltf 2.7 cannot parse as it is, before it does, and remembers what was taken:
@@ -666,6 +710,109 @@ void GltfReader::visit(int node, const double* parent, int depth) {
     for (int child : n.children) visit(child, world, depth + 1);
 }
 
+// The stream's channels, from the primitives the scene instances: a channel is present when
+// any of them has it, and primitives without it give its default (normal (0, 0, 0), colour
+// opaque white, texture coordinates (0, 0)). Colour keeps the accessors' type when they all
+// agree (float, normalized ubyte or ushort), else travels as float; alpha when any is VEC4.
+// Materials: the document's, with glTF's default material appended for primitives without one.
+void GltfReader::describe_channels(const ImageBytes& images) {
+    Channels& ch = header_.channels;
+    ch.vertex_id = true;  // primitive and vertex: seams and split vertices stay apart
+    bool with_material = false, without_material = false, first_color = true;
+    for (const Instance& inst : instances_)
+        for (size_t pi = 0; pi < model_.meshes[inst.mesh].primitives.size(); ++pi) {
+            const tinygltf::Primitive& p = model_.meshes[inst.mesh].primitives[pi];
+            ch.normal = ch.normal || p.attributes.count("NORMAL") > 0;
+            if (auto it = p.attributes.find("COLOR_0"); it != p.attributes.end()) {
+                if (it->second < 0 || it->second >= int(model_.accessors.size()))
+                    throw Error(name_, where(inst.mesh, int(pi)) + " COLOR_0 refers to accessor " +
+                                           std::to_string(it->second) + ", which does not exist");
+                const tinygltf::Accessor& a = model_.accessors[it->second];
+                const ScalarType t = a.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE    ? ScalarType::kUInt8
+                                     : a.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT ? ScalarType::kUInt16
+                                                                                                 : ScalarType::kFloat32;
+                ColorFormat f = ch.color.value_or(ColorFormat{t, false});
+                if (!first_color && f.type != t) f.type = ScalarType::kFloat32;
+                f.alpha = f.alpha || a.type == TINYGLTF_TYPE_VEC4;
+                ch.color = f;
+                first_color = false;
+            }
+            for (int s = 0; s < kMaxUvSets && p.attributes.count("TEXCOORD_" + std::to_string(s)); ++s)
+                ch.uv_sets = std::max(ch.uv_sets, s + 1);
+            if (p.material >= int(model_.materials.size()))
+                throw Error(name_, where(inst.mesh, int(pi)) + " refers to material " + std::to_string(p.material) +
+                                       ", which does not exist");
+            (p.material >= 0 ? with_material : without_material) = true;
+        }
+    if (!with_material) return;
+    ch.material = true;
+    uv_transforms_.resize(model_.materials.size());
+    for (size_t i = 0; i < model_.materials.size(); ++i) {
+        const tinygltf::Material& gm = model_.materials[i];
+        Material m;
+        m.name = gm.name.empty() ? "material" + std::to_string(i) : gm.name;
+        const auto& pbr = gm.pbrMetallicRoughness;
+        if (pbr.baseColorFactor.size() == 4)
+            for (int c = 0; c < 4; ++c) m.base_color[c] = static_cast<float>(pbr.baseColorFactor[c]);
+        m.texture = texture_of(pbr.baseColorTexture, images);
+        if (pbr.baseColorTexture.index >= 0) {
+            UvTransform t;
+            t.set = pbr.baseColorTexture.texCoord;
+            auto ext = pbr.baseColorTexture.extensions.find("KHR_texture_transform");
+            if (ext != pbr.baseColorTexture.extensions.end() && ext->second.IsObject()) {
+                const tinygltf::Value& x = ext->second;
+                auto number = [](const tinygltf::Value& v, size_t k, double fallback) {
+                    return v.IsArray() && v.ArrayLen() > k && v.Get(int(k)).IsNumber() ? v.Get(int(k)).GetNumberAsDouble()
+                                                                                        : fallback;
+                };
+                const double ox = number(x.Get("offset"), 0, 0), oy = number(x.Get("offset"), 1, 0);
+                const double sx = number(x.Get("scale"), 0, 1), sy = number(x.Get("scale"), 1, 1);
+                const double r = x.Get("rotation").IsNumber() ? x.Get("rotation").GetNumberAsDouble() : 0.0;
+                if (x.Get("texCoord").IsInt()) t.set = x.Get("texCoord").Get<int>();
+                // KHR_texture_transform: uv' = T · R · S · uv, R = [cos r, sin r; -sin r, cos r].
+                const double c = std::cos(r), sn = std::sin(r);
+                const double m6[6] = {c * sx, sn * sy, ox, -sn * sx, c * sy, oy};
+                std::copy(m6, m6 + 6, t.m);
+                uv_transforms_[i] = t;
+            }
+        }
+        header_.materials.push_back(std::move(m));
+    }
+    default_material_ = uint32_t(header_.materials.size());
+    if (without_material) header_.materials.push_back(Material{"default", {1, 1, 1, 1}, std::nullopt});
+}
+
+// The image a texture reference names, with its bytes: from its bufferView (bounds checked),
+// a data: URI or a file beside the document (tinygltf read those). Null without a texture;
+// without bytes when the image could not be read.
+std::optional<Texture> GltfReader::texture_of(const tinygltf::TextureInfo& info, const ImageBytes& images) const {
+    if (info.index < 0 || info.index >= int(model_.textures.size())) return std::nullopt;
+    const int source = model_.textures[info.index].source;
+    if (source < 0 || source >= int(model_.images.size())) return std::nullopt;
+    const tinygltf::Image& image = model_.images[source];
+    Texture t;
+    t.uri = !image.uri.empty() ? image.uri : image.name;
+    t.mime_type = image.mimeType;
+    if (t.mime_type.empty()) {
+        std::string lower = image.uri;
+        for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+        if (lower.ends_with(".png")) t.mime_type = "image/png";
+        else if (lower.ends_with(".jpg") || lower.ends_with(".jpeg")) t.mime_type = "image/jpeg";
+    }
+    if (image.bufferView >= 0) {
+        if (image.bufferView >= int(model_.bufferViews.size())) return t;
+        const tinygltf::BufferView& bv = model_.bufferViews[image.bufferView];
+        if (bv.buffer < 0 || bv.buffer >= int(model_.buffers.size()) || fallback_buffers_.count(bv.buffer)) return t;
+        const auto& data = model_.buffers[bv.buffer].data;
+        if (bv.byteOffset > data.size() || bv.byteLength > data.size() - bv.byteOffset) return t;
+        const auto* p = reinterpret_cast<const std::byte*>(data.data() + bv.byteOffset);
+        t.bytes.assign(p, p + bv.byteLength);
+    } else if (auto it = images.find(source); it != images.end()) {
+        t.bytes = it->second;
+    }
+    return t;
+}
+
 int GltfReader::mode_of(int mesh, int prim) const {
     int mode = model_.meshes[mesh].primitives[prim].mode;
     if (mode == -1) mode = TINYGLTF_MODE_TRIANGLES;  // the default when absent
@@ -799,6 +946,30 @@ std::shared_ptr<const PrimitiveGeometry> GltfReader::geometry(int mesh, int prim
                               " (" + at + ")";
         geo->positions = std::move(d.positions);
         geo->triangles = std::move(d.indices);
+        // The other attributes the extension maps (semantic -> Draco unique id), per point.
+        const size_t points = geo->positions.size() / 3;
+        auto take = [&](const std::string& semantic, int min_components, int max_components, int per,
+                        std::vector<float>& out) {
+            const tinygltf::Value& id = attrs.Get(semantic);
+            if (!id.IsInt() || !wanted(p, semantic)) return;
+            auto it = std::find_if(d.attributes.begin(), d.attributes.end(),
+                                   [&](const DracoAttribute& a) { return a.unique_id == id.Get<int>(); });
+            if (it == d.attributes.end())
+                throw Error(name_, at + ": KHR_draco_mesh_compression maps " + semantic + " to Draco attribute " +
+                                       std::to_string(id.Get<int>()) + ", which the Draco data does not hold");
+            if (it->components < min_components || it->components > max_components || it->values.size() != points * it->components)
+                throw Error(name_, at + ": the Draco attribute of " + semantic + " has " +
+                                       std::to_string(it->components) + " components");
+            out.assign(points * per, 1.0f);
+            for (size_t v = 0; v < points; ++v)
+                for (int c = 0; c < it->components; ++c) out[v * per + c] = float(it->values[v * it->components + c]);
+        };
+        take("NORMAL", 3, 3, 3, geo->normals);
+        take("COLOR_0", 3, 4, 4, geo->colors);
+        for (int s = 0; s < header_.channels.uv_sets; ++s) {
+            geo->uvs.emplace_back();
+            take("TEXCOORD_" + std::to_string(s), 2, 2, 2, geo->uvs.back());
+        }
         draco_cache_[{mesh, prim}] = geo;
         return geo;
     }
@@ -816,6 +987,13 @@ std::shared_ptr<const PrimitiveGeometry> GltfReader::geometry(int mesh, int prim
     geo->positions.resize(pos.count * 3);
     for (size_t i = 0; i < pos.count; ++i)
         for (int c = 0; c < 3; ++c) geo->positions[3 * i + c] = static_cast<float>(pos.get(i, c));
+
+    read_attribute(p, "NORMAL", at, pos.count, 3, geo->normals);
+    read_attribute(p, "COLOR_0", at, pos.count, 4, geo->colors);
+    for (int s = 0; s < header_.channels.uv_sets; ++s) {
+        geo->uvs.emplace_back();
+        read_attribute(p, "TEXCOORD_" + std::to_string(s), at, pos.count, 2, geo->uvs.back());
+    }
 
     std::vector<uint32_t> order;  // the vertex sequence the mode walks
     if (p.indices >= 0) {
@@ -854,6 +1032,24 @@ std::shared_ptr<const PrimitiveGeometry> GltfReader::geometry(int mesh, int prim
     return geo;
 }
 
+void GltfReader::read_attribute(const tinygltf::Primitive& p, const std::string& semantic, const std::string& at,
+                                size_t vertices, int per, std::vector<float>& out) const {
+    auto it = p.attributes.find(semantic);
+    if (it == p.attributes.end() || !wanted(p, semantic)) return;
+    const AccessorView a = view(it->second, at + " " + semantic);
+    const int want_min = semantic == "COLOR_0" ? 3 : per;
+    if (a.components < want_min || a.components > per)
+        throw Error(name_, at + " " + semantic + " (accessor " + std::to_string(it->second) + ") has " +
+                               std::to_string(a.components) + " components, not " +
+                               (want_min == per ? std::to_string(per) : "3 or 4"));
+    if (a.count != vertices)
+        throw Error(name_, at + " " + semantic + " (accessor " + std::to_string(it->second) + ") has " +
+                               std::to_string(a.count) + " elements, POSITION " + std::to_string(vertices));
+    out.assign(vertices * per, 1.0f);  // a VEC3 colour's alpha stays 1
+    for (size_t v = 0; v < vertices; ++v)
+        for (int c = 0; c < a.components; ++c) out[v * per + c] = static_cast<float>(a.get(v, c));
+}
+
 void GltfReader::load_current() {
     const Instance& inst = instances_[inst_];
     current_ = geometry(inst.mesh, static_cast<int>(prim_));
@@ -889,6 +1085,56 @@ void GltfReader::load_current() {
         if (!morphed.empty()) x = morphed[i], y = morphed[i + 1], z = morphed[i + 2];
         for (int r = 0; r < 3; ++r) world_[i + r] = static_cast<float>(m[r] * x + m[4 + r] * y + m[8 + r] * z + m[12 + r]);
     }
+    // Normals go through the inverse transpose of the transform's 3 × 3 part: its cofactor
+    // matrix, over the sign of its determinant (the length is normalised away).
+    world_normals_.clear();
+    if (!current_->normals.empty()) {
+        const double sign = det3(m) < 0 ? -1.0 : 1.0;
+        double cof[9];  // column-major, as m
+        for (int c = 0; c < 3; ++c)
+            for (int r = 0; r < 3; ++r) {
+                const int c1 = (c + 1) % 3, c2 = (c + 2) % 3, r1 = (r + 1) % 3, r2 = (r + 2) % 3;
+                cof[c * 3 + r] = sign * (m[c1 * 4 + r1] * m[c2 * 4 + r2] - m[c1 * 4 + r2] * m[c2 * 4 + r1]);
+            }
+        const auto& n = current_->normals;
+        // Without rotation or scale the file's values are kept bit for bit.
+        const bool identity = m[0] == 1 && m[5] == 1 && m[10] == 1 && m[1] == 0 && m[2] == 0 && m[4] == 0 &&
+                              m[6] == 0 && m[8] == 0 && m[9] == 0;
+        world_normals_.assign(n.begin(), n.end());
+        for (size_t i = 0; i < n.size() && !identity; i += 3) {
+            double w[3], len = 0;
+            for (int r = 0; r < 3; ++r) {
+                w[r] = cof[r] * n[i] + cof[3 + r] * n[i + 1] + cof[6 + r] * n[i + 2];
+                len += w[r] * w[r];
+            }
+            const double scale = len > 0 ? 1.0 / std::sqrt(len) : 0.0;
+            for (int r = 0; r < 3; ++r) world_normals_[i + r] = static_cast<float>(w[r] * scale);
+        }
+    }
+    // Texture coordinates: the material's KHR_texture_transform, then v flipped (glTF's v runs
+    // down the image, the chunk's up).
+    material_ = p.material >= 0 ? uint32_t(p.material) : default_material_;
+    const UvTransform* transform = p.material >= 0 && size_t(p.material) < uv_transforms_.size() && uv_transforms_[p.material]
+                                       ? &*uv_transforms_[p.material]
+                                       : nullptr;
+    chunk_uvs_.assign(current_->uvs.size(), {});
+    for (size_t s = 0; s < current_->uvs.size(); ++s) {
+        const auto& uv = current_->uvs[s];
+        auto& out = chunk_uvs_[s];
+        out.resize(uv.size());
+        for (size_t i = 0; i < uv.size(); i += 2) {
+            double u = uv[i], v = uv[i + 1];
+            if (transform && transform->set == int(s)) {
+                const double* t = transform->m;
+                const double tu = t[0] * u + t[1] * v + t[2], tv = t[3] * u + t[4] * v + t[5];
+                u = tu, v = tv;
+            }
+            out[i] = static_cast<float>(u);
+            out[i + 1] = static_cast<float>(1.0 - v);
+        }
+    }
+    id_base_ = next_id_;
+    next_id_ += src.size() / 3;
     tri_ = 0;
     loaded_ = true;
 }
@@ -906,11 +1152,26 @@ bool GltfReader::next(TriangleChunk& chunk) {
         if (!loaded_) load_current();
         const std::vector<uint32_t>& t = current_->triangles;
         const size_t count = t.size() / 3;
+        const Channels& want = chunk.channels();
+        const bool normals = want.normal && !world_normals_.empty();
+        const bool colors = want.color && !current_->colors.empty();
+        const int uv_sets = std::min(want.uv_sets, int(chunk_uvs_.size()));
         while (tri_ < count && !chunk.full()) {
+            const size_t i = chunk.size();
             float* dst = chunk.push_slot();
             uint32_t v[3] = {t[3 * tri_], t[3 * tri_ + 1], t[3 * tri_ + 2]};
             if (flip_) std::swap(v[1], v[2]);
-            for (int k = 0; k < 3; ++k) std::memcpy(dst + 3 * k, &world_[3 * size_t{v[k]}], 3 * sizeof(float));
+            for (int k = 0; k < 3; ++k) {
+                const size_t x = v[k];
+                std::memcpy(dst + 3 * k, &world_[3 * x], 3 * sizeof(float));
+                if (normals) std::memcpy(chunk.normal_at(i) + 3 * k, &world_normals_[3 * x], 3 * sizeof(float));
+                if (colors) std::memcpy(chunk.color_at(i) + 4 * k, &current_->colors[4 * x], 4 * sizeof(float));
+                else if (want.color) std::fill_n(chunk.color_at(i) + 4 * k, 4, 1.0f);  // glTF: no colour is white
+                for (int s = 0; s < uv_sets; ++s)
+                    if (!chunk_uvs_[s].empty()) std::memcpy(chunk.uv_at(i, s) + 2 * k, &chunk_uvs_[s][2 * x], 2 * sizeof(float));
+                if (want.vertex_id) chunk.id_at(i)[k] = id_base_ + x;
+            }
+            if (want.material) *chunk.material_at(i) = material_;
             ++tri_;
         }
         if (tri_ == count) {

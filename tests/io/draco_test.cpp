@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <random>
 #include <sstream>
 
 using namespace web_test;
@@ -286,3 +287,125 @@ TEST(DracoWriter, RejectsOutOfRangeSettings) {
 }
 
 }  // namespace
+
+namespace {
+
+// The PLY header draco_decoder writes for `drc`: its vertex properties tell the attributes it
+// decoded.
+std::string draco_decoder_header(const std::string& drc, const std::string& ply) {
+    draco_decoder_counts(drc, ply);
+    const std::string text = slurp(ply);
+    return text.substr(0, text.find("end_header"));
+}
+
+// A small mesh of random triangles with two named scalars: 'intensity' (ushort) and
+// 'confidence' (float).
+Mesh scalar_mesh() {
+    Mesh m;
+    m.header.channels.vertex_scalars = {{"intensity", io::ScalarType::kUInt16}, {"confidence", io::ScalarType::kFloat32}};
+    m.scalars.resize(2);
+    std::mt19937 rng(11);
+    for (int t = 0; t < 40; ++t)
+        for (int k = 0; k < 3; ++k) {
+            for (int a = 0; a < 3; ++a) m.xyz.push_back(float(rng() % 1000) / 8);
+            m.scalars[0].push_back(double(rng() % 65536));
+            m.scalars[1].push_back(double(float(rng() % 100000) / 100000.0f));
+        }
+    return m;
+}
+
+}  // namespace
+
+TEST(DracoChannels, EveryChannelRoundTripsAndDracoDecoderReadsIt) {
+    TempDir dir;
+    {
+        SCOPED_TRACE("colours: the cactus, uchar RGB");
+        const Mesh ref = read_mesh(fixture("ply/cactus_vcolor.binary_le.ply"));
+        EXPECT_TRUE(write_mesh(ref, dir / "c.drc").empty());
+        const Mesh back = read_mesh(dir / "c.drc");
+        EXPECT_EQ(back.header.channels.color, ref.header.channels.color);
+        const ChannelErrors e = compare_meshes(ref, back, 1e-4);
+        EXPECT_EQ(e.unmatched, 0u);
+        EXPECT_EQ(e.color, 0.0);  // integers are stored as they are
+        EXPECT_NE(draco_decoder_header(dir / "c.drc", dir / "c.ply").find("property uchar red"), std::string::npos);
+    }
+    {
+        SCOPED_TRACE("normals: the elephant");
+        const Mesh ref = read_mesh(fixture("drc/elephant_normals_sequential_cl0.drc"));
+        write_mesh(ref, dir / "n.drc");
+        const Mesh back = read_mesh(dir / "n.drc");
+        EXPECT_TRUE(back.header.channels.normal);
+        const ChannelErrors e = compare_meshes(ref, back, 2e-4);
+        EXPECT_EQ(e.unmatched, 0u);
+        EXPECT_LE(e.normal, 4.0 / 1023);  // --draco-qn 10: 2 steps of the octahedral square
+        EXPECT_NE(draco_decoder_header(dir / "n.drc", dir / "n.ply").find("property float nx"), std::string::npos);
+    }
+    {
+        SCOPED_TRACE("texture coordinates and normals with seams: BoxTextured");
+        const Mesh ref = read_mesh(fixture("gltf/BoxTextured.glb"));
+        write_mesh(ref, dir / "b.drc");
+        const Mesh back = read_mesh(dir / "b.drc");
+        EXPECT_EQ(back.header.channels.uv_sets, 1);
+        EXPECT_TRUE(back.header.channels.normal);
+        EXPECT_FALSE(back.header.channels.material);  // Draco has no materials
+        EXPECT_EQ(back.header.vertex_count, 24u) << "the glTF's vertices, seams apart";
+        const ChannelErrors e = compare_meshes(ref, back, 0.5 / 16383 * 1.0001);
+        EXPECT_EQ(e.unmatched, 0u);
+        EXPECT_LE(e.uv, 0.5 * 6 / 4095 * 1.0001 + 1e-6);  // --draco-qt 12 over their range, 6
+        EXPECT_LE(e.normal, 4.0 / 1023);
+        EXPECT_EQ(draco_decoder_counts(dir / "b.drc", dir / "b.ply").first, 24u);
+    }
+    {
+        SCOPED_TRACE("named scalars: Draco generic attributes with 'name' metadata");
+        const Mesh ref = scalar_mesh();
+        write_mesh(ref, dir / "s.drc");
+        const Mesh back = read_mesh(dir / "s.drc");
+        ASSERT_EQ(back.header.channels.vertex_scalars, ref.header.channels.vertex_scalars);
+        const ChannelErrors e = compare_meshes(ref, back, 0.5 * 125 / 16383 * 1.0001);
+        EXPECT_EQ(e.unmatched, 0u);
+        double intensity = 0, confidence = 0;
+        Mesh only = ref;
+        // Per channel: ushort exactly, float within --draco-qc 10 bits over its range (< 1).
+        only.scalars = {ref.scalars[0], std::vector<double>(ref.scalars[1].size(), 0.0)};
+        Mesh back_only = back;
+        back_only.scalars = {back.scalars[0], std::vector<double>(back.scalars[1].size(), 0.0)};
+        intensity = compare_meshes(only, back_only, 0.5 * 125 / 16383 * 1.0001).scalar;
+        only.scalars = {ref.scalars[1]};
+        back_only.scalars = {back.scalars[1]};
+        confidence = compare_meshes(only, back_only, 0.5 * 125 / 16383 * 1.0001).scalar;
+        EXPECT_EQ(intensity, 0.0);
+        EXPECT_GT(confidence, 0.0);
+        EXPECT_LE(confidence, 0.5 / 1023 * 1.0001);
+        EXPECT_EQ(draco_decoder_counts(dir / "s.drc", dir / "s.ply").second, 40u);
+    }
+}
+
+TEST(DracoChannels, QuantizationFlagsBoundTheirChannels) {
+    // --draco-qn, --draco-qt and --draco-qc as draco_encoder's -qn, -qt and -qg: each bounds its
+    // channel's error, and fewer bits give more.
+    TempDir dir;
+    const Mesh box = read_mesh(fixture("gltf/BoxTextured.glb"));
+    const Mesh scalars = scalar_mesh();
+    ChannelErrors coarse, fine;
+    for (int bits : {6, 16}) {
+        SCOPED_TRACE(bits);
+        io::WriteOptions o;
+        o.draco_normal_bits = o.draco_texcoord_bits = o.draco_color_bits = bits;
+        write_mesh(box, dir / "b.drc", o);
+        write_mesh(scalars, dir / "s.drc", o);
+        ChannelErrors e = compare_meshes(box, read_mesh(dir / "b.drc"), 0.5 / 16383 * 1.0001);
+        Mesh s = scalars, back = read_mesh(dir / "s.drc");
+        s.scalars.erase(s.scalars.begin());
+        back.scalars.erase(back.scalars.begin());
+        e.scalar = compare_meshes(s, back, 0.5 * 125 / 16383 * 1.0001).scalar;
+        EXPECT_EQ(e.unmatched, 0u);
+        const double steps = double((1 << bits) - 1);
+        EXPECT_LE(e.uv, 0.5 * 6 / steps * 1.0001 + 1e-6);
+        EXPECT_LE(e.normal, 4.0 / steps);
+        EXPECT_LE(e.scalar, 0.5 / steps * 1.0001);
+        (bits == 6 ? coarse : fine) = e;
+    }
+    EXPECT_GT(coarse.uv, 10 * fine.uv);
+    EXPECT_GT(coarse.scalar, 10 * fine.scalar);
+    EXPECT_GE(coarse.normal, fine.normal);  // the box's axis-aligned normals may stay exact
+}

@@ -23,6 +23,7 @@
 #include <random>
 #include <set>
 #include <thread>
+#include <tuple>
 
 using namespace web_test;
 using nlohmann::json;
@@ -1059,6 +1060,203 @@ TEST(GltfWriter, LeavesOutNonFiniteTrianglesOrRefusesThemUnderStrict) {
     }
 }
 
+// Channels: NORMAL, COLOR_0, TEXCOORD_0 and materials with their texture, read from every
+// encoding of the same box and written back with every compression.
+
+std::string box_png() { return slurp(fixture("gltf/BoxTextured_external/CesiumLogoFlat.png")); }
+
+std::string texture_bytes(const Mesh& m, size_t material = 0) {
+    if (material >= m.header.materials.size() || !m.header.materials[material].texture) return {};
+    const auto& b = m.header.materials[material].texture->bytes;
+    return {reinterpret_cast<const char*>(b.data()), b.size()};
+}
+
+// The Cesium logo is 211 × 211 pixels: the validator notes that, as it does for the sample file.
+const std::set<std::string> kNpot = {"IMAGE_NPOT_DIMENSIONS"};
+
+TEST(GltfChannels, BoxTexturedReadsNormalsUvsAndItsTextureFromEveryEncoding) {
+    const Mesh ref = read_mesh(fixture("gltf/BoxTextured.glb"));
+    const io::Channels& ch = ref.header.channels;
+    ASSERT_EQ(ref.triangles(), 12u);
+    EXPECT_TRUE(ch.normal);
+    EXPECT_EQ(ch.uv_sets, 1);
+    EXPECT_TRUE(ch.material);
+    EXPECT_FALSE(ch.color);
+    EXPECT_TRUE(ch.vertex_id);
+    ASSERT_EQ(ref.header.materials.size(), 1u);
+    EXPECT_EQ(ref.header.materials[0].name, "Texture");
+    EXPECT_EQ(ref.header.materials[0].texture->mime_type, "image/png");
+    EXPECT_EQ(texture_bytes(ref), box_png());
+    // 24 vertices: each face its own four, for its normal and texture coordinates.
+    EXPECT_EQ(std::set<uint64_t>(ref.ids.begin(), ref.ids.end()).size(), 24u);
+    // The node turns the box -90° about x: each normal (turned with it) is its face's.
+    for (size_t t = 0; t < 12; ++t) {
+        const float* p = &ref.xyz[9 * t];
+        double e1[3], e2[3], n[3];
+        for (int a = 0; a < 3; ++a) e1[a] = p[3 + a] - p[a], e2[a] = p[6 + a] - p[a];
+        n[0] = e1[1] * e2[2] - e1[2] * e2[1], n[1] = e1[2] * e2[0] - e1[0] * e2[2], n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+        const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        for (int k = 0; k < 3; ++k)
+            for (int a = 0; a < 3; ++a) EXPECT_NEAR(ref.normals[9 * t + 3 * k + a], n[a] / len, 1e-6) << t;
+    }
+    // Texture coordinates as the chunk holds them (v up): the file's (0.0, 1.0) corner of the
+    // first face is its top left, (6, 0) in glTF's v-down convention.
+    float umax = 0, vmin = 1;
+    for (size_t i = 0; i < ref.uvs.size(); i += 2) umax = std::max(umax, ref.uvs[i]), vmin = std::min(vmin, ref.uvs[i + 1]);
+    EXPECT_FLOAT_EQ(umax, 6.0f);
+    EXPECT_NEAR(vmin, 0.0f, 1e-6);
+
+    struct Case {
+        const char* file;
+        double position, normal, uv;  // the encoding's quantization
+    } cases[] = {
+        {"gltf/BoxTextured_embedded.gltf", 0, 0, 0},
+        {"gltf/BoxTextured_external/BoxTextured.gltf", 0, 0, 0},
+        // draco_transcoder's defaults: positions 11 bits, normals 8, texture coordinates 10
+        // over their range (6): steps 1/2047, about 2/255 and 6/1023.
+        {"gltf/BoxTextured_draco_transcoder.glb", 0.5 / 2047, 4.0 / 255, 0.5 * 6 / 1023},
+        // gltfpack -cc: positions 14 bits, normals 8-bit, texture coordinates 12 bits, undone
+        // by the node's scale and KHR_texture_transform.
+        {"gltf/BoxTextured_gltfpack_cc.glb", 0.5 / 16383, 2.0 / 127, 0.5 * 6 / 4095},
+    };
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.file);
+        const Mesh m = read_mesh(fixture(c.file));
+        EXPECT_EQ(m.header.channels, ch);
+        const ChannelErrors e = compare_meshes(ref, m, c.position * 1.0001 + 1e-7);
+        EXPECT_EQ(e.unmatched, 0u);
+        EXPECT_EQ(e.material_mismatches, 0u);
+        EXPECT_LE(e.normal, c.normal * 1.0001 + 1e-7);
+        EXPECT_LE(e.uv, c.uv * 1.0001 + 1e-6);
+        // draco_transcoder's image view is padded to 4 bytes with zeros, which the file counts.
+        const std::string bytes = texture_bytes(m), png = box_png();
+        EXPECT_EQ(bytes.substr(0, png.size()), png);
+        EXPECT_EQ(bytes.find_first_not_of('\0', png.size()), std::string::npos);
+        EXPECT_LT(bytes.size(), png.size() + 4);
+    }
+    // The external image is one of the document's side files.
+    io::MeshHeader h;
+    read_soup(fixture("gltf/BoxTextured_external/BoxTextured.gltf"), 100, &h);
+    EXPECT_EQ(h.side_files.size(), 2u);
+    EXPECT_TRUE(std::any_of(h.side_files.begin(), h.side_files.end(),
+                            [](const std::string& f) { return f.ends_with("CesiumLogoFlat.png"); }));
+}
+
+TEST(GltfChannels, BoxTexturedRoundTripsThroughEveryCompression) {
+    TempDir dir;
+    const Mesh ref = read_mesh(fixture("gltf/BoxTextured.glb"));
+    struct Case {
+        io::WriteOptions::Compression compression;
+        const char* name;
+        double position, normal;  // meshopt: 14-bit positions, 8-bit octahedral normals; Draco: 14 and 10 bits
+    } cases[] = {
+        {io::WriteOptions::Compression::kNone, "none.glb", 0, 0},
+        {io::WriteOptions::Compression::kNone, "none.gltf", 0, 0},
+        {io::WriteOptions::Compression::kMeshopt, "meshopt.glb", 0.5 / 16383, 2.0 / 127},
+        {io::WriteOptions::Compression::kMeshopt, "meshopt.gltf", 0.5 / 16383, 2.0 / 127},
+        {io::WriteOptions::Compression::kDraco, "draco.glb", 0.5 / 16383, 4.0 / 1023},
+        {io::WriteOptions::Compression::kDraco, "draco.gltf", 0.5 / 16383, 4.0 / 1023},
+    };
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.name);
+        io::WriteOptions o;
+        o.compression = c.compression;
+        EXPECT_TRUE(write_mesh(ref, dir / c.name, o).empty());
+        expect_valid_allowing(dir / c.name, kNpot);
+        const Mesh back = read_mesh(dir / c.name);
+        EXPECT_EQ(back.header.channels, ref.header.channels);
+        const ChannelErrors e = compare_meshes(ref, back, c.position * 1.0001 + 1e-7);
+        EXPECT_EQ(e.unmatched, 0u);
+        EXPECT_EQ(e.material_mismatches, 0u);
+        EXPECT_LE(e.normal, c.normal * 1.0001 + 1e-7);
+        // Texture coordinates: float with meshopt and none, 12 bits over their range with Draco.
+        EXPECT_LE(e.uv, c.compression == io::WriteOptions::Compression::kDraco ? 0.5 * 6 / 4095 * 1.0001 + 1e-6 : 0.0);
+        EXPECT_EQ(texture_bytes(back), box_png());
+        EXPECT_EQ(std::set<uint64_t>(back.ids.begin(), back.ids.end()).size(), 24u) << "seams kept";
+    }
+    // A .gltf's texture is a file beside it, named in its images.
+    const json doc = json::parse(slurp(dir / "none.gltf"));
+    ASSERT_EQ(doc["images"].size(), 1u);
+    EXPECT_EQ(doc["images"][0]["uri"], "none_0.png");
+    EXPECT_EQ(slurp(dir / "none_0.png"), box_png());
+}
+
+TEST(GltfChannels, ColoursKeepTheirTypeAndValues) {
+    TempDir dir;
+    // CGAL's cactus: RGB as uchar (PLY and Draco), and one float RGBA triangle.
+    for (const char* file : {"ply/cactus_vcolor.binary_le.ply", "drc/cactus_vcolor_edgebreaker.drc", "ply/float-color.ply"}) {
+        SCOPED_TRACE(file);
+        const Mesh ref = read_mesh(fixture(file));
+        ASSERT_TRUE(ref.header.channels.color);
+        const io::ColorFormat format = *ref.header.channels.color;
+        const bool is_float = format.type == io::ScalarType::kFloat32;
+        for (auto [c, name] : {std::pair{io::WriteOptions::Compression::kNone, "c.glb"},
+                               std::pair{io::WriteOptions::Compression::kMeshopt, "c.gltf"},
+                               std::pair{io::WriteOptions::Compression::kDraco, "d.glb"}}) {
+            SCOPED_TRACE(name);
+            io::WriteOptions o;
+            o.compression = c;
+            write_mesh(ref, dir / name, o);
+            expect_valid(dir / name);
+            const Mesh back = read_mesh(dir / name);
+            ASSERT_TRUE(back.header.channels.color);
+            EXPECT_EQ(*back.header.channels.color, format);
+            const bool draco = c == io::WriteOptions::Compression::kDraco;
+            // Positions: 14 bits over the largest extent.
+            float lo = ref.xyz[0], hi = ref.xyz[0];
+            for (float x : ref.xyz) lo = std::min(lo, x), hi = std::max(hi, x);
+            const double step = c == io::WriteOptions::Compression::kNone ? 0 : (hi - lo) / 16383.0;
+            const ChannelErrors e = compare_meshes(ref, back, step);
+            EXPECT_EQ(e.unmatched, 0u);
+            // Integer colours are stored as they are; float ones quantized by Draco (--draco-qc
+            // 10 bits over their range, at most 1).
+            EXPECT_LE(e.color, draco && is_float ? 0.5 / 1023 * 1.0001 : 0.0);
+        }
+    }
+    // 16-bit RGBA, made here: glTF's normalized unsigned short, VEC4.
+    Mesh m;
+    m.header.channels.color = io::ColorFormat{io::ScalarType::kUInt16, true};
+    std::mt19937 rng(7);
+    for (int t = 0; t < 50; ++t)
+        for (int k = 0; k < 9; ++k) m.xyz.push_back(float(rng() % 1000) / 10);
+    for (int i = 0; i < 50 * 12; ++i) m.colors.push_back(float(rng() % 65536) / 65535.0f);
+    write_mesh(m, dir / "u16.glb", [] {
+        io::WriteOptions o;
+        o.compression = io::WriteOptions::Compression::kNone;
+        return o;
+    }());
+    expect_valid(dir / "u16.glb");
+    const json doc = glb_json(dir / "u16.glb");
+    const json& acc = doc["accessors"][doc["meshes"][0]["primitives"][0]["attributes"]["COLOR_0"].get<int>()];
+    EXPECT_EQ(acc["componentType"], 5123);
+    EXPECT_EQ(acc["type"], "VEC4");
+    EXPECT_EQ(acc["normalized"], true);
+    const Mesh back = read_mesh(dir / "u16.glb");
+    EXPECT_EQ(*back.header.channels.color, (io::ColorFormat{io::ScalarType::kUInt16, true}));
+    const ChannelErrors e = compare_meshes(m, back, 0);
+    EXPECT_EQ(e.unmatched, 0u);
+    EXPECT_LE(e.color, 0.5 / 65535);  // the same 16-bit value
+}
+
+TEST(GltfChannels, DracoElephantsNormalsThroughEveryCompression) {
+    TempDir dir;
+    const Mesh ref = read_mesh(fixture("drc/elephant_normals_sequential_cl0.drc"));
+    ASSERT_TRUE(ref.header.channels.normal);
+    for (auto [c, name, normal] : {std::tuple{io::WriteOptions::Compression::kNone, "n.glb", 0.0},
+                                   std::tuple{io::WriteOptions::Compression::kMeshopt, "m.glb", 2.0 / 127},
+                                   std::tuple{io::WriteOptions::Compression::kDraco, "d.glb", 4.0 / 1023}}) {
+        SCOPED_TRACE(name);
+        io::WriteOptions o;
+        o.compression = c;
+        write_mesh(ref, dir / name, o);
+        expect_valid(dir / name);
+        const Mesh back = read_mesh(dir / name);
+        const ChannelErrors e = compare_meshes(ref, back, c == io::WriteOptions::Compression::kNone ? 0 : 2e-4);
+        EXPECT_EQ(e.unmatched, 0u);
+        EXPECT_LE(e.normal, normal);
+    }
+}
+
 TEST(GltfRender, WrittenFilesRenderInThreeJs) {
     // What a web page shows: three.js's GLTFLoader (with MeshoptDecoder and DRACOLoader) in
     // headless Chromium loads each output, and the picture holds the mesh.
@@ -1075,17 +1273,53 @@ TEST(GltfRender, WrittenFilesRenderInThreeJs) {
         write_soup(bunny, dir / name, o);
         files.push_back(dir / name);
     }
+    // The textured box, as the sample file holds it, round-tripped with every compression, and
+    // with positions only (the grey box a reader without texture coordinates and materials
+    // gave).
+    const size_t boxes = files.size();
+    files.push_back(fixture("gltf/BoxTextured.glb"));
+    const Mesh box = read_mesh(fixture("gltf/BoxTextured.glb"));
+    for (auto [c, name] : {std::pair{io::WriteOptions::Compression::kMeshopt, "box_meshopt.glb"},
+                           std::pair{io::WriteOptions::Compression::kDraco, "box_draco.glb"},
+                           std::pair{io::WriteOptions::Compression::kNone, "box_plain.gltf"}}) {
+        io::WriteOptions o;
+        o.compression = c;
+        write_mesh(box, dir / name, o);
+        files.push_back(dir / name);
+    }
+    write_soup(read_soup(fixture("gltf/BoxTextured.glb")), dir / "box_grey.glb");
+    files.push_back(dir / "box_grey.glb");
+
     const json report = render(dir, files);
     ASSERT_EQ(report.size(), files.size());
-    for (const json& r : report) {
+    for (size_t i = 0; i < boxes; ++i) {
+        const json& r = report[i];
         SCOPED_TRACE(r.dump());
         EXPECT_EQ(r["triangles"], 69451);
         EXPECT_GT(r["covered"].get<double>(), 0.1);  // the bunny fills about 28 % of the frame
         EXPECT_GT(r["distinct"].get<int>(), 8);      // shaded, not a flat silhouette
     }
     // The same picture whatever the compression: quantization moves nothing visible.
-    for (const json& r : report)
-        EXPECT_NEAR(r["covered"].get<double>(), report[2]["covered"].get<double>(), 0.01) << r["file"];
+    for (size_t i = 0; i < boxes; ++i)
+        EXPECT_NEAR(report[i]["covered"].get<double>(), report[2]["covered"].get<double>(), 0.01) << report[i]["file"];
+    // The boxes show the logo's colours as the sample does (its render: about 55 % of the
+    // covered pixels saturated, mean RGB about (125, 149, 148)); the grey box shows none.
+    const json& sample = report[boxes];
+    EXPECT_GT(sample["saturated"].get<double>(), 0.3) << sample.dump();
+    for (size_t i = boxes + 1; i < boxes + 4; ++i) {
+        const json& r = report[i];
+        SCOPED_TRACE(r.dump());
+        EXPECT_EQ(r["triangles"], 12);
+        EXPECT_NEAR(r["covered"].get<double>(), sample["covered"].get<double>(), 0.005);
+        EXPECT_NEAR(r["saturated"].get<double>(), sample["saturated"].get<double>(), 0.05);
+        for (int c = 0; c < 3; ++c) EXPECT_NEAR(r["mean"][c].get<double>(), sample["mean"][c].get<double>(), 4.0) << c;
+    }
+    const json& grey = report[boxes + 4];
+    EXPECT_LT(grey["saturated"].get<double>(), 0.02) << grey.dump();
+    EXPECT_GT(std::abs(grey["mean"][0].get<double>() - sample["mean"][0].get<double>()) +
+                  std::abs(grey["mean"][2].get<double>() - sample["mean"][2].get<double>()),
+              20.0)
+        << grey.dump();
 }
 
 TEST(GltfFormat, DetectedByContentWhateverTheName) {

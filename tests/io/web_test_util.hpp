@@ -64,6 +64,140 @@ inline std::vector<std::string> write_soup(const Soup& soup, const std::string& 
     return out.writer->notes();
 }
 
+// A soup with every channel its reader fills (the header's), corner by corner.
+struct Mesh {
+    io::MeshHeader header;                     // as it stands after the last chunk
+    std::vector<float> xyz, normals, colors;   // per corner: 3, 3, 4 (RGBA)
+    std::vector<float> uvs;                    // per corner: 2 (set 0)
+    std::vector<uint32_t> materials;           // per triangle
+    std::vector<std::vector<double>> scalars;  // per vertex scalar channel, per corner
+    std::vector<uint64_t> ids;                 // per corner
+    size_t triangles() const { return xyz.size() / 9; }
+};
+
+inline Mesh read_mesh(const std::string& path) {
+    io::Input in = io::open_input(path);
+    Mesh m;
+    const io::Channels ch = in.reader->header().channels;
+    m.scalars.resize(ch.vertex_scalars.size());
+    io::TriangleChunk chunk(1000, ch);
+    while (in.reader->next(chunk)) {
+        for (size_t i = 0; i < chunk.size(); ++i) {
+            m.xyz.insert(m.xyz.end(), &chunk.xyz()[9 * i], &chunk.xyz()[9 * i] + 9);
+            if (ch.normal) m.normals.insert(m.normals.end(), chunk.normal_at(i), chunk.normal_at(i) + 9);
+            if (ch.color) m.colors.insert(m.colors.end(), chunk.color_at(i), chunk.color_at(i) + 12);
+            if (ch.uv_sets > 0) m.uvs.insert(m.uvs.end(), chunk.uv_at(i, 0), chunk.uv_at(i, 0) + 6);
+            if (ch.material) m.materials.push_back(*chunk.material_at(i));
+            if (ch.vertex_id) m.ids.insert(m.ids.end(), chunk.id_at(i), chunk.id_at(i) + 3);
+            for (size_t c = 0; c < ch.vertex_scalars.size(); ++c)
+                m.scalars[c].insert(m.scalars[c].end(), chunk.vertex_scalar_at(i, c), chunk.vertex_scalar_at(i, c) + 3);
+        }
+    }
+    m.header = in.reader->header();
+    return m;
+}
+
+// Writes `m` to `path` with the channels the output format keeps of m's (and its materials),
+// the way convert does; returns the writer's notes.
+inline std::vector<std::string> write_mesh(const Mesh& m, const std::string& path, io::WriteOptions options = {}) {
+    const io::Format& format = io::output_format(path, {});
+    const io::Channels& in = m.header.channels;
+    options.channels = io::writable_channels(format, in, options);
+    options.materials = m.header.materials;
+    const io::Channels& ch = options.channels;
+    io::Output out = io::open_output(path, {}, options);
+    io::TriangleChunk chunk(1000, ch);
+    for (size_t t = 0; t < m.triangles(); ++t) {
+        if (chunk.full()) {
+            out.write(chunk);
+            chunk.clear();
+        }
+        float* p = chunk.push_slot();
+        const size_t i = chunk.size() - 1;
+        std::copy(&m.xyz[9 * t], &m.xyz[9 * t] + 9, p);
+        if (ch.normal) std::copy(&m.normals[9 * t], &m.normals[9 * t] + 9, chunk.normal_at(i));
+        if (ch.color) std::copy(&m.colors[12 * t], &m.colors[12 * t] + 12, chunk.color_at(i));
+        if (ch.uv_sets > 0) std::copy(&m.uvs[6 * t], &m.uvs[6 * t] + 6, chunk.uv_at(i, 0));
+        if (ch.material) *chunk.material_at(i) = m.materials[t];
+        if (ch.vertex_id) std::copy(&m.ids[3 * t], &m.ids[3 * t] + 3, chunk.id_at(i));
+        for (size_t c = 0; c < ch.vertex_scalars.size(); ++c)
+            for (size_t s = 0; s < in.vertex_scalars.size(); ++s)
+                if (in.vertex_scalars[s].name == ch.vertex_scalars[c].name)
+                    std::copy(&m.scalars[s][3 * t], &m.scalars[s][3 * t] + 3, chunk.vertex_scalar_at(i, c));
+    }
+    if (!chunk.empty()) out.write(chunk);
+    out.finish();
+    return out.writer->notes();
+}
+
+// The largest differences between the channels of two meshes holding the same triangles in
+// any order, any starting corner: each triangle of `a` is matched to the one of `b` whose
+// corners lie within `position_tolerance` (max norm), corner to corner.
+struct ChannelErrors {
+    size_t unmatched = 0;
+    double position = 0, normal = 0, color = 0, uv = 0, scalar = 0;
+    size_t material_mismatches = 0;
+};
+inline ChannelErrors compare_meshes(const Mesh& a, const Mesh& b, double position_tolerance) {
+    ChannelErrors e;
+    if (a.triangles() != b.triangles()) {
+        e.unmatched = a.triangles();
+        return e;
+    }
+    // Grid of b's triangles by centroid, cells of 4 tolerances (and at least 1e-6).
+    const double cell = std::max(4 * position_tolerance, 1e-6);
+    auto key = [&](const float* t, int dx, int dy, int dz) {
+        const long x = std::lround((t[0] + t[3] + t[6]) / 3 / cell) + dx, y = std::lround((t[1] + t[4] + t[7]) / 3 / cell) + dy,
+                   z = std::lround((t[2] + t[5] + t[8]) / 3 / cell) + dz;
+        return std::array<long, 3>{x, y, z};
+    };
+    std::multimap<std::array<long, 3>, size_t> grid;
+    for (size_t t = 0; t < b.triangles(); ++t) grid.emplace(key(&b.xyz[9 * t], 0, 0, 0), t);
+    std::vector<bool> used(b.triangles(), false);
+    for (size_t t = 0; t < a.triangles(); ++t) {
+        const float* pa = &a.xyz[9 * t];
+        size_t best = SIZE_MAX;
+        int best_rot = 0;
+        double best_err = 1e300;
+        for (int dx = -1; dx <= 1; ++dx)
+            for (int dy = -1; dy <= 1; ++dy)
+                for (int dz = -1; dz <= 1; ++dz) {
+                    auto [lo, hi] = grid.equal_range(key(pa, dx, dy, dz));
+                    for (auto it = lo; it != hi; ++it) {
+                        if (used[it->second]) continue;
+                        const float* pb = &b.xyz[9 * it->second];
+                        for (int r = 0; r < 3; ++r) {
+                            double err = 0;
+                            for (int k = 0; k < 3; ++k)
+                                for (int c = 0; c < 3; ++c)
+                                    err = std::max(err, std::abs(double(pa[3 * k + c]) - pb[3 * ((k + r) % 3) + c]));
+                            if (err < best_err) best_err = err, best = it->second, best_rot = r;
+                        }
+                    }
+                }
+        if (best == SIZE_MAX || best_err > position_tolerance) {
+            ++e.unmatched;
+            continue;
+        }
+        used[best] = true;
+        e.position = std::max(e.position, best_err);
+        for (int k = 0; k < 3; ++k) {
+            const size_t ca = 3 * t + k, cb = 3 * best + (k + best_rot) % 3;
+            if (!a.normals.empty() && !b.normals.empty())
+                for (int c = 0; c < 3; ++c) e.normal = std::max(e.normal, std::abs(double(a.normals[3 * ca + c]) - b.normals[3 * cb + c]));
+            if (!a.colors.empty() && !b.colors.empty())
+                for (int c = 0; c < 4; ++c) e.color = std::max(e.color, std::abs(double(a.colors[4 * ca + c]) - b.colors[4 * cb + c]));
+            if (!a.uvs.empty() && !b.uvs.empty())
+                for (int c = 0; c < 2; ++c) e.uv = std::max(e.uv, std::abs(double(a.uvs[2 * ca + c]) - b.uvs[2 * cb + c]));
+            for (size_t s = 0; s < a.scalars.size() && s < b.scalars.size(); ++s)
+                e.scalar = std::max(e.scalar, std::abs(a.scalars[s][ca] - b.scalars[s][cb]));
+        }
+        if (!a.materials.empty() && !b.materials.empty())
+            e.material_mismatches += a.header.materials[a.materials[t]].name != b.header.materials[b.materials[best]].name;
+    }
+    return e;
+}
+
 // Runs a shell command; returns its exit status and captures stdout into `out`.
 inline int run(const std::string& command, std::string* out = nullptr) {
     FILE* p = ::popen(command.c_str(), "r");

@@ -318,3 +318,36 @@ TEST(CliConvert, DropIsSilentAndKeepsTheRest) {
         EXPECT_FALSE(std::filesystem::exists(dir / "d.stl"));
     }
 }
+
+TEST(CliConvert, GltfAndDracoKeepTheirChannelsAndSayWhatTheyDrop) {
+    TempDir dir;
+    const std::string fixtures = MESHSTREAM_FIXTURES_DIR;
+    const std::string box = fixtures + "/gltf/BoxTextured.glb";
+    // glTF holds normals, texture coordinates and the textured material: nothing to say.
+    for (const char* compress : {"draco", "meshopt", "none"}) {
+        cli_test::CliRun glb = run("convert " + box + " " + dir / "b.glb --compress " + compress);
+        EXPECT_EQ(glb.code, 0) << glb.err;
+        EXPECT_EQ(glb.err.find("dropped"), std::string::npos) << compress << ": " << glb.err;
+    }
+    cli_test::CliRun stl = run("convert " + box + " " + dir / "b.stl");
+    EXPECT_NE(stl.err.find("warning: normals, texture coordinates, materials dropped: stl output carries positions only"),
+              std::string::npos)
+        << stl.err;
+    // Draco keeps the normals and texture coordinates, not the material.
+    cli_test::CliRun drc = run("convert " + box + " " + dir / "b.drc");
+    EXPECT_EQ(drc.code, 0) << drc.err;
+    EXPECT_NE(drc.err.find("warning: materials dropped: draco output"), std::string::npos) << drc.err;
+    EXPECT_EQ(drc.err.find("normals"), std::string::npos) << drc.err;
+    cli_test::CliRun dropped = run("convert " + box + " " + dir / "c.drc --drop materials");
+    EXPECT_EQ(dropped.code, 0) << dropped.err;
+    EXPECT_EQ(dropped.err.find("dropped"), std::string::npos) << dropped.err;
+    // Named vertex scalars are Draco generic attributes, which glTF does not carry.
+    const std::string tetra = fixtures + "/ply/cgal_colored_tetra.ply";
+    cli_test::CliRun tetra_drc = run("convert " + tetra + " " + dir / "t.drc");
+    EXPECT_EQ(tetra_drc.code, 0) << tetra_drc.err;
+    EXPECT_EQ(tetra_drc.err.find("vertex property 'id'"), std::string::npos) << tetra_drc.err;
+    EXPECT_NE(tetra_drc.err.find("face property 'label'"), std::string::npos) << tetra_drc.err;
+    cli_test::CliRun tetra_glb = run("convert " + tetra + " " + dir / "t.glb");
+    EXPECT_NE(tetra_glb.err.find("vertex property 'id'"), std::string::npos) << tetra_glb.err;
+    EXPECT_EQ(tetra_glb.err.find("colour"), std::string::npos) << tetra_glb.err;
+}
