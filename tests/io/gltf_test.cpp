@@ -1257,6 +1257,51 @@ TEST(GltfChannels, DracoElephantsNormalsThroughEveryCompression) {
     }
 }
 
+TEST(GltfChannels, PlyNormalsAndTextureCoordinatesThroughGlbAndDrc) {
+    // cube_uv.ply: 24 corner vertices with normals and s/t; the elephant: per-vertex normals.
+    TempDir dir;
+    for (const char* file : {"ply/cube_uv.ply", "ply/elephant_normals.binary_be.ply"}) {
+        SCOPED_TRACE(file);
+        const Mesh ref = read_mesh(fixture(file));
+        ASSERT_TRUE(ref.header.channels.normal);
+        const bool uv = ref.header.channels.uv_sets > 0;
+        float lo = ref.xyz[0], hi = ref.xyz[0];
+        for (float x : ref.xyz) lo = std::min(lo, x), hi = std::max(hi, x);
+        const double step = 0.5 * (hi - lo) / 16383 * 1.0001 + 1e-7;
+        float ulo = 0, uhi = 0;
+        for (float x : ref.uvs) ulo = std::min(ulo, x), uhi = std::max(uhi, x);
+        struct Case {
+            const char* name;
+            io::WriteOptions::Compression compression;
+            double position, normal, uv;
+        } cases[] = {
+            {"p.glb", io::WriteOptions::Compression::kNone, 0, 0, 0},
+            {"m.glb", io::WriteOptions::Compression::kMeshopt, step, 2.0 / 127, 0},
+            {"d.glb", io::WriteOptions::Compression::kDraco, step, 4.0 / 1023, 0.5 * (uhi - ulo) / 4095 * 1.0001 + 1e-6},
+            {"d.drc", io::WriteOptions::Compression::kDraco, step, 4.0 / 1023, 0.5 * (uhi - ulo) / 4095 * 1.0001 + 1e-6},
+        };
+        for (const Case& c : cases) {
+            SCOPED_TRACE(c.name);
+            io::WriteOptions o;
+            o.compression = c.compression;
+            EXPECT_TRUE(write_mesh(ref, dir / c.name, o).empty());
+            if (std::string(c.name).ends_with(".glb")) expect_valid(dir / c.name);
+            const Mesh back = read_mesh(dir / c.name);
+            EXPECT_TRUE(back.header.channels.normal);
+            EXPECT_EQ(back.header.channels.uv_sets, ref.header.channels.uv_sets);
+            const ChannelErrors e = compare_meshes(ref, back, c.position);
+            EXPECT_EQ(e.unmatched, 0u);
+            EXPECT_LE(e.normal, c.normal);
+            if (uv) {
+                EXPECT_LE(e.uv, c.uv);
+            }
+            // The vertices are the PLY's: 24 for the cube (its seams), the elephant's 2775.
+            EXPECT_EQ(back.header.vertex_count.value_or(std::set<uint64_t>(back.ids.begin(), back.ids.end()).size()),
+                      ref.header.vertex_count);
+        }
+    }
+}
+
 TEST(GltfRender, WrittenFilesRenderInThreeJs) {
     // What a web page shows: three.js's GLTFLoader (with MeshoptDecoder and DRACOLoader) in
     // headless Chromium loads each output, and the picture holds the mesh.
