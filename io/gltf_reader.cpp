@@ -424,7 +424,8 @@ private:
     AccessorView view(int accessor, const std::string& what) const;
     std::shared_ptr<const PrimitiveGeometry> geometry(int mesh, int prim);
     // Reads vertex attribute `semantic` of a plain primitive into `out` (`per` values a vertex:
-    // the accessor's components, then `fill` up to `per`), checking its type and count.
+    // the accessor's components, then 1 up to `per`, so a VEC3 colour is opaque), checking its
+    // component count and element count; nothing when absent or not wanted.
     void read_attribute(const tinygltf::Primitive& p, const std::string& semantic, const std::string& at,
                         size_t vertices, int per, std::vector<float>& out) const;
     void describe_channels(const ImageBytes& images);
