@@ -1,8 +1,11 @@
-// Bench-only speed reference (bench/decimate.sh): the in-core pipeline a user would write with
-// meshoptimizer: read the whole mesh, weld exact duplicate positions
-// (meshopt_generateVertexRemap), meshopt_simplify to the target count, write. Prints one line
-// "ref_meshopt: in N out M seconds S" on stderr.
-//   ref_meshopt IN OUT --target N
+// Bench-only speed and quality reference (bench/decimate.sh): the in-core pipeline a user
+// would write with meshoptimizer 1.2 (../shared/peers/meshoptimizer-1.2, built by
+// bench/CMakeLists.txt, never linked into the product): read the whole mesh, weld exact
+// duplicate positions (meshopt_generateVertexRemap), simplify to the target count, write.
+// By default meshopt_simplifyWithUpdate, which moves the kept vertices to their quadric optimum
+// as meshstream does; --plain calls meshopt_simplify (vertices stay at input positions).
+// Prints one line "ref_meshopt: in N out M seconds S" on stderr.
+//   ref_meshopt IN OUT --target N [--plain]
 #include "io/error.hpp"
 #include "io/format.hpp"
 
@@ -17,8 +20,9 @@
 
 int main(int argc, char** argv) {
     using namespace meshstream;
-    if (argc != 5 || std::string(argv[3]) != "--target") {
-        std::fprintf(stderr, "usage: ref_meshopt IN OUT --target TRIANGLES\n");
+    const bool plain = argc == 6 && std::string(argv[5]) == "--plain";
+    if ((argc != 5 && !plain) || std::string(argv[3]) != "--target") {
+        std::fprintf(stderr, "usage: ref_meshopt IN OUT --target TRIANGLES [--plain]\n");
         return 2;
     }
     size_t target = std::strtoull(argv[4], nullptr, 10);
@@ -38,11 +42,21 @@ int main(int argc, char** argv) {
         meshopt_remapVertexBuffer(vertices.data(), soup.data(), corners, 3 * sizeof(float), remap.data());
         soup = {};
         std::vector<unsigned int> indices(remap);  // the unindexed soup's index buffer is the remap
-        std::vector<unsigned int> out(indices.size());
+        remap = {};
         float error = 0;
         // target_error 1 (the whole mesh extent): stop on the count, not on an error bound.
-        size_t n = meshopt_simplify(out.data(), indices.data(), indices.size(), vertices.data(), vertex_count,
-                                    3 * sizeof(float), 3 * target, 1.0f, 0, &error);
+        size_t n = 0;
+        std::vector<unsigned int> out;
+        if (plain) {
+            out.resize(indices.size());
+            n = meshopt_simplify(out.data(), indices.data(), indices.size(), vertices.data(), vertex_count,
+                                 3 * sizeof(float), 3 * target, 1.0f, 0, &error);
+        } else {
+            n = meshopt_simplifyWithUpdate(indices.data(), indices.size(), vertices.data(), vertex_count,
+                                           3 * sizeof(float), nullptr, 0, nullptr, 0, nullptr, 3 * target, 1.0f, 0,
+                                           &error);
+            out.swap(indices);
+        }
         io::Output o = io::open_output(argv[2], "", {});
         io::TriangleChunk chunk;
         for (size_t i = 0; i < n; i += 3) {
