@@ -32,28 +32,20 @@ void* allocate_pool(size_t bytes) {
     return p;
 }
 
-FaceSet::FaceSet(size_t capacity, Face* faces, int slot)
-    : items_(raw_array<uint32_t>(capacity)), faces_(faces), slot_(slot) {}
-
 namespace {
 
 size_t pow2_at_least(size_t n) { return std::bit_ceil(n < 16 ? size_t{16} : n); }
 
 using io::mix64;
 
-uint32_t float_key(float x) {
-    if (x == 0.0f) x = 0.0f;  // −0 welds with +0
-    uint32_t bits;
-    std::memcpy(&bits, &x, 4);
-    return bits;
-}
-
 }  // namespace
 
 size_t HalfEdgeBuffer::reserved_bytes(size_t triangle_capacity) {
     const size_t n = triangle_capacity, vertices = 3 * n + 3;
-    return n * (sizeof(Face) + 4 + 3 * 4) + vertices * (sizeof(VertexSlot) + 4) +
-           pow2_at_least(2 * vertices) * 4 + pow2_at_least(n / 8) * sizeof(Stub);
+    const size_t hash_slots = pow2_at_least(2 * vertices);
+    return n * (sizeof(Face) + 4) + pow2_at_least(2 * n) * sizeof(InteriorEntry) +
+           vertices * (sizeof(VertexSlot) + 4 + 4) + hash_slots * 4 + hash_slots / 2 * 4 +
+           pow2_at_least(n / 8) * sizeof(Stub);
 }
 
 HalfEdgeBuffer::HalfEdgeBuffer(size_t triangle_capacity, double weld_eps)
@@ -64,15 +56,17 @@ HalfEdgeBuffer::HalfEdgeBuffer(size_t triangle_capacity, double weld_eps)
       weld_eps_(weld_eps),
       faces_(raw_array<Face>(triangle_capacity)),
       free_faces_(raw_array<uint32_t>(triangle_capacity)),
-      live_(triangle_capacity, faces_.get(), 0),
-      interior_(triangle_capacity, faces_.get(), 1),
-      frontier_(triangle_capacity, faces_.get(), 2),
+      interior_(raw_array<InteriorEntry>(pow2_at_least(2 * triangle_capacity))),
+      interior_mask_(pow2_at_least(2 * triangle_capacity) - 1),
       slots_(raw_array<VertexSlot>(vertex_capacity_)),
-      free_vertices_(raw_array<uint32_t>(vertex_capacity_)) {
+      free_vertices_(raw_array<uint32_t>(vertex_capacity_)),
+      pending_(raw_array<uint32_t>(vertex_capacity_)) {
     // Half-edge indices 4·f + k must stay below the twin markers.
     assert(triangle_capacity >= 4 && triangle_capacity <= (size_t{1} << 30) - 1);
-    const size_t slots = pow2_at_least(2 * vertex_capacity_);
-    hash_ = raw_array<uint32_t>(slots);
+    hash_max_slots_ = pow2_at_least(2 * vertex_capacity_);
+    hash_ = raw_array<uint32_t>(hash_max_slots_);
+    hash_scratch_ = raw_array<uint32_t>(hash_max_slots_ / 2);
+    const size_t slots = std::min<size_t>(hash_max_slots_, 1u << 15);
     std::fill_n(hash_.get(), slots, kNoIndex);
     hash_mask_ = slots - 1;
     const size_t stub_slots = pow2_at_least(triangle_capacity / 8);
@@ -98,26 +92,28 @@ double HalfEdgeBuffer::weld_cell(float x) const {
     return std::floor(double(x) / weld_eps_ + 0.5);
 }
 
-size_t HalfEdgeBuffer::hash_slot(const float p[3]) const {
-    if (weld_eps_ == 0) {
-        // Exact welding hashes every corner (and prefetches hash it again): one multiply-
-        // xorshift round over the 96 key bits is enough to spread float bit patterns.
-        const uint64_t xy = uint64_t{float_key(p[0])} | uint64_t{float_key(p[1])} << 32;
-        uint64_t h = xy * 0x9e3779b97f4a7c15ull ^ uint64_t{float_key(p[2])} * 0xc2b2ae3d27d4eb4full;
-        h ^= h >> 32;
-        h *= 0xd6e8feb86659fd93ull;
-        h ^= h >> 32;
-        return h & hash_mask_;
-    }
+uint64_t HalfEdgeBuffer::cell_hash(const float p[3]) const {
     uint64_t k[3];
     for (int i = 0; i < 3; ++i)
         // The cell index as the bits of the (integral) double: an int64 cast overflows for
         // huge coordinates or tiny cells (fuzz finding, FuzzRegression.Issue7_WeldHugeCoordinate).
-        k[i] = weld_eps_ == 0 ? float_key(p[i])
-                              : std::bit_cast<uint64_t>(weld_cell(p[i]) + 0.0);
-    return mix64(k[0] * 0x9e3779b97f4a7c15ull ^ mix64(k[1] + 0x632be59bd9b4e019ull) ^
-                 (k[2] * 0xc2b2ae3d27d4eb4full)) &
-           hash_mask_;
+        k[i] = std::bit_cast<uint64_t>(weld_cell(p[i]) + 0.0);
+    return mix64(k[0] * 0x9e3779b97f4a7c15ull ^ mix64(k[1] + 0x632be59bd9b4e019ull) ^ (k[2] * 0xc2b2ae3d27d4eb4full));
+}
+
+void HalfEdgeBuffer::grow_hash() {
+    const size_t old_slots = hash_mask_ + 1;
+    size_t n = 0;
+    for (size_t i = 0; i < old_slots; ++i)
+        if (hash_[i] != kNoIndex) hash_scratch_[n++] = hash_[i];
+    std::fill_n(hash_.get(), 2 * old_slots, kNoIndex);
+    hash_mask_ = 2 * old_slots - 1;
+    for (size_t i = 0; i < n; ++i) {
+        const uint32_t v = hash_scratch_[i];
+        size_t slot = weld_hash(slots_[v].vertex.pos) & hash_mask_;
+        while (hash_[slot] != kNoIndex) slot = (slot + 1) & hash_mask_;
+        hash_[slot] = v;
+    }
 }
 
 uint32_t HalfEdgeBuffer::alloc_vertex() {
@@ -138,12 +134,11 @@ uint32_t HalfEdgeBuffer::alloc_vertex() {
     slot.vertex.flags = kAlive;
     slot.vertex.id = 0;
     slot.quadric = Quadric{};
-    slot.stamp = 0;
+    slot.mark = 0;
     return v;
 }
 
 void HalfEdgeBuffer::free_vertex(uint32_t v) {
-    ++edits_;
     Vertex& x = slots_[v].vertex;
     assert(x.face_count == 0 && (x.flags & kInHash) == 0);
     x.flags = 0;
@@ -152,7 +147,8 @@ void HalfEdgeBuffer::free_vertex(uint32_t v) {
     --vertex_used_;
 }
 
-uint32_t HalfEdgeBuffer::weld(const float p[3], size_t slot) {
+uint32_t HalfEdgeBuffer::weld(const float p[3], uint64_t hash) {
+    size_t slot = hash & hash_mask_;
     if (weld_eps_ == 0) {
         // Exact welding: vertices in the table keep the position they were entered with,
         // stored with −0 made +0, so comparing raw bits against the normalized key is
@@ -188,12 +184,19 @@ uint32_t HalfEdgeBuffer::weld(const float p[3], size_t slot) {
     // moving every vertex to the grid point).
     for (int i = 0; i < 3; ++i) x.pos[i] = p[i] == 0.0f ? 0.0f : p[i];
     x.flags |= kInHash;
+    if (2 * (hash_count_ + 1) > hash_mask_ + 1 && hash_mask_ + 1 < hash_max_slots_) {
+        grow_hash();
+        slot = hash & hash_mask_;
+        while (hash_[slot] != kNoIndex) slot = (slot + 1) & hash_mask_;
+    }
     hash_[slot] = v;
+    ++hash_count_;
     return v;
 }
 
 void HalfEdgeBuffer::hash_erase(uint32_t v) {
-    size_t slot = hash_slot(slots_[v].vertex.pos);
+    --hash_count_;
+    size_t slot = weld_hash(slots_[v].vertex.pos) & hash_mask_;
     while (hash_[slot] != v) {
         assert(hash_[slot] != kNoIndex);
         slot = (slot + 1) & hash_mask_;
@@ -203,7 +206,7 @@ void HalfEdgeBuffer::hash_erase(uint32_t v) {
     for (size_t i = (hole + 1) & hash_mask_;; i = (i + 1) & hash_mask_) {
         const uint32_t w = hash_[i];
         if (w == kNoIndex) break;
-        const size_t home = hash_slot(slots_[w].vertex.pos);
+        const size_t home = weld_hash(slots_[w].vertex.pos) & hash_mask_;
         // Move w into the hole when its home is not cyclically within (hole, i].
         const bool home_in_range = hole <= i ? (home > hole && home <= i) : (home > hole || home <= i);
         if (!home_in_range) {
@@ -214,15 +217,53 @@ void HalfEdgeBuffer::hash_erase(uint32_t v) {
     hash_[hole] = kNoIndex;
 }
 
-void HalfEdgeBuffer::update_face_sets(uint32_t f) {
-    if (faces_[f].pin_count == 0) {
-        interior_.insert(f);
-        if (faces_[f].touches_out) frontier_.insert(f);
-        else frontier_.erase(f);
-    } else {
-        interior_.erase(f);
-        frontier_.erase(f);
+void HalfEdgeBuffer::enter_interior(uint32_t f) {
+    if (interior_size_ == interior_mask_ + 1) {
+        // Full: drop the entries of faces removed since they were listed, keeping the order.
+        // At most face_capacity_ faces are in core, so at least half the ring comes free.
+        size_t kept = 0;
+        for (size_t i = 0; i < interior_size_; ++i) {
+            const InteriorEntry e = interior_[(interior_head_ + i) & interior_mask_];
+            if (faces_[e.face].alive && faces_[e.face].born == e.born)
+                interior_[(interior_head_ + kept++) & interior_mask_] = e;
+        }
+        interior_size_ = kept;
+        assert(interior_size_ <= interior_mask_);
     }
+    interior_[(interior_head_ + interior_size_++) & interior_mask_] = InteriorEntry{f, faces_[f].born};
+}
+
+uint32_t HalfEdgeBuffer::oldest_interior_face() {
+    while (interior_size_ > 0) {
+        const InteriorEntry e = interior_[interior_head_];
+        if (faces_[e.face].alive && faces_[e.face].born == e.born) return e.face;
+        interior_head_ = (interior_head_ + 1) & interior_mask_;
+        --interior_size_;
+    }
+    return kNoIndex;
+}
+
+bool HalfEdgeBuffer::one_fan(uint32_t v) const {
+    // Walk round v from its first corner one way (e → twin(prev(e))) until back at the start
+    // or at an edge without partner, then the other way (e → next(twin(e))); one fan reaches
+    // every face of v.
+    const Vertex& x = slots_[v].vertex;
+    const uint32_t start = x.first_corner;
+    uint32_t count = 1;
+    for (uint32_t e = start;;) {
+        const uint32_t t = twin(prev_in_face(e));
+        if (!is_half_edge(t)) break;
+        if (t == start) return count == x.face_count;
+        e = t;
+        if (++count > x.face_count) return false;
+    }
+    for (uint32_t e = start;;) {
+        const uint32_t t = twin(e);
+        if (!is_half_edge(t)) break;
+        e = next_in_face(t);
+        if (++count > x.face_count) return false;
+    }
+    return count == x.face_count;
 }
 
 bool HalfEdgeBuffer::take_written_stub(uint32_t a, uint32_t b) {
@@ -265,12 +306,11 @@ void HalfEdgeBuffer::add_written_stub(uint32_t a, uint32_t b) {
 // add_triangle); shorter ones are, as the faster way for ordinary valences.
 constexpr uint32_t kLongCornerList = 64;
 
-HalfEdgeBuffer::Added HalfEdgeBuffer::add_triangle(const float tri[9], const size_t slots[3]) {
-    ++edits_;
+HalfEdgeBuffer::Added HalfEdgeBuffer::add_triangle(const float tri[9], const uint64_t hashes[3]) {
     assert(!full() && free_vertex_count() >= 3);
     Added added;
     for (int k = 0; k < 3; ++k)
-        added.vertex[k] = weld(tri + 3 * k, slots ? slots[k] : hash_slot(tri + 3 * k));
+        added.vertex[k] = weld(tri + 3 * k, hashes ? hashes[k] : weld_hash(tri + 3 * k));
     const uint32_t* v = added.vertex;
     if (!origin_set_) {
         for (int i = 0; i < 3; ++i) origin_[i] = tri[i];
@@ -287,9 +327,11 @@ HalfEdgeBuffer::Added HalfEdgeBuffer::add_triangle(const float tri[9], const siz
     for (int k = 0; k < 3; ++k) slots_[v[k]].quadric += q;
 
     const uint32_t f = free_face_count_ > 0 ? free_faces_[--free_face_count_] : face_high_++;
-    live_.reset(f);
-    interior_.reset(f);
-    frontier_.reset(f);
+    ++face_count_;
+    Face& added_face = faces_[f];
+    added_face.born = ++born_counter_;
+    added_face.key[0] = added_face.key[1] = added_face.key[2] = kNotQueued;
+    added_face.alive = 1;
     // Connect each half-edge a→b to an open partner b→a. Anything else (a second a→b, or
     // b→a already taken) makes the edge non-manifold: the new half-edge stays unconnected and
     // both ends are frozen against collapses.
@@ -363,25 +405,17 @@ HalfEdgeBuffer::Added HalfEdgeBuffer::add_triangle(const float tri[9], const siz
             ++nonmanifold_edges_;
         }
     }
-    bool out = false;
-    for (uint32_t k = 0; k < 3; ++k) {
-        link_corner(v[k], half_edge(f, k));
-        out |= (slots_[v[k]].vertex.flags & kFrozen) != 0;
-    }
+    for (uint32_t k = 0; k < 3; ++k) link_corner(v[k], half_edge(f, k));
     // Every corner was found through (or entered into) the hash table, so all three are on
     // P_in; vertices whose fan just closed leave it.
-    faces_[f].pin_count = 3;
-    faces_[f].touches_out = out;
-    live_.insert(f);
+    added_face.pin_count = 3;
     for (int k = 0; k < 3; ++k)
         if (slots_[v[k]].vertex.open_edges == 0) finalize_vertex(v[k]);
-    update_face_sets(f);
     added.face = f;
     return added;
 }
 
 void HalfEdgeBuffer::finalize_vertex(uint32_t v) {
-    ++edits_;
     Vertex& x = slots_[v].vertex;
     if ((x.flags & kInHash) == 0) return;
     // Its open edges are final now (no input reaches v any more): a true boundary. Add Garland
@@ -406,27 +440,24 @@ void HalfEdgeBuffer::finalize_vertex(uint32_t v) {
     }
     hash_erase(v);
     x.flags &= ~kInHash;
-    for (uint32_t c = x.first_corner; c != kNoIndex; c = next_corner(c)) {
-        const uint32_t f = face_of(c);
-        --faces_[f].pin_count;
-        update_face_sets(f);
+    if (x.face_count == 0) {
+        free_vertex(v);
+        return;
     }
-    if (x.face_count == 0) free_vertex(v);
+    for (uint32_t c = x.first_corner; c != kNoIndex; c = next_corner(c))
+        if (--faces_[face_of(c)].pin_count == 0) enter_interior(face_of(c));
+    // A vertex where two fans touch must not move (it is not a manifold vertex); finding out
+    // now, once, spares every collapse the walk.
+    if (!one_fan(v)) x.flags |= kManyFans;
+    mark_pending(v);
 }
 
 void HalfEdgeBuffer::freeze(uint32_t v, uint64_t id) {
-    ++edits_;
     Vertex& x = slots_[v].vertex;
     assert((x.flags & kFrozen) == 0);
     x.flags |= kFrozen;
     x.id = id;
-    for (uint32_t c = x.first_corner; c != kNoIndex; c = next_corner(c)) {
-        const uint32_t f = face_of(c);
-        if (!faces_[f].touches_out) {
-            faces_[f].touches_out = 1;
-            update_face_sets(f);
-        }
-    }
+    mark_pending(v);
 }
 
 void HalfEdgeBuffer::link_corner(uint32_t v, uint32_t c) {
@@ -450,28 +481,19 @@ void HalfEdgeBuffer::unlink_corner(uint32_t v, uint32_t c) {
 }
 
 void HalfEdgeBuffer::detach_face(uint32_t f) {
-    ++edits_;
     for (uint32_t k = 0; k < 3; ++k) unlink_corner(faces_[f].vertex[k], half_edge(f, k));
-    live_.erase(f);
-    interior_.erase(f);
-    frontier_.erase(f);
+    faces_[f].alive = 0;
+    --face_count_;
     free_faces_[free_face_count_++] = f;
 }
 
 void HalfEdgeBuffer::move_corners(uint32_t p, uint32_t q) {
-    ++edits_;
     Vertex& from = slots_[p].vertex;
-    const bool q_frozen = (slots_[q].vertex.flags & kFrozen) != 0;
     uint32_t c = from.first_corner;
     while (c != kNoIndex) {
         const uint32_t next = next_corner(c);
         faces_[face_of(c)].vertex[corner_of(c)] = q;
-        link_corner(q, c);  // at the head of q's list, in p's order reversed (as before)
-        const uint32_t f = face_of(c);
-        if (q_frozen && !faces_[f].touches_out) {
-            faces_[f].touches_out = 1;
-            update_face_sets(f);
-        }
+        link_corner(q, c);  // at the head of q's list, in p's order reversed
         c = next;
     }
     from.first_corner = kNoIndex;

@@ -6,34 +6,39 @@
 //   kOpenEdge        no partner yet: the edge lies on P_in (towards unread input) or on a hole,
 //   kWrittenEdge     the partner was written (the edge lies on P_out),
 //   kNonManifoldEdge a third face on an edge, a duplicate or an orientation conflict: frozen.
-// Every vertex also keeps a singly linked list of its corners, so its full neighbourhood is
+// Every vertex also keeps a doubly linked list of its corners, so its full neighbourhood is
 // known even where the input is not manifold (the link condition needs that).
 //
 // READ (§4.2) welds vertices on exact position (or on a grid of `weld_eps`) through an
 // open-addressing hash table that holds only vertices still open towards unread input (P_in):
 // a vertex leaves the table once every incident edge has a partner, or when it is finalized
-// (end of input, sorted sweep, eviction). Each incoming triangle adds its area-weighted plane
-// quadric to its three vertices.
+// (end of input, sorted sweep, eviction). Each incoming triangle adds its plane quadric to its
+// three vertices.
 //
-// Two dense index sets serve the writer (§4.4): faces touching no P_in vertex ("interior"),
-// and the subset of those touching P_out (a frozen, already written vertex).
+// Two lists tell the decimator what changed: vertices whose collapses need rating (they left
+// P_in or were written: take_pending()), and faces that left P_in, oldest first (the write
+// order, oldest_interior_face()). Each face record also holds the collapse queue's key of its
+// three half-edges (collapse_queue.hpp).
 //
 // Layout (the pools are far larger than the caches and are read at random, so the number of
 // distinct cache lines touched per operation is what costs): everything about a face — its
-// three corner vertices, twins, both corner-list links and its places in the face sets — is
-// one 64-byte line; everything about a vertex — the record, the walk stamp and its quadric —
-// is one 128-byte pair of lines.
+// three corner vertices, twins, both corner-list links and its queue keys — is one 64-byte
+// line; everything about a vertex — the record, a mark and its quadric — is one 128-byte pair
+// of lines.
 //
-// Memory bound: for capacity N triangles, 64·N bytes of faces plus 12·N of face sets and free
-// list, 3·N+3 vertex slots of 128 + 4 bytes and a 4-byte hash slot per 1/2 vertex: about
-// 490·N bytes reserved, of which only the touched part becomes resident (pools hand out the
-// most recently freed slot first, and a manifold buffer holds about N/2 vertices).
+// Memory bound: for capacity N triangles, 64·N bytes of faces plus 4·N of free list and up to
+// 32·N of interior order, 3·N+3 vertex slots of 128 + 8 bytes (free list, pending list) and
+// 12–24 bytes of welding hash per vertex (the table and half as much to rehash through),
+// a 16-byte stub slot per N/8 to N/4 triangles: about 560·N bytes reserved, of which only the
+// touched part becomes resident (pools hand out the most recently freed slot first, a manifold
+// buffer holds about N/2 vertices, and the hash table grows with P_in).
 #pragma once
 
 #include "decimate/quadric.hpp"
 
-#include <cstddef>
 #include <algorithm>
+#include <bit>
+#include <cstddef>
 #include <cstdint>
 #include <cstdlib>
 #include <memory>
@@ -58,20 +63,23 @@ inline uint32_t next_in_face(uint32_t h) { return h + kToNextInFace[h & 3]; }
 inline uint32_t prev_in_face(uint32_t h) { return h + kToPrevInFace[h & 3]; }
 
 // Vertex flags.
-inline constexpr uint8_t kInHash = 1;        // open towards unread input: on P_in
-inline constexpr uint8_t kFrozen = 2;        // written (on P_out): position final, id assigned
-inline constexpr uint8_t kNonManifold = 4;   // touches a non-manifold edge: never collapsed
-inline constexpr uint8_t kWeldMerged = 8;    // absorbed another input position (--weld)
-inline constexpr uint8_t kAlive = 16;
-inline constexpr uint8_t kHasPartner = 32;  // partner_position() holds a collapsed edge's far end
+inline constexpr uint16_t kInHash = 1;        // open towards unread input: on P_in
+inline constexpr uint16_t kFrozen = 2;        // written (on P_out): position final, id assigned
+inline constexpr uint16_t kNonManifold = 4;   // touches a non-manifold edge: never collapsed
+inline constexpr uint16_t kWeldMerged = 8;    // absorbed another input position (--weld)
+inline constexpr uint16_t kAlive = 16;
+inline constexpr uint16_t kHasPartner = 32;   // partner_position() holds a collapsed edge's far end
+inline constexpr uint16_t kPending = 64;      // listed for take_pending()
+inline constexpr uint16_t kBlocked = 128;     // a collapse at it was refused (collapse.hpp)
+inline constexpr uint16_t kManyFans = 256;    // its faces are not one fan (two fans touch here)
 
 struct Vertex {
-    float pos[3];           // input position, moved once when written (§4.4)
+    float pos[3];           // input position, moved by collapses and once when written (§4.4)
     uint32_t first_corner;  // head of the corner list (kNoIndex when no face)
     uint32_t face_count;
     uint32_t open_edges;    // incident half-edges without partner (kOpenEdge), also written ones
     uint32_t generation;    // bumped at every allocation (stale references detect reuse)
-    uint8_t flags;
+    uint16_t flags;
     union {
         uint64_t id;               // output vertex id, valid once kFrozen
         float partner_xy[2];       // before freezing: see HalfEdgeBuffer::partner_position
@@ -91,6 +99,9 @@ template <class T> RawArray<T> raw_array(size_t n) {
     return RawArray<T>(static_cast<T*>(allocate_pool(n * sizeof(T))));
 }
 
+// The queue key of a half-edge that is not queued (collapse_queue.hpp).
+inline constexpr uint16_t kNotQueued = 0xFFFF;
+
 // Everything about one face, in one cache line. Corner k of face f is corner 4·f + k, which is
 // also the half-edge from corner k to corner (k+1) mod 3.
 struct alignas(64) Face {
@@ -98,60 +109,33 @@ struct alignas(64) Face {
     uint32_t twin[3];       // half-edge → twin half-edge or marker
     uint32_t next[3];       // corner → next corner of the same vertex (kNoIndex: last)
     uint32_t prev[3];       // corner → previous corner of the same vertex (kNoIndex: first)
-    uint32_t where[3];      // index in the live, interior and frontier FaceSets (kNoIndex: absent)
+    uint32_t born;          // creation serial: tells a reused slot from the face listed before
+    uint16_t key[3];        // collapse queue key of half-edge k's edge, or kNotQueued
     uint8_t pin_count;      // vertices on P_in
-    uint8_t touches_out;    // has a frozen vertex
+    uint8_t alive;
 };
 static_assert(sizeof(Face) == 64);
-
-// A set of face indices with O(1) insert, erase and uniform sampling. The item array is dense;
-// a face's index in it is kept in the face record (Face::where[slot]).
-class FaceSet {
-public:
-    FaceSet(size_t capacity, Face* faces, int slot);
-    bool contains(uint32_t f) const { return faces_[f].where[slot_] != kNoIndex; }
-    void insert(uint32_t f) {
-        uint32_t& w = faces_[f].where[slot_];
-        if (w != kNoIndex) return;
-        w = static_cast<uint32_t>(size_);
-        items_[size_++] = f;
-    }
-    void erase(uint32_t f) {
-        uint32_t& w = faces_[f].where[slot_];
-        if (w == kNoIndex) return;
-        const uint32_t i = w;
-        const uint32_t last = items_[--size_];
-        items_[i] = last;
-        faces_[last].where[slot_] = i;
-        w = kNoIndex;
-    }
-    // Call when slot f is (re)allocated: marks it absent.
-    void reset(uint32_t f) { faces_[f].where[slot_] = kNoIndex; }
-    size_t size() const { return size_; }
-    uint32_t at(size_t i) const { return items_[i]; }
-    void prefetch(size_t i) const { __builtin_prefetch(&items_[i]); }
-
-private:
-    RawArray<uint32_t> items_;
-    Face* faces_;
-    int slot_;
-    size_t size_ = 0;
-};
 
 class HalfEdgeBuffer {
 public:
     // `triangle_capacity` ≥ 4. `weld_eps` = 0: weld on exact float position (−0 equals +0);
     // > 0: weld positions nearest to the same point of a grid of that size.
     HalfEdgeBuffer(size_t triangle_capacity, double weld_eps);
-    // The address space the constructor reserves for `triangle_capacity` (about 500 bytes a
-    // triangle); the hash and stub tables of it are resident at once, the pools when touched.
+    // The address space the constructor reserves for `triangle_capacity` (about 560 bytes a
+    // triangle); the stub table is resident at once, the welding hash as it grows, the pools
+    // when touched.
     static size_t reserved_bytes(size_t triangle_capacity);
 
     size_t face_capacity() const { return face_capacity_; }
-    size_t face_count() const { return live_.size(); }
-    bool full() const { return live_.size() == face_capacity_; }
+    size_t face_count() const { return face_count_; }
+    bool full() const { return face_count_ == face_capacity_; }
     // Free vertex slots; add_triangle needs 3.
     size_t free_vertex_count() const { return vertex_capacity_ - vertex_used_; }
+    // Face slots [0, face_slots()) have been used; face_alive() tells which hold a face.
+    uint32_t face_slots() const { return face_high_; }
+    // Vertex slots [0, vertex_slots()) have been used; kAlive tells which hold a vertex.
+    uint32_t vertex_slots() const { return vertex_high_; }
+    bool face_alive(uint32_t f) const { return faces_[f].alive != 0; }
 
     struct Added {
         uint32_t face;     // kNoIndex when degenerate (two corners welded to one vertex)
@@ -161,20 +145,22 @@ public:
     // its in-core neighbours. Preconditions: !full(), free_vertex_count() ≥ 3. A degenerate
     // triangle is not inserted (its vertices are, so the caller can pass it through).
     Added add_triangle(const float tri[9]) { return add_triangle(tri, nullptr); }
-    // The same with the corners' welding hash slots precomputed by weld_slots() (or null).
-    Added add_triangle(const float tri[9], const size_t slots[3]);
-    // The welding hash slots of a triangle's corners (a pure function of the positions).
-    void weld_slots(const float tri[9], size_t slots[3]) const {
-        for (int k = 0; k < 3; ++k) slots[k] = hash_slot(tri + 3 * k);
+    // The same with the corners' welding hashes precomputed by weld_hashes() (or null).
+    Added add_triangle(const float tri[9], const uint64_t hashes[3]);
+    // The welding hashes of a triangle's corners (a pure function of the positions).
+    void weld_hashes(const float tri[9], uint64_t hashes[3]) const {
+        for (int k = 0; k < 3; ++k) hashes[k] = weld_hash(tri + 3 * k);
     }
 
-    // The vertex leaves P_in (no more input will reach it): removed from the hash table; a
-    // vertex without faces is freed.
+    // The vertex leaves P_in (no more input will reach it): removed from the hash table, its
+    // open edges become boundary (quadric planes added), its faces may become interior; it is
+    // listed for take_pending(). A vertex without faces is freed.
     void finalize_vertex(uint32_t v);
-    // Marks the vertex written (P_out) with output id `id`.
+    // Marks the vertex written (P_out) with output id `id`, and lists it for take_pending()
+    // (collapses into it are rated differently now).
     void freeze(uint32_t v, uint64_t id);
-    // Removes face f from the vertex lists and sets and frees it. Twins and open-edge counts
-    // are the caller's business. Vertices left without faces are not freed here.
+    // Removes face f from the vertex lists and frees it. Twins and open-edge counts are the
+    // caller's business. Vertices left without faces are not freed here.
     void detach_face(uint32_t f);
     // Re-points every corner of p to q (the vertex part of a half-edge collapse p→q).
     void move_corners(uint32_t p, uint32_t q);
@@ -188,26 +174,59 @@ public:
     // End of input: every vertex still on P_in becomes true boundary (finalize_vertex).
     void finalize_all();
 
+    // The face that left P_in first among those still in core (all three corners off P_in),
+    // or kNoIndex when every face touches P_in. Faces leave the order only when removed.
+    uint32_t oldest_interior_face();
+
+    // Vertices whose collapses need (re)rating: marks v (at most one entry per vertex until
+    // taken). finalize_vertex() and freeze() mark; so do collapses that change a neighbour.
+    void mark_pending(uint32_t v) {
+        Vertex& x = slots_[v].vertex;
+        if (x.flags & kPending) return;
+        x.flags |= kPending;
+        if (pending_count_ < vertex_capacity_) pending_[pending_count_++] = v;
+        else pending_overflow_ = true;  // take_pending() then scans every vertex
+    }
+    // Calls f(v) for each marked vertex still alive, unmarking it, and empties the list.
+    template <class F> void take_pending(F&& f) {
+        auto take = [&](uint32_t v) {
+            Vertex& x = slots_[v].vertex;
+            if ((x.flags & (kPending | kAlive)) != (kPending | kAlive)) return;
+            x.flags &= ~kPending;
+            f(v);
+        };
+        if (pending_overflow_) {
+            for (uint32_t v = 0; v < vertex_high_; ++v) take(v);
+        } else {
+            for (size_t i = 0; i < pending_count_; ++i) take(pending_[i]);
+        }
+        pending_count_ = 0;
+        pending_overflow_ = false;
+    }
+
     // Accessors.
     uint32_t corner_vertex(uint32_t h) const { return faces_[face_of(h)].vertex[corner_of(h)]; }
     uint32_t twin(uint32_t h) const { return faces_[face_of(h)].twin[corner_of(h)]; }
-    // Cache prefetch hints for batched random sampling (no effect on results).
+    uint16_t& queue_key(uint32_t h) { return faces_[face_of(h)].key[corner_of(h)]; }
+    uint16_t queue_key(uint32_t h) const { return faces_[face_of(h)].key[corner_of(h)]; }
+    const Face& face(uint32_t f) const { return faces_[f]; }
+    // Cache prefetch hints (no effect on results).
     void prefetch_face(uint32_t f) const { __builtin_prefetch(&faces_[f]); }
     void prefetch_vertex(uint32_t v) const {
         __builtin_prefetch(&slots_[v]);
         __builtin_prefetch(reinterpret_cast<const char*>(&slots_[v]) + 64);
     }
-    // Prefetch hints for reading a triangle soon, given its weld_slots(): `stage` 0 fetches
+    // Prefetch hints for reading a triangle soon, given its weld_hashes(): `stage` 0 fetches
     // the hash slots, stage 1 (a few triangles later, once the slots are cached) the vertices
     // they name. Hints only: the table may change before the triangle is read.
-    void prefetch_triangle(const size_t slots[3], int stage) const {
+    void prefetch_triangle(const uint64_t hashes[3], int stage) const {
         for (int k = 0; k < 3; ++k) {
             if (stage == 0) {
-                __builtin_prefetch(&hash_[slots[k]]);
+                __builtin_prefetch(&hash_[hashes[k] & hash_mask_]);
             } else {
                 // An empty slot prefetches vertex 0 instead of branching: whether a corner is
                 // new is a coin toss to the branch predictor.
-                const uint32_t v = hash_[slots[k]];
+                const uint32_t v = hash_[hashes[k] & hash_mask_];
                 prefetch_vertex(v != kNoIndex ? v : 0);
             }
         }
@@ -244,7 +263,6 @@ public:
         slot.vertex.flags |= kHasPartner;
     }
     void set_position(uint32_t v, const double rel[3]) {
-        ++edits_;
         for (int i = 0; i < 3; ++i) slots_[v].vertex.pos[i] = float(rel[i] + origin_[i]);
     }
     // Rounds a relative position to what set_position() would store (float coordinates), so
@@ -266,22 +284,15 @@ public:
 #endif
         return f;
     }
-    const FaceSet& live_faces() const { return live_; }
-    const FaceSet& interior_faces() const { return interior_; }  // no P_in vertex
-    const FaceSet& frontier_faces() const { return frontier_; }  // interior and touching P_out
-    // A fresh mark value for stamp(): vertices stamped with it are "in the current set".
-    uint32_t new_stamp() {
-        if (++stamp_counter_ == 0) {  // wrapped: old marks could alias
-            for (uint32_t v = 0; v < vertex_high_; ++v) slots_[v].stamp = 0;
-            stamp_counter_ = 1;
+    // A fresh mark value for mark(): vertices marked with it are "in the current set".
+    uint32_t new_mark() {
+        if (++mark_counter_ == 0) {  // wrapped: old marks could alias
+            for (uint32_t v = 0; v < vertex_high_; ++v) slots_[v].mark = 0;
+            mark_counter_ = 1;
         }
-        return stamp_counter_;
+        return mark_counter_;
     }
-    uint32_t& stamp(uint32_t v) { return slots_[v].stamp; }
-
-    // Counts structural edits (reads, finalizations, writes, face removals, moves): equal
-    // counts mean nothing changed in between, so ratings computed then are still exact.
-    uint64_t edits() const { return edits_; }
+    uint32_t& mark(uint32_t v) { return slots_[v].mark; }
 
     // Running counts for Stats.
     uint64_t vertices_merged() const { return vertices_merged_; }
@@ -292,14 +303,33 @@ public:
     size_t peak_vertices() const { return vertex_used_peak_; }
 
 private:
-    uint32_t weld(const float p[3], size_t slot);
+    uint32_t weld(const float p[3], uint64_t hash);
     uint32_t alloc_vertex();
-    void update_face_sets(uint32_t f);
     void hash_erase(uint32_t v);
-    size_t hash_slot(const float p[3]) const;
+    void grow_hash();
+    // The welding hash of a position: its float bits with −0 made +0 (exact welding), or its
+    // weld grid cell, mixed.
+    uint64_t weld_hash(const float p[3]) const {
+        if (weld_eps_ == 0) {
+            const uint64_t xy = uint64_t{float_key(p[0])} | uint64_t{float_key(p[1])} << 32;
+            uint64_t h = xy * 0x9e3779b97f4a7c15ull ^ uint64_t{float_key(p[2])} * 0xc2b2ae3d27d4eb4full;
+            h ^= h >> 32;
+            h *= 0xd6e8feb86659fd93ull;
+            return h ^ (h >> 32);
+        }
+        return cell_hash(p);
+    }
+    uint64_t cell_hash(const float p[3]) const;
+    // A float's bits, −0 as +0 (so that they weld).
+    static uint32_t float_key(float x) {
+        const uint32_t bits = std::bit_cast<uint32_t>(x);
+        return (bits << 1) == 0 ? 0 : bits;
+    }
     bool same_key(const float a[3], const float b[3]) const;
     double weld_cell(float x) const;  // grid index (an integral double) of a coordinate
     bool take_written_stub(uint32_t a, uint32_t b);
+    bool one_fan(uint32_t v) const;
+    void enter_interior(uint32_t f);
 
     size_t face_capacity_, vertex_capacity_;
     double weld_eps_;
@@ -309,7 +339,7 @@ private:
     // Everything about one vertex, in one 128-byte pair of cache lines.
     struct alignas(128) VertexSlot {
         Vertex vertex;
-        uint32_t stamp;
+        uint32_t mark;
         float partner_z;  // with Vertex::partner_xy
         Quadric quadric;
     };
@@ -320,26 +350,39 @@ private:
 
     RawArray<Face> faces_;
     RawArray<uint32_t> free_faces_;
-    size_t free_face_count_ = 0;
-    uint32_t face_high_ = 0;
-    FaceSet live_, interior_, frontier_;
+    size_t free_face_count_ = 0, face_count_ = 0;
+    uint32_t face_high_ = 0, born_counter_ = 0;
+
+    // Faces in the order they left P_in: a ring of (face, born) compacted when full (entries
+    // of removed faces are dropped then).
+    struct InteriorEntry {
+        uint32_t face, born;
+    };
+    RawArray<InteriorEntry> interior_;
+    size_t interior_mask_, interior_head_ = 0, interior_size_ = 0;  // capacity a power of two
 
     RawArray<VertexSlot> slots_;
     RawArray<uint32_t> free_vertices_;
     size_t free_vertex_stack_ = 0;
     uint32_t vertex_high_ = 0;
     size_t vertex_used_ = 0, vertex_used_peak_ = 0;
-    uint32_t stamp_counter_ = 0;
+    uint32_t mark_counter_ = 0;
+    RawArray<uint32_t> pending_;
+    size_t pending_count_ = 0;
+    bool pending_overflow_ = false;
 
-    RawArray<uint32_t> hash_;  // vertex index or kNoIndex; linear probing
-    size_t hash_mask_;
+    // Vertex index or kNoIndex; linear probing. The table in use is the first hash_mask_ + 1
+    // slots, doubled (rehashing through hash_scratch_) when half full: P_in is usually a small
+    // front, whose table then stays in cache, but may grow to every in-core vertex.
+    RawArray<uint32_t> hash_;
+    RawArray<uint32_t> hash_scratch_;
+    size_t hash_mask_, hash_max_slots_, hash_count_ = 0;
 
     struct Stub { uint32_t a, gen_a, b, gen_b; };
     RawArray<Stub> stubs_;  // a == kNoIndex: empty; linear probing
     size_t stub_mask_, stub_count_ = 0;
 
     uint64_t vertices_merged_ = 0, nonmanifold_edges_ = 0, boundary_edges_ = 0;
-    uint64_t edits_ = 0;
 };
 
 }  // namespace meshstream::decimate

@@ -21,7 +21,7 @@ namespace meshstream::decimate {
 
 enum class Phase : int {
     kRead,      // READ: add_triangle (welding, quadrics, connectivity)
-    kDraw,      // DECIMATE: drawing candidates and rating them (includes kRate)
+    kQueue,     // DECIMATE: queue upkeep, popping and rating edges (includes kRate, kValidate, kApply)
     kRate,      // collapse_placement (quadric sum, 3×3 solve, errors)
     kValidate,  // collapse_valid (fan, link condition, fold checks)
     kApply,     // apply_collapse
@@ -63,16 +63,17 @@ private:
 };
 
 // Prints each phase's calls, ticks per call and share of the ticks since the first timed
-// scope (drawing without the ratings it contains, so the shares add up).
+// scope (queue upkeep without the phases it contains, so the shares add up).
 inline void print_phase_report(std::FILE* out) {
     const PhaseTotals& t = g_phase_totals;
     const double total = double(phase_ticks() - t.first);
-    static const char* const names[] = {"read", "draw", "rate", "validate", "apply", "write"};
+    static const char* const names[] = {"read", "queue", "rate", "validate", "apply", "write"};
     std::fprintf(out, "phase timers (time-stamp counter ticks):\n");
     double covered = 0;
     for (int i = 0; i < int(Phase::kCount); ++i) {
         double ticks = double(t.ticks[i]);
-        if (i == int(Phase::kDraw)) ticks -= double(t.ticks[int(Phase::kRate)]);
+        if (i == int(Phase::kQueue))
+            ticks -= double(t.ticks[int(Phase::kRate)] + t.ticks[int(Phase::kValidate)] + t.ticks[int(Phase::kApply)]);
         covered += ticks;
         std::fprintf(out, "  %-9s %11llu calls %9.0f ticks/call %5.1f %%\n", names[i],
                      static_cast<unsigned long long>(t.calls[i]), t.calls[i] ? ticks / double(t.calls[i]) : 0.0,

@@ -3,6 +3,7 @@
 // the sorted-sweep finalization of hole boundaries and forced writes for stuck buffers.
 #include "decimate/stream_decimator.hpp"
 
+#include "decimate/greedy.hpp"
 #include "decimate/phase_timers.hpp"
 #include "decimate/schedule.hpp"
 
@@ -15,15 +16,11 @@
 namespace meshstream::decimate {
 namespace {
 
-// The buffer counts as stalled after this many consecutive DECIMATE(1) calls without a valid
-// candidate: at least 16, and enough calls to have tried 128 candidates, so that a small
-// --candidates does not give up on a mesh that still has collapses to find (with one
-// candidate a call tests one collapse, and 16 invalid draws in a row are common when coarse).
-int stall_attempts(int candidates) { return std::max(16, 128 / std::max(candidates, 1)); }
-
-// At the end of input, a stalled buffer of at most this many faces is scanned for a valid
-// collapse (a scan rates every half-edge: about 2 ms at this size).
+// At the end of input, a buffer of at most this many faces whose queue holds no valid collapse
+// is scanned for one (a scan rates every half-edge: about 2 ms at this size).
 constexpr size_t kScanLimit = 4096;
+// Candidates for a forced write.
+constexpr int kForcedCandidates = 8;
 
 // The options, checked before anything is allocated (std::invalid_argument: the command line
 // checks them itself, with its own messages, so these only reach library callers).
@@ -34,7 +31,6 @@ const Options& checked(const Options& options, std::optional<uint64_t> input_cou
     if (options.target && *options.target > *input_count) refuse("target is more than the input triangle count");
     if (options.sorted_by_minimum && !options.sorted_axis) refuse("sorted_by_minimum needs sorted_axis");
     if (options.buffer_triangles < 16) refuse("buffer_triangles must be at least 16");
-    if (options.candidates < 1 || options.candidates > 64) refuse("candidates must be 1 to 64");
     if (options.sorted_axis && (*options.sorted_axis < 0 || *options.sorted_axis > 2)) refuse("sorted_axis must be 0, 1 or 2");
     if (options.output_chunk_triangles == 0) refuse("output_chunk_triangles must be at least 1");
     return options;
@@ -60,6 +56,7 @@ StreamDecimator::StreamDecimator(const Options& options, io::InputCount own, con
       input_(input != nullptr ? input : &own_count_),
       ratio_(choose_ratio(options, own.promised)),
       buffer_(options.buffer_triangles, options.weld_eps),
+      queue_(options.buffer_triangles),
       rng_(options.seed),
       output_(options.output_chunk_triangles) {
     stats_.buffer_capacity = options.buffer_triangles;
@@ -74,6 +71,10 @@ uint64_t StreamDecimator::expected_output(double ratio, uint64_t input_triangle_
     return final_triangle_count(ratio, input_triangle_count);
 }
 
+size_t StreamDecimator::reserved_bytes(size_t buffer_triangles) {
+    return HalfEdgeBuffer::reserved_bytes(buffer_triangles) + CollapseQueue::reserved_bytes(buffer_triangles);
+}
+
 void StreamDecimator::push(const io::TriangleChunk& in, const Emit& out) {
     if (finished_) throw std::logic_error("StreamDecimator::push after finish()");
     const std::span<const float> xyz = in.xyz();
@@ -82,31 +83,31 @@ void StreamDecimator::push(const io::TriangleChunk& in, const Emit& out) {
         throw std::invalid_argument("StreamDecimator::push needs finite coordinates");
     // Welding reads a random hash slot and then a random vertex per corner; prefetching them
     // a few triangles ahead overlaps those misses (hints only: results do not change). Each
-    // corner's slot is hashed once, kept in a small ring until the triangle is read.
+    // corner is hashed once, kept in a small ring until the triangle is read.
     constexpr size_t kSlotsAhead = 8, kVerticesAhead = 4, kRing = 16;
-    size_t ring[kRing][3];
+    uint64_t ring[kRing][3];
     const size_t n = in.size();
     for (size_t i = 0; i < std::min(n, kSlotsAhead); ++i) {
-        buffer_.weld_slots(&xyz[9 * i], ring[i % kRing]);
+        buffer_.weld_hashes(&xyz[9 * i], ring[i % kRing]);
         buffer_.prefetch_triangle(ring[i % kRing], 0);
     }
     for (size_t i = 0; i < n; ++i) {
         if (i + kSlotsAhead < n) {
-            size_t* slots = ring[(i + kSlotsAhead) % kRing];
-            buffer_.weld_slots(&xyz[9 * (i + kSlotsAhead)], slots);
-            buffer_.prefetch_triangle(slots, 0);
+            uint64_t* hashes = ring[(i + kSlotsAhead) % kRing];
+            buffer_.weld_hashes(&xyz[9 * (i + kSlotsAhead)], hashes);
+            buffer_.prefetch_triangle(hashes, 0);
         }
         if (i + kVerticesAhead < n) buffer_.prefetch_triangle(ring[(i + kVerticesAhead) % kRing], 1);
         read_triangle(&xyz[9 * i], ring[i % kRing], out);
     }
 }
 
-void StreamDecimator::read_triangle(const float tri[9], const size_t slots[3], const Emit& out) {
+void StreamDecimator::read_triangle(const float tri[9], const uint64_t hashes[3], const Emit& out) {
     if (buffer_.full() || buffer_.free_vertex_count() < 3) make_room(out);
     if (options_.sorted_axis) track_sweep(tri);
     const HalfEdgeBuffer::Added added = [&] {
         const PhaseTimer timer(Phase::kRead);
-        return buffer_.add_triangle(tri, slots);
+        return buffer_.add_triangle(tri, hashes);
     }();
     ++stats_.triangles_in;
     if (added.face == kNoIndex) {
@@ -210,7 +211,7 @@ void StreamDecimator::sweep() {
 
 void StreamDecimator::write_one(const Emit& out, bool allow_forced) {
     const PhaseTimer timer(Phase::kWrite);
-    uint32_t f = pick_write(buffer_, rng_, options_.candidates);
+    uint32_t f = pick_write(buffer_);
     if (f == kNoIndex) {
         // Every in-core triangle touches P_in: the input is not in a streaming-friendly order
         // (or holes pile up). Write one anyway rather than fail.
@@ -219,10 +220,13 @@ void StreamDecimator::write_one(const Emit& out, bool allow_forced) {
         // Of a few random faces, the one with the most written corners, then the fewest on
         // P_in: P_out grows as one front instead of scattering, which would leave written
         // vertices everywhere (they never collapse) and stall the next rounds as well.
-        const FaceSet& live = buffer_.live_faces();
+        // Random slots; the buffer is full or nearly so when writes are forced, so nearly every
+        // draw finds a face (a bounded number of draws, then the first face there is).
         int best_score = -1;
-        for (int i = 0; i < options_.candidates; ++i) {
-            const uint32_t g = live.at(static_cast<size_t>(((rng_.next() >> 32) * live.size()) >> 32));
+        for (int draws = 0, found = 0; found < kForcedCandidates && draws < 8 * kForcedCandidates; ++draws) {
+            const uint32_t g = rng_.below(buffer_.face_slots());
+            if (!buffer_.face_alive(g)) continue;
+            ++found;
             int score = 0;
             for (uint32_t k = 0; k < 3; ++k) {
                 const uint8_t flags = buffer_.vertex(buffer_.corner_vertex(half_edge(g, k))).flags;
@@ -233,6 +237,8 @@ void StreamDecimator::write_one(const Emit& out, bool allow_forced) {
                 f = g;
             }
         }
+        for (uint32_t g = 0; f == kNoIndex; ++g)
+            if (buffer_.face_alive(g)) f = g;
         ++stats_.forced_writes;
     }
     stats_.vertices_moved += write_face(buffer_, f, next_id_, output_, out);
@@ -251,15 +257,8 @@ void StreamDecimator::make_room(const Emit& out) {
     if (options_.sorted_axis) sweep();
     const RoomPlan plan = plan_full_buffer(buffer_.face_capacity(), ratio_, stats_.triangles_in,
                                            output_.triangle_count());
-    int failures = 0;
-    while (buffer_.face_count() > plan.decimate_to) {
-        if (decimate_once(buffer_, rng_, options_.candidates, &candidate_memory_)) {
-            ++stats_.collapses;
-            failures = 0;
-        } else if (++failures >= stall_attempts(options_.candidates)) {
-            break;
-        }
-    }
+    rate_pending(buffer_, queue_);
+    while (buffer_.face_count() > plan.decimate_to && collapse_cheapest(buffer_, queue_)) ++stats_.collapses;
     while (buffer_.face_count() > plan.write_to) {
         const double budget =
             resolution_budget(ratio_, stats_.triangles_in, output_.triangle_count());
@@ -280,30 +279,24 @@ void StreamDecimator::finish(const Emit& out) {
                                             : final_triangle_count(ratio_, stats_.triangles_in);
     stats_.target_triangles = target;
     const size_t budget = final_budget(target, output_.triangle_count());
-    int failures = 0;
-    KnifeEdges knife_edges = KnifeEdges::kRefuse;
+    rate_pending(buffer_, queue_);
+    bool rated_all = false;
     while (buffer_.face_count() >= budget + 2) {
-        if (decimate_once(buffer_, rng_, options_.candidates, &candidate_memory_, knife_edges)) {
+        if (collapse_cheapest(buffer_, queue_)) {
             ++stats_.collapses;
-            failures = 0;
-        } else if (++failures >= stall_attempts(options_.candidates)) {
-            failures = 0;
-            if (buffer_.face_count() <= kScanLimit) {
-                // Random draws miss the few valid collapses left in a small buffer (a closed
-                // 5 558 triangle elephant stopped at 62 of 56): a scan finds them (allowing a
-                // knife edge only when nothing else is left), or shows there are none.
-                if (!collapse_best_of_all(buffer_)) {
-                    stats_.no_valid_collapse_left = true;
-                    break;
-                }
-                ++stats_.collapses;
-            } else if (knife_edges == KnifeEdges::kRefuse) {
-                // Too large to scan: the count comes first, so draws may now leave knife edges
-                // (the strips between a CAD part's many small faces cannot come down otherwise).
-                knife_edges = KnifeEdges::kAllow;
-            } else {
-                break;
-            }
+        } else if (!rated_all) {
+            // The queue ran out of valid collapses: every edge rated afresh, refused ones too
+            // (a refusal may have lapsed without a neighbour of its ends changing).
+            rate_all(buffer_, queue_);
+            rated_all = true;
+        } else if (buffer_.face_count() <= kScanLimit && collapse_best_of_all(buffer_)) {
+            // A small buffer is scanned for the few valid collapses left, or shows there are
+            // none (a closed 5 558 triangle elephant at 1 %).
+            ++stats_.collapses;
+            rated_all = false;
+        } else {
+            stats_.no_valid_collapse_left = buffer_.face_count() <= kScanLimit;
+            break;
         }
     }
     // Collapses remove two faces; an odd remainder needs one boundary collapse.

@@ -10,7 +10,7 @@
 // and counted instead of failing.
 #pragma once
 
-#include "decimate/collapse.hpp"
+#include "decimate/collapse_queue.hpp"
 #include "decimate/halfedge_buffer.hpp"
 #include "decimate/random.hpp"
 #include "decimate/writing.hpp"
@@ -29,8 +29,7 @@ struct Options {
     double ratio = 0.1;                 // p in (0, 1]: output = round(p · input)
     std::optional<uint64_t> target;     // exact output triangle count instead of ratio
     size_t buffer_triangles = 400000;   // N_max, in-core capacity (≥ 16)
-    int candidates = 8;                 // multiple-choice sample size (1..64)
-    uint64_t seed = 1;
+    uint64_t seed = 1;                  // draws the candidates of forced writes
     double weld_eps = 0;                // 0: exact welding; > 0: grid cell size (absolute)
     std::optional<int> sorted_axis;     // 0,1,2 when the input is sorted on it (either direction)
     // The order is known exactly: ascending by each triangle's minimum coordinate along
@@ -67,7 +66,7 @@ class StreamDecimator {
 public:
     // `input_triangle_count` is the reader's count when known; Options::target needs it.
     // Options outside their ranges throw std::invalid_argument. Allocates every buffer once;
-    // see halfedge_buffer.hpp for the bound (about 470 bytes reserved per buffer triangle).
+    // reserved_bytes() tells how much (about 580 bytes reserved per buffer triangle).
     StreamDecimator(const Options& options, std::optional<uint64_t> input_triangle_count);
     // The same for input that passes a read loop (io::TriangleInput) which may drop triangles
     // on the way: `input` (observed, must outlive this) says what its header promised and how
@@ -90,12 +89,15 @@ public:
     const Stats& stats() const { return stats_; }
     // round(ratio · input_triangle_count): the output size finish() lands on.
     static uint64_t expected_output(double ratio, uint64_t input_triangle_count);
+    // The address space a decimator with a buffer of `buffer_triangles` reserves (the buffer,
+    // hash tables and collapse queue); see docs/decimation.md for what becomes resident.
+    static size_t reserved_bytes(size_t buffer_triangles);
     // The ratio in use (target / input count with Options::target, less what was dropped).
     double ratio() const { return ratio_; }
 
 private:
     StreamDecimator(const Options& options, io::InputCount own, const io::InputCount* input);
-    void read_triangle(const float tri[9], const size_t slots[3], const Emit& out);
+    void read_triangle(const float tri[9], const uint64_t hashes[3], const Emit& out);
     void make_room(const Emit& out);
     void write_one(const Emit& out, bool allow_forced);
     void sweep();
@@ -107,8 +109,8 @@ private:
     const io::InputCount* input_;      // own_count_ or the caller's read loop's
     double ratio_;
     HalfEdgeBuffer buffer_;
+    CollapseQueue queue_;
     Rng rng_;
-    CandidateMemory candidate_memory_;  // decimate_once's runners-up
     TriangleOutput output_;
     uint64_t next_id_ = 0;
     Stats stats_;

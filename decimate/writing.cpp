@@ -25,61 +25,7 @@ void TriangleOutput::flush(const Emit& out) {
     chunk_.clear();
 }
 
-uint32_t pick_write(const HalfEdgeBuffer& buffer, Rng& rng, int candidates) {
-    // Preferring faces on P_out keeps the number of P_out components from growing (§4.4,
-    // Fig. 3): random interior faces would punch small holes all over the in-core mesh.
-    const FaceSet& set = buffer.frontier_faces().size() > 0 ? buffer.frontier_faces()
-                                                            : buffer.interior_faces();
-    const uint64_t size = set.size();
-    if (size == 0) return kNoIndex;
-    // The candidates' set slots, faces and vertices are fetched stage by stage, so the
-    // random reads overlap (the buffer is far larger than the caches).
-    constexpr int kMaxCandidates = 64;
-    const int n = std::clamp(candidates, 1, kMaxCandidates);
-    uint32_t faces[kMaxCandidates];
-    for (int i = 0; i < n; ++i) {
-        faces[i] = static_cast<uint32_t>(((rng.next() >> 32) * size) >> 32);
-        set.prefetch(faces[i]);
-    }
-    for (int i = 0; i < n; ++i) {
-        faces[i] = set.at(faces[i]);
-        buffer.prefetch_face(faces[i]);
-    }
-    for (int i = 0; i < n; ++i)
-        for (int k = 0; k < 3; ++k) buffer.prefetch_vertex(buffer.corner_vertex(half_edge(faces[i], k)));
-    // Beyond the paper: the face with the most corners already on P_out first, then the
-    // largest error. The paper's largest error alone writes faces all along P_out, leaving
-    // it ragged: on a 10 M-triangle stream half the in-core faces ended up touching P_out and
-    // 107 k of the 168 k in-core vertices were frozen, which grows memory with the input and
-    // blocks collapses. A face whose corners are already written extends P_out the
-    // least (by none, one or two vertices), so the front stays short and advances evenly.
-    uint32_t best = kNoIndex;
-    double best_error = -1;
-    int best_frozen = -1;
-    for (int i = 0; i < n; ++i) {
-        const uint32_t f = faces[i];
-        Quadric q;
-        double centre[3] = {0, 0, 0};
-        int frozen = 0;
-        for (int k = 0; k < 3; ++k) {
-            const uint32_t v = buffer.corner_vertex(half_edge(f, k));
-            q += buffer.quadric(v);
-            frozen += (buffer.vertex(v).flags & kFrozen) != 0;
-            double x[3];
-            buffer.position(v, x);
-            for (int j = 0; j < 3; ++j) centre[j] += x[j] / 3;
-        }
-        const double error = q.error(centre);
-        // `best == kNoIndex`: a NaN error (inf·0 from extreme coordinates) must not leave the
-        // pick empty (issue 7, FuzzRegression.Issue7_NanQuadricErrorStillPicksAFaceToWrite).
-        if (best == kNoIndex || frozen > best_frozen || (frozen == best_frozen && error > best_error)) {
-            best_error = error;
-            best_frozen = frozen;
-            best = f;
-        }
-    }
-    return best;
-}
+uint32_t pick_write(HalfEdgeBuffer& buffer) { return buffer.oldest_interior_face(); }
 
 bool place_vertex(HalfEdgeBuffer& buffer, uint32_t v) {
     const Vertex& x = buffer.vertex(v);

@@ -1,12 +1,9 @@
-// WRITE by multiple-choice selection (Wu & Kobbelt 2003, §4.4): candidates are the in-core
-// triangles adjacent to P_out and not to P_in (all faces without a P_in vertex when none
-// qualify); the one with the largest error, (Q_a + Q_b + Q_c) at its centre, is written.
-// At write time each vertex not yet written moves once to the minimum of its quadric and is
-// then frozen, with a stable output id, so neighbouring triangles written later share it.
+// WRITE (Wu & Kobbelt 2003, §4.4): the in-core face that left P_in first is written. At write
+// time each vertex not yet written moves once to the minimum of its quadric and is then
+// frozen, with a stable output id, so neighbouring triangles written later share it.
 #pragma once
 
 #include "decimate/halfedge_buffer.hpp"
-#include "decimate/random.hpp"
 #include "io/chunk.hpp"
 
 #include <cstdint>
@@ -32,11 +29,13 @@ private:
     uint64_t triangle_count_ = 0;
 };
 
-// The face to write next (§4.4's multiple choice among `candidates` random faces next to
-// P_out, or interior ones when none is): the one with the most corners already written,
-// among those the one with the largest quadric error at its centre. kNoIndex when every
-// in-core face touches P_in (the caller must then force a write or read no further).
-uint32_t pick_write(const HalfEdgeBuffer& buffer, Rng& rng, int candidates);
+// The face to write next: the one that left P_in first among those in core
+// (HalfEdgeBuffer::oldest_interior_face), or kNoIndex when every in-core face touches P_in
+// (the caller must then force a write or read no further). Wu & Kobbelt (§4.4) write the face
+// of largest error among a few on P_out; on streaming input the faces that left P_in first lie
+// on P_out or next to it, so P_out advances as one front behind the input, and they are the
+// faces the greedy decimation has long finished with.
+uint32_t pick_write(HalfEdgeBuffer& buffer);
 
 // Moves vertex v to its quadric minimum when its quadric is complete (not on P_in, manifold,
 // no open edge), the 3×3 system is well conditioned, the move stays within the longest

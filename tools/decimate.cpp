@@ -44,7 +44,6 @@ struct DecimateOptions {
     std::optional<double> ratio;
     std::optional<uint64_t> target;
     size_t buffer = 400000;
-    int candidates = 8;
     uint64_t seed = 1;
     std::string weld;  // "" / "0.001" / "0.01%"
     std::optional<int> sorted_axis;
@@ -202,7 +201,6 @@ decimate::Options decimation_options(const DecimateOptions& opt, const io::MeshH
         options.ratio = opt.ratio.value_or(0.1);
     }
     options.buffer_triangles = opt.buffer;
-    options.candidates = opt.candidates;
     options.seed = opt.seed;
     options.weld_eps = weld_epsilon(opt, name);
     options.sorted_axis = opt.sorted_axis ? opt.sorted_axis : header.sorted_axis;
@@ -218,10 +216,10 @@ std::unique_ptr<decimate::StreamDecimator> make_decimator(const decimate::Option
     } catch (const std::bad_alloc&) {
         throw std::runtime_error(
             "--buffer " + std::to_string(options.buffer_triangles) + " reserves " +
-            human_bytes(double(decimate::HalfEdgeBuffer::reserved_bytes(options.buffer_triangles))) +
-            " of memory (about 500 bytes a triangle), which this system refused: give a smaller --buffer (the "
+            human_bytes(double(decimate::StreamDecimator::reserved_bytes(options.buffer_triangles))) +
+            " of memory (about 580 bytes a triangle), which this system refused: give a smaller --buffer (the "
             "default 400000 reserves " +
-            human_bytes(double(decimate::HalfEdgeBuffer::reserved_bytes(400000))) + ")");
+            human_bytes(double(decimate::StreamDecimator::reserved_bytes(400000))) + ")");
     }
 }
 
@@ -538,8 +536,6 @@ void add_decimate(CLI::App& app) {
         ->check(whole_number(1, "a whole number of triangles"));
     cmd->add_option("--buffer", opt->buffer, "In-core buffer capacity in triangles (memory is fixed by it)")
         ->capture_default_str()->check(CLI::Range(size_t{16}, size_t{1} << 29));
-    cmd->add_option("--candidates", opt->candidates, "Multiple-choice sample size for collapses and writes")
-        ->capture_default_str()->check(CLI::Range(1, 64));
     cmd->add_option("--seed", opt->seed, "Random seed (same input, options and seed give identical output)")
         ->capture_default_str()->check(whole_number(0, "a whole number"));
     cmd->add_option("--weld", opt->weld, "Weld vertices on a grid of this size (absolute, or N% of the bbox diagonal)");

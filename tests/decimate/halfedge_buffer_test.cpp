@@ -40,7 +40,7 @@ TEST(HalfEdgeBuffer, TwoTrianglesShareAnEdge) {
     // The outer edges are still open towards the input: every vertex is on P_in.
     EXPECT_EQ(buffer.vertex(b).open_edges, 2u);
     EXPECT_TRUE(buffer.vertex(b).flags & kInHash);
-    EXPECT_EQ(buffer.interior_faces().size(), 0u);
+    EXPECT_EQ(buffer.oldest_interior_face(), kNoIndex);
     EXPECT_TRUE(buffer_consistent(buffer));
 }
 
@@ -55,8 +55,8 @@ TEST(HalfEdgeBuffer, ClosedMeshLeavesPin) {
         EXPECT_FALSE(buffer.vertex(v).flags & kInHash);
         EXPECT_EQ(buffer.vertex(v).face_count, 4u);
     }
-    EXPECT_EQ(buffer.interior_faces().size(), 8u);
-    EXPECT_EQ(buffer.frontier_faces().size(), 0u);  // nothing written yet: no P_out
+    // Every face left P_in: the first to, the one whose last corner closed first, is listed.
+    EXPECT_NE(buffer.oldest_interior_face(), kNoIndex);
     EXPECT_TRUE(buffer_consistent(buffer));
 }
 
@@ -166,17 +166,25 @@ TEST(HalfEdgeBuffer, WeldGridRoundsToTheNearestPointSoRoundNumbersWeld) {
     EXPECT_EQ(split.free_vertex_count(), 3 * 64 + 3 - 4u);
 }
 
-TEST(HalfEdgeBuffer, FreezingMarksNeighbourFacesAsFrontier) {
+TEST(HalfEdgeBuffer, LeavingPinAndFreezingListVerticesForRating) {
     HalfEdgeBuffer buffer(64, 0);
     add_indexed(buffer, octahedron_points(), octahedron_faces());
-    buffer.freeze(vertex_at(buffer, {0, 0, 1}), 0);
-    EXPECT_EQ(buffer.frontier_faces().size(), 4u);
+    std::vector<uint32_t> taken;
+    buffer.take_pending([&](uint32_t v) { taken.push_back(v); });
+    EXPECT_EQ(taken.size(), 6u);  // each vertex once, when its fan closed
+    taken.clear();
+    buffer.take_pending([&](uint32_t v) { taken.push_back(v); });
+    EXPECT_TRUE(taken.empty());
+    const uint32_t top = vertex_at(buffer, {0, 0, 1});
+    buffer.freeze(top, 0);
+    buffer.take_pending([&](uint32_t v) { taken.push_back(v); });
+    EXPECT_EQ(taken, std::vector<uint32_t>{top});
 }
 
 TEST(HalfEdgeBuffer, FinalizedOpenVertexLeavesPin) {
     HalfEdgeBuffer buffer(64, 0);
     add_indexed(buffer, {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {{0, 1, 2}});
-    EXPECT_EQ(buffer.interior_faces().size(), 0u);
+    EXPECT_EQ(buffer.oldest_interior_face(), kNoIndex);
     buffer.finalize_all();
-    EXPECT_EQ(buffer.interior_faces().size(), 1u);
+    EXPECT_EQ(buffer.oldest_interior_face(), 0u);
 }

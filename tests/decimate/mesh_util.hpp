@@ -225,14 +225,21 @@ inline const std::vector<std::array<int, 3>>& octahedron_faces() {
 
 // The buffer vertex at exact position p (linear search over live faces), or kNoIndex.
 inline uint32_t vertex_at(const HalfEdgeBuffer& buffer, const std::array<float, 3>& p) {
-    const FaceSet& live = buffer.live_faces();
-    for (size_t i = 0; i < live.size(); ++i)
-        for (uint32_t k = 0; k < 3; ++k) {
-            const uint32_t v = buffer.corner_vertex(decimate::half_edge(live.at(i), k));
+    for (uint32_t f = 0; f < buffer.face_slots(); ++f)
+        for (uint32_t k = 0; buffer.face_alive(f) && k < 3; ++k) {
+            const uint32_t v = buffer.corner_vertex(decimate::half_edge(f, k));
             const float* x = buffer.vertex(v).pos;
             if (x[0] == p[0] && x[1] == p[1] && x[2] == p[2]) return v;
         }
     return kNoIndex;
+}
+
+// Every half-edge of the in-core faces, in face slot order.
+inline std::vector<uint32_t> live_half_edges(const HalfEdgeBuffer& buffer) {
+    std::vector<uint32_t> out;
+    for (uint32_t f = 0; f < buffer.face_slots(); ++f)
+        for (uint32_t k = 0; buffer.face_alive(f) && k < 3; ++k) out.push_back(decimate::half_edge(f, k));
+    return out;
 }
 
 // The half-edge from vertex a to vertex b, or kNoIndex.
@@ -244,10 +251,9 @@ inline uint32_t half_edge(const HalfEdgeBuffer& buffer, uint32_t a, uint32_t b) 
 
 // Structural invariants: twins are mutual and opposite, vertex lists match faces.
 inline bool buffer_consistent(const HalfEdgeBuffer& buffer) {
-    const FaceSet& live = buffer.live_faces();
-    for (size_t i = 0; i < live.size(); ++i)
-        for (uint32_t k = 0; k < 3; ++k) {
-            const uint32_t h = decimate::half_edge(live.at(i), k);
+    for (uint32_t f = 0; f < buffer.face_slots(); ++f)
+        for (uint32_t k = 0; buffer.face_alive(f) && k < 3; ++k) {
+            const uint32_t h = decimate::half_edge(f, k);
             const uint32_t t = buffer.twin(h);
             if (!is_half_edge(t)) continue;
             if (buffer.twin(t) != h) return false;

@@ -1,17 +1,19 @@
-// Tests of decimate/quadric: plane quadrics are area × squared distance, and the 3×3 minimum
+// Tests of decimate/quadric: plane quadrics are √area × squared distance, and the 3×3 minimum
 // solve finds plane intersections and refuses singular systems.
 #include "decimate/quadric.hpp"
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 using meshstream::decimate::Quadric;
 
-TEST(Quadric, ErrorIsAreaTimesSquaredDistance) {
+TEST(Quadric, ErrorIsSquareRootOfAreaTimesSquaredDistance) {
     const double a[3] = {0, 0, 0}, b[3] = {2, 0, 0}, c[3] = {0, 2, 0};  // area 2, plane z = 0
     const Quadric q = Quadric::from_triangle(a, b, c);
     const double on[3] = {5, -3, 0}, above[3] = {1, 1, 3};
     EXPECT_NEAR(q.error(on), 0.0, 1e-12);
-    EXPECT_NEAR(q.error(above), 2.0 * 9.0, 1e-12);
+    EXPECT_NEAR(q.error(above), std::sqrt(2.0) * 9.0, 1e-12);
 }
 
 TEST(Quadric, DegenerateTriangleGivesZeroQuadric) {

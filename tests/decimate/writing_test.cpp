@@ -52,17 +52,14 @@ TEST(Writing, WriteFreezesVerticesAndOpensPout) {
     ASSERT_EQ(ids.size(), 3u);
     EXPECT_EQ(ids, (std::vector<uint64_t>{0, 1, 2}));
     EXPECT_EQ(buffer.face_count(), 7u);
-    // Every remaining face but the opposite one (-x, -y, -z) touches a written vertex.
-    EXPECT_EQ(buffer.frontier_faces().size(), 6u);
     // The three neighbours across the written face's edges now border P_out.
     int written_edges = 0;
-    const FaceSet& live = buffer.live_faces();
-    for (size_t i = 0; i < live.size(); ++i)
-        for (uint32_t k = 0; k < 3; ++k) written_edges += buffer.twin(half_edge(live.at(i), k)) == kWrittenEdge;
+    for (uint32_t g = 0; g < buffer.face_slots(); ++g)
+        for (uint32_t k = 0; buffer.face_alive(g) && k < 3; ++k)
+            written_edges += buffer.twin(half_edge(g, k)) == kWrittenEdge;
     EXPECT_EQ(written_edges, 3);
     // The next write reuses the frozen ids of shared vertices.
-    Rng rng(1);
-    const uint32_t f = pick_write(buffer, rng, 8);
+    const uint32_t f = pick_write(buffer);
     ASSERT_NE(f, kNoIndex);
     write_face(buffer, f, next_id, output, emit);
     output.flush(emit);
@@ -70,25 +67,26 @@ TEST(Writing, WriteFreezesVerticesAndOpensPout) {
     EXPECT_TRUE(buffer_consistent(buffer));
 }
 
-TEST(Writing, PrefersFacesWhoseCornersAreAlreadyWritten) {
-    // After one octahedron face is written, three faces share an edge with it (two corners
-    // on P_out) and three only a corner. Writing one of the former extends P_out by one
-    // vertex instead of two: every pick must be one of them, whatever the errors say.
-    for (uint64_t seed = 1; seed <= 20; ++seed) {
-        HalfEdgeBuffer buffer(64, 0);
-        const auto faces = add_indexed(buffer, octahedron_points(), octahedron_faces());
-        TriangleOutput output(4);
-        const Emit emit = [](const meshstream::io::TriangleChunk&) {};
-        uint64_t next_id = 0;
-        write_face(buffer, faces[0], next_id, output, emit);
-        Rng rng(seed);
-        const uint32_t f = pick_write(buffer, rng, 16);
-        ASSERT_NE(f, kNoIndex);
-        int frozen = 0;
-        for (uint32_t k = 0; k < 3; ++k)
-            frozen += (buffer.vertex(buffer.corner_vertex(half_edge(f, k))).flags & kFrozen) != 0;
-        EXPECT_EQ(frozen, 2) << "seed " << seed;
+TEST(Writing, WritesTheFaceThatLeftPinFirst) {
+    // A strip of four faces read left to right, then closed off: faces leave P_in as their
+    // last corner does. finalize_vertex() on the left end first makes face 0 interior first,
+    // and the writer takes faces in that order, skipping the removed ones.
+    HalfEdgeBuffer buffer(64, 0);
+    const auto faces = add_indexed(buffer, {{0, 0, 0}, {0, 1, 0}, {1, 0, 0}, {1, 1, 0}, {2, 0, 0}, {2, 1, 0}},
+                                   {{0, 2, 1}, {1, 2, 3}, {2, 4, 3}, {3, 4, 5}});
+    EXPECT_EQ(pick_write(buffer), kNoIndex);  // every face touches P_in
+    for (const std::array<float, 3>& p : std::vector<std::array<float, 3>>{
+             {0, 0, 0}, {0, 1, 0}, {1, 0, 0}, {1, 1, 0}, {2, 0, 0}, {2, 1, 0}})
+        buffer.finalize_vertex(vertex_at(buffer, p));
+    TriangleOutput output(4);
+    const Emit emit = [](const meshstream::io::TriangleChunk&) {};
+    uint64_t next_id = 0;
+    std::vector<uint32_t> order;
+    for (uint32_t f = pick_write(buffer); f != kNoIndex; f = pick_write(buffer)) {
+        order.push_back(f);
+        write_face(buffer, f, next_id, output, emit);
     }
+    EXPECT_EQ(order, (std::vector<uint32_t>{faces[0], faces[1], faces[2], faces[3]}));
 }
 
 TEST(Writing, VertexMovesToItsQuadricMinimumOnce) {

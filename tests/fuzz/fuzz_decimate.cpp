@@ -2,7 +2,7 @@
 // options and an indexed soup, so that shared (repeated) vertices are common and the raw
 // float bits give NaN, ±inf, denormals, huge and tiny magnitudes:
 //   byte 0: buffer_triangles = 16 + 4·b     byte 1: ratio = (b + 1) / 256
-//   byte 2: candidates = 1 + b % 16         byte 3: weld_eps from a table (0, tiny, 1e-3, 1, huge, inf)
+//   byte 2: seed = b                        byte 3: weld_eps from a table (0, tiny, 1e-3, 1, huge, inf)
 //   byte 4: sorted axis (none, x, y, z)     byte 5: bit 0 = use --target (target = byte 1, ≥ 1)
 //                                                   bits 1..: input chunk capacity 1 + (b >> 1)
 //   byte 6: palette size P = 1 + b % 64, then P × 12 bytes of float xyz,
@@ -27,7 +27,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     decimate::Options options;
     options.buffer_triangles = 16 + 4 * size_t{data[0]};
     options.ratio = (data[1] + 1) / 256.0;
-    options.candidates = 1 + data[2] % 16;
+    options.seed = data[2];
     constexpr double kEps[] = {0, 1e-30, 1e-3, 1, 1e30, std::numeric_limits<double>::infinity()};
     options.weld_eps = kEps[data[3] % 6];
     if (data[4] % 4) options.sorted_axis = data[4] % 4 - 1;

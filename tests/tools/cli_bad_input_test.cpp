@@ -609,7 +609,7 @@ TEST(CliBadInput, ABufferTheSystemCannotReserveIsNamedWithItsSize) {
     CliRun r = run("decimate --buffer 10000000 -r 0.5 " + dir / "in.stl" + " " + dir / "out.stl", "ulimit -v 1048576;");
     EXPECT_EQ(r.code, 1) << r.err;
     EXPECT_NE(r.err.find("meshstream: error: --buffer 10000000 reserves 5."), std::string::npos) << r.err;
-    EXPECT_NE(r.err.find("which this system refused: give a smaller --buffer (the default 400000 reserves 208.2 MB)"),
+    EXPECT_NE(r.err.find("which this system refused: give a smaller --buffer (the default 400000 reserves 233.5 MB)"),
               std::string::npos) << r.err;
     EXPECT_EQ(listing(dir.path()), std::vector<std::string>{"in.stl"});
 #endif

@@ -1,0 +1,181 @@
+// The greedy collapse order over the buffer (Garland & Heckbert 1997, in place of the multiple
+// choice of Wu & Kobbelt 2003, §4.3), with the end-of-input scans.
+#include "decimate/greedy.hpp"
+
+#include "decimate/phase_timers.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+namespace meshstream::decimate {
+
+void rate_edge(HalfEdgeBuffer& buffer, CollapseQueue& queue, uint32_t h) {
+    // collapse_eligible() both ways, from the two vertex records and h's twin.
+    const uint32_t t = buffer.twin(h);
+    const uint32_t p = buffer.corner_vertex(h), q = buffer.corner_vertex(next_in_face(h));
+    const Vertex& vp = buffer.vertex(p);
+    const Vertex& vq = buffer.vertex(q);
+    constexpr uint16_t kNoSource = kInHash | kFrozen | kNonManifold | kManyFans, kNoTarget = kInHash | kNonManifold;
+    const bool twin_real = is_half_edge(t);
+    const bool forward = (vp.flags & kNoSource) == 0 && (vq.flags & kNoTarget) == 0 &&
+                         (vp.open_edges == 0 ? twin_real : vp.open_edges == 2 && t == kOpenEdge);
+    const bool backward = twin_real && (vq.flags & kNoSource) == 0 && (vp.flags & kNoTarget) == 0 && vq.open_edges == 0;
+    if (!forward && !backward) {
+        CollapseQueue::forget(buffer, h);
+        return;
+    }
+    if (forward && backward && vp.face_count <= kMaxMovedFaces && vq.face_count <= kMaxMovedFaces) {
+        // Both ends free (collapse_target_free either way): the same merge at the minimum of
+        // Q_p + Q_q. Rated at the exact minimum; collapse_placement() rounds it to floats.
+        const Quadric sum = buffer.quadric(p) + buffer.quadric(q);
+        double x[3];
+        queue.push(buffer, h, false, sum.minimum(x) ? sum.error_at_minimum(x) : collapse_placement(buffer, h).error);
+        return;
+    }
+    const double e_forward = forward ? collapse_placement(buffer, h).error : INFINITY;
+    const double e_backward = backward ? collapse_placement(buffer, t).error : INFINITY;
+    if (e_backward < e_forward) queue.push(buffer, h, true, e_backward);
+    else queue.push(buffer, h, false, e_forward);
+}
+
+namespace {
+
+// Rates the edges of v; with `skip_pending`, not those whose other end is still listed for
+// take_pending() (it rates them when its turn comes: each edge once).
+void rate_edges_around(HalfEdgeBuffer& buffer, CollapseQueue& queue, uint32_t v, bool skip_pending) {
+    for (uint32_t c = buffer.vertex(v).first_corner; c != kNoIndex; c = buffer.next_corner(c)) {
+        const uint32_t to = buffer.corner_vertex(next_in_face(c));
+        if (!skip_pending || (buffer.vertex(to).flags & kPending) == 0) rate_edge(buffer, queue, c);  // v→next
+        // prev→v is also the next one's v→prev, except where v's fan is open.
+        const uint32_t in = prev_in_face(c);
+        if (is_half_edge(buffer.twin(in))) continue;
+        const uint32_t from = buffer.corner_vertex(in);
+        if (!skip_pending || (buffer.vertex(from).flags & kPending) == 0) rate_edge(buffer, queue, in);
+    }
+}
+
+}  // namespace
+
+void rate_vertex_edges(HalfEdgeBuffer& buffer, CollapseQueue& queue, uint32_t v) {
+    rate_edges_around(buffer, queue, v, false);
+}
+
+void rate_pending(HalfEdgeBuffer& buffer, CollapseQueue& queue) {
+    const PhaseTimer timer(Phase::kQueue);
+    buffer.take_pending([&](uint32_t v) { rate_edges_around(buffer, queue, v, true); });
+}
+
+void rate_all(HalfEdgeBuffer& buffer, CollapseQueue& queue) {
+    queue.clear(buffer);
+    buffer.take_pending([](uint32_t) {});
+    for (uint32_t f = 0; f < buffer.face_slots(); ++f) {
+        if (!buffer.face_alive(f)) continue;
+        for (uint32_t k = 0; k < 3; ++k) {
+            const uint32_t h = half_edge(f, k), t = buffer.twin(h);
+            if (is_half_edge(t) && t < h) continue;  // each edge once
+            rate_edge(buffer, queue, h);
+        }
+    }
+    for (uint32_t v = 0; v < buffer.vertex_slots(); ++v) buffer.vertex(v).flags &= ~kBlocked;
+}
+
+bool collapse_cheapest(HalfEdgeBuffer& buffer, CollapseQueue& queue) {
+    const PhaseTimer timer(Phase::kQueue);
+    for (;;) {
+        bool dirty = false;
+        const uint32_t h = queue.pop(buffer, dirty);
+        if (h == kNoIndex) return false;
+        if (dirty) {
+            // Its key was a lower bound: rated now, it goes back where it belongs (straight
+            // back out, when that is still the cheapest bucket).
+            rate_edge(buffer, queue, h);
+            continue;
+        }
+        if (!collapse_eligible(buffer, h)) continue;
+        const uint32_t p = buffer.corner_vertex(h), q = buffer.corner_vertex(next_in_face(h));
+        const CollapsePlacement placement = collapse_placement(buffer, h);
+        if (!collapse_valid(buffer, h, placement.target)) {
+            // Its neighbourhood's shape or topology refuses it: that changes only when a
+            // neighbour of p or q changes, which rates their edges again.
+            buffer.vertex(p).flags |= kBlocked;
+            buffer.vertex(q).flags |= kBlocked;
+            continue;
+        }
+        apply_collapse(buffer, h, placement.target);
+        // q's queued edges cost at least what they did (Q_q only grew): their keys stay, as
+        // lower bounds. Its other edges (refused before, or not eligible) are rated afresh, as
+        // are blocked neighbours', which may have valid collapses now.
+        for (uint32_t c = buffer.vertex(q).first_corner; c != kNoIndex; c = buffer.next_corner(c)) {
+            for (const uint32_t e : {c, prev_in_face(c)}) {
+                const uint32_t t = buffer.twin(e);
+                const bool queued = buffer.queue_key(e) != kNotQueued || (is_half_edge(t) && buffer.queue_key(t) != kNotQueued);
+                if (!queued) {
+                    rate_edge(buffer, queue, e);
+                    continue;
+                }
+                CollapseQueue::mark_dirty(buffer, e);
+                if (is_half_edge(t)) CollapseQueue::mark_dirty(buffer, t);
+            }
+            for (const uint32_t w : {buffer.corner_vertex(next_in_face(c)), buffer.corner_vertex(prev_in_face(c))}) {
+                Vertex& x = buffer.vertex(w);
+                if ((x.flags & kBlocked) == 0) continue;
+                x.flags &= ~kBlocked;
+                rate_vertex_edges(buffer, queue, w);
+            }
+        }
+        buffer.vertex(q).flags &= ~kBlocked;
+        buffer.take_pending([&](uint32_t v) { rate_edges_around(buffer, queue, v, true); });
+        return true;
+    }
+}
+
+bool collapse_best_of_all(HalfEdgeBuffer& buffer) {
+    struct Candidate {
+        uint32_t h;
+        CollapsePlacement placement;
+    };
+    std::vector<Candidate> all;
+    for (uint32_t f = 0; f < buffer.face_slots(); ++f) {
+        if (!buffer.face_alive(f)) continue;
+        for (uint32_t k = 0; k < 3; ++k) {
+            const uint32_t h = half_edge(f, k);
+            if (collapse_eligible(buffer, h)) all.push_back({h, collapse_placement(buffer, h)});
+        }
+    }
+    // Stable: ties keep buffer order, so the result is deterministic.
+    std::stable_sort(all.begin(), all.end(),
+                     [](const Candidate& a, const Candidate& b) { return a.placement.error < b.placement.error; });
+    for (const Candidate& c : all)
+        if (collapse_valid(buffer, c.h, c.placement.target)) {
+            apply_collapse(buffer, c.h, c.placement.target);
+            return true;
+        }
+    return false;
+}
+
+bool collapse_one_boundary_edge(HalfEdgeBuffer& buffer) {
+    struct Candidate {
+        uint32_t h;
+        double error;
+    };
+    std::vector<Candidate> all;
+    for (uint32_t f = 0; f < buffer.face_slots(); ++f) {
+        if (!buffer.face_alive(f)) continue;
+        for (uint32_t k = 0; k < 3; ++k) {
+            const uint32_t h = half_edge(f, k);
+            if (buffer.twin(h) == kOpenEdge && collapse_eligible(buffer, h)) all.push_back({h, collapse_error(buffer, h)});
+        }
+    }
+    // Stable: ties keep buffer order, so the result is deterministic. Every candidate is tried
+    // (the cheapest few are often all refused on a welded scan's ragged rim).
+    std::stable_sort(all.begin(), all.end(), [](const Candidate& a, const Candidate& b) { return a.error < b.error; });
+    for (const Candidate& c : all)
+        if (collapse_valid(buffer, c.h)) {
+            apply_collapse(buffer, c.h);
+            return true;
+        }
+    return false;
+}
+
+}  // namespace meshstream::decimate
