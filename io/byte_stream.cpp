@@ -39,6 +39,7 @@ public:
         }
     }
     std::optional<uint64_t> size() const override { return size_; }
+    uint64_t stored_offset() const override { return pos_; }
 
 private:
     int fd_;
@@ -62,6 +63,8 @@ public:
         compressed_ = prefix.size();
     }
     ~GzipInput() override { inflateEnd(&zs_); }
+    uint64_t stored_offset() const override { return compressed_ - zs_.avail_in; }
+    std::optional<uint64_t> stored_size() const override { return raw_->stored_size(); }
 
     size_t read(void* dst, size_t n) override {
         if (done_) return 0;

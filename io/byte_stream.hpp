@@ -24,6 +24,10 @@ public:
     virtual size_t read(void* dst, size_t n) = 0;
     // Total size in bytes when known before reading (regular uncompressed files).
     virtual std::optional<uint64_t> size() const { return std::nullopt; }
+    // The file as stored, for progress: bytes taken from it so far (compressed bytes under
+    // gzip) and its size when it is a regular file (compressed or not).
+    virtual uint64_t stored_offset() const { return 0; }
+    virtual std::optional<uint64_t> stored_size() const { return size(); }
 };
 
 class ByteSource {
@@ -56,6 +60,11 @@ public:
     uint64_t offset() const { return offset_; }
     // Decoded total size when known up front: plain regular files only.
     std::optional<uint64_t> size() const;
+    // How far through the file as stored, for progress with any format: bytes read from it so
+    // far (compressed bytes for gzip; up to a buffer ahead of offset()), and its size when it
+    // is a regular file, gzip or not. Same thread as the reads.
+    uint64_t stored_offset() const { return raw_->stored_offset(); }
+    std::optional<uint64_t> stored_size() const { return raw_->stored_size(); }
     const std::string& name() const { return name_; }
     bool gzip() const { return gzip_; }
     // The filesystem path when the source is a plain (not gzip) regular file, for readers that

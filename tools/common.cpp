@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <fstream>
 #include <limits>
+#include <sys/ioctl.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -338,6 +339,15 @@ bool bar_terminal() {
     const char* term = std::getenv("TERM");
     return ::isatty(2) && term != nullptr && *term != '\0' && std::string_view(term) != "dumb";
 }
+
+// Writes `text` over the bar's line, cut to the terminal's width: a line that wrapped would
+// leave its first rows behind when the next frame or done() returns to its start.
+void draw_line(std::string_view text) {
+    struct winsize ws;
+    const size_t width = ::ioctl(2, TIOCGWINSZ, &ws) == 0 && ws.ws_col > 1 ? ws.ws_col - 1 : 79;
+    if (text.size() > width) text = text.substr(0, width);
+    std::fprintf(stderr, "\r%.*s\x1b[K", int(text.size()), text.data());
+}
 }  // namespace
 
 Progress::Progress(std::string label, std::optional<uint64_t> total, std::string unit)
@@ -350,19 +360,30 @@ void Progress::phase(std::string label, std::optional<uint64_t> total) {
     label_ = std::move(label);
     total_ = total;
     done_ = 0;
+    bytes_read_ = 0;
+    file_bytes_.reset();
     start_ = std::chrono::steady_clock::now();
     draw(true);
 }
 
 void Progress::status(const std::string& text) {
     if (!enabled_) return;
-    std::fprintf(stderr, "\r%s\x1b[K", text.c_str());
+    draw_line(text);
     drawn_ = true;
 }
 
+// The first update draws at once (a phase shows from its first chunk), the others at most
+// 5 times a second.
 void Progress::update(uint64_t done) {
     done_ = done;
-    if (enabled_) draw(false);
+    if (enabled_) draw(!drawn_);
+}
+
+void Progress::update(uint64_t done, uint64_t bytes_read, std::optional<uint64_t> file_bytes) {
+    done_ = done;
+    bytes_read_ = bytes_read;
+    file_bytes_ = file_bytes;
+    if (enabled_) draw(!drawn_);
 }
 
 void Progress::draw(bool force) {
@@ -373,19 +394,24 @@ void Progress::draw(bool force) {
     double secs = std::chrono::duration<double>(now - start_).count();
     double rate = secs > 0 ? done_ / secs : 0;
     char line[256];
-    if (total_ && *total_ > 0) {
-        double frac = std::min(1.0, static_cast<double>(done_) / static_cast<double>(*total_));
+    // The share done: of the file's bytes when reading one (every format, gzip too), else of
+    // the count's total.
+    std::optional<double> share;
+    if (file_bytes_ && *file_bytes_ > 0) share = double(bytes_read_) / double(*file_bytes_);
+    else if (total_ && *total_ > 0) share = double(done_) / double(*total_);
+    if (share) {
+        const double frac = std::min(1.0, *share);
         int filled = static_cast<int>(frac * 24);
         std::string bar(filled, '#');
         bar.resize(24, '.');
-        double eta = rate > 0 ? (static_cast<double>(*total_) - done_) / rate : 0;
-        std::snprintf(line, sizeof line, "\r%s [%s] %5.1f%% %s %s, %s/s, ETA %.0fs\x1b[K", label_.c_str(), bar.c_str(),
+        const double eta = frac > 0 ? secs * (1 - frac) / frac : 0;
+        std::snprintf(line, sizeof line, "%s [%s] %5.1f%% %s %s, %s/s, ETA %.0fs", label_.c_str(), bar.c_str(),
                       100 * frac, human_count(done_).c_str(), unit_.c_str(), human_count(rate).c_str(), eta);
     } else {
-        std::snprintf(line, sizeof line, "\r%s %s %s, %s/s, %.0fs\x1b[K", label_.c_str(), human_count(done_).c_str(),
+        std::snprintf(line, sizeof line, "%s %s %s, %s/s, %.0fs", label_.c_str(), human_count(done_).c_str(),
                       unit_.c_str(), human_count(rate).c_str(), secs);
     }
-    std::fputs(line, stderr);
+    draw_line(line);
     drawn_ = true;
 }
 
@@ -457,7 +483,7 @@ io::Bounds input_bounds(const std::string& path, std::string_view from, const io
                     box.min[a] = std::min(box.min[a], xyz[i + a]);
                     box.max[a] = std::max(box.max[a], xyz[i + a]);
                 }
-        progress.update(done += chunk.size());
+        progress.update(done += chunk.size(), *in.source);
     }
     return box;
 }

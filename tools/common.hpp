@@ -3,6 +3,7 @@
 // prints; the libraries report through return values and io::Error.
 #pragma once
 
+#include "io/byte_stream.hpp"
 #include "io/format.hpp"
 
 #include <CLI/CLI.hpp>
@@ -110,13 +111,21 @@ struct Global {
 Global& global();
 
 // A one-line progress bar on stderr, drawn only when stderr is a terminal and --quiet is not
-// given: phase label, count, rate, and percent + ETA when the total is known. Redraws at most
-// 5 times a second, so calling update() per chunk costs nothing.
+// given: phase label, count, rate, and percent + ETA when the total is known: the bytes read
+// of the input file's size when the phase reads a file (any format, gzip too), else the count
+// of its total. Redraws at most 5 times a second, so calling update() per chunk costs nothing.
 class Progress {
 public:
     Progress(std::string label, std::optional<uint64_t> total, std::string unit = "triangles");
     ~Progress();
     void update(uint64_t done);
+    // The same while reading a file of `file_bytes` bytes as stored (nullopt: not a regular
+    // file), of which `bytes_read` are read: percent and ETA come from the bytes.
+    void update(uint64_t done, uint64_t bytes_read, std::optional<uint64_t> file_bytes);
+    // update(done, ...) with the count read and the position of `source` in its file.
+    void update(uint64_t done, const io::ByteSource& source) {
+        update(done, source.stored_offset(), source.stored_size());
+    }
     // Starts a new phase (keeps the bar); total may change.
     void phase(std::string label, std::optional<uint64_t> total);
     // Replaces the bar with one line of text until done() or the next update (a last step
@@ -130,6 +139,8 @@ private:
     std::optional<uint64_t> total_;
     std::string unit_;
     uint64_t done_ = 0;
+    uint64_t bytes_read_ = 0;
+    std::optional<uint64_t> file_bytes_;  // set by update(done, bytes, size) until phase()
     bool enabled_;
     bool drawn_ = false;
     std::chrono::steady_clock::time_point start_, last_;

@@ -48,7 +48,7 @@ void run_convert(const ConvertOptions& opt) {
     Progress progress("converting", header.triangle_count);
     while (in.next(chunk)) {
         out.write(chunk);
-        progress.update(in.count().read);
+        progress.update(in.count().read, in.source());
     }
     // A reader may have added materials while reading (OBJ: names met after the first face).
     if (wo.channels.material) out.writer->update_materials(in.header().materials);

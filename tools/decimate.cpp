@@ -223,15 +223,15 @@ std::unique_ptr<decimate::StreamDecimator> make_decimator(const decimate::Option
     }
 }
 
-// Pushes what `next` gives through `decimator`; returns false when `stop`, asked after each
-// chunk, said to stop, true at the end of the input.
+// Pushes what `next` gives through `decimator`, calling `show_progress` after each chunk;
+// returns false when `stop`, asked after each chunk, said to stop, true at the end of the input.
 bool decimate_pass(const ChunkSource& next, decimate::StreamDecimator& decimator, const decimate::Emit& emit,
-                   Progress& progress, const std::function<uint64_t()>& done, const std::function<bool()>& stop) {
+                   const std::function<void()>& show_progress, const std::function<bool()>& stop) {
     // The decimator rates and writes positions only: no other channel is read.
     io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, io::Channels{});
     while (next(chunk)) {
         decimator.push(chunk, emit);
-        progress.update(done());
+        show_progress();
         if (stop && stop()) return false;
     }
     return true;
@@ -272,7 +272,7 @@ SortedInput sort_file(const DecimateOptions& opt, uint64_t sort_budget, const io
     io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, io::Channels{});
     while (in.next(chunk)) {
         s.sorter->add(chunk);
-        progress.update(in.count().read);
+        progress.update(in.count().read, in.source());
     }
     s.count = in.count();
     s.dropped = dropped_triangles(in);
@@ -290,7 +290,7 @@ SortedInput sort_spooled(io::TriangleInput& in, PositionSpool& spool, uint64_t s
     io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, io::Channels{});
     while (in.next(chunk)) {
         spool.add(chunk);
-        progress.update(in.count().read);
+        progress.update(in.count().read, in.source());
     }
     if (!spool.ok()) throw io::Error(in.name(), "cannot spool the input to sort it: " + spool.error());
     SortedInput s;
@@ -407,7 +407,7 @@ void run_decimate(const DecimateOptions& opt) {
             return true;
         };
         const bool whole = decimate_pass(
-            next, *decimator, emit, progress, [&] { return in.count().read; },
+            next, *decimator, emit, [&] { progress.update(in.count().read, in.source()); },
             [&] { return may_restart && decimator->stats().forced_writes > 0 && !gate.released() && (!spool || spool->ok()); });
         if (!whole) {
             outcome.kind = SortOutcome::Kind::kSorted;
@@ -463,13 +463,13 @@ void run_decimate(const DecimateOptions& opt) {
                 done += chunk.size();
                 return true;
             };
-            decimate_pass(next, *decimator, emit, progress, [&] { return done; }, {});
+            decimate_pass(next, *decimator, emit, [&] { progress.update(done); }, {});
         } else {
             in = open_triangle_input(opt.input, opt.read, read, Command::kDecimate);
             decimator = make_decimator(options, in.count());
             progress.phase("decimating", header.triangle_count);
-            decimate_pass([&](io::TriangleChunk& chunk) { return in.next(chunk); }, *decimator, emit, progress,
-                          [&] { return in.count().read; }, {});
+            decimate_pass([&](io::TriangleChunk& chunk) { return in.next(chunk); }, *decimator, emit,
+                          [&] { progress.update(in.count().read, in.source()); }, {});
         }
     }
     progress.phase("finishing", std::nullopt);
@@ -493,7 +493,7 @@ void run_decimate(const DecimateOptions& opt) {
     facts.skipped = sorted ? sorted->count.dropped : in.count().dropped;
     facts.input_name = input_name;
     facts.sort = outcome;
-    if (!opt.json) print_decimate_summary(facts, opt.output, seconds);
+    if (!opt.json && !global().quiet) print_decimate_summary(facts, opt.output, seconds);
 
     Warnings warnings;
     if (const std::string dropped = io::describe_missing(header.channels, io::Channels{}); !dropped.empty())

@@ -141,7 +141,7 @@ void run_info(const InfoOptions& opt) {
             accumulate(chunk, stats);
             if (topology) topology->add(chunk);
             if (meter) meter->add(chunk);
-            progress.update(stats.triangles);
+            progress.update(stats.triangles, in.source());
         }
     }
     // The size on disk (compressed for gzip input, whose decoded size is reported beside it).

@@ -16,7 +16,7 @@ int main(int argc, char** argv) {
     using namespace meshstream;
     CLI::App app{"meshstream: convert, sort and decimate triangle meshes larger than memory, in one streaming pass"};
     app.set_help_all_flag("--help-all", "Show help for every command");
-    app.add_flag("-q,--quiet", tools::global().quiet, "No progress bar");
+    app.add_flag("-q,--quiet", tools::global().quiet, "No progress bar and no summary (warnings and errors stay)");
     app.set_version_flag("--version", std::string("meshstream ") + MESHSTREAM_VERSION);
     app.require_subcommand(1);
     // Subcommands pass options they do not know to the app, so -q works after the command too.

@@ -239,12 +239,15 @@ void run_sort(const SortOptions& opt) {
         // Input thread: reads, parses and filters chunks; this thread adds them to the runs
         // (and sorts and spills each full run).
         ChunkPipe pipe(chunk_capacity, so.channels);
-        std::atomic<uint64_t> read{0};
+        // Counted on the reader's thread, shown on this one: triangles, and bytes of the file.
+        std::atomic<uint64_t> read{0}, bytes_read{0};
+        const std::optional<uint64_t> file_bytes = in.source().stored_size();
         PipeWorker reader(pipe, [&] {
             try {
                 while (io::TriangleChunk* chunk = pipe.get_free()) {
                     if (!in.next(*chunk)) break;
                     read.store(in.count().read, std::memory_order_relaxed);
+                    bytes_read.store(in.source().stored_offset(), std::memory_order_relaxed);
                     pipe.put_full(chunk);
                 }
                 pipe.close();
@@ -255,7 +258,7 @@ void run_sort(const SortOptions& opt) {
         while (io::TriangleChunk* chunk = pipe.get_full()) {
             sorter.add(*chunk);
             pipe.put_free(chunk);
-            progress.update(read.load(std::memory_order_relaxed));
+            progress.update(read.load(std::memory_order_relaxed), bytes_read.load(std::memory_order_relaxed), file_bytes);
         }
     }
     // What the reader noted by the end of the input (a last line without a line end), before

@@ -246,7 +246,7 @@ TEST(CliPipe, SortIntoDecimateStreamsWithoutASpool) {
     TempDir dir;
     const std::string glb = dir / "out.glb";
     cli_test::CliRun r = run("sort --memory 64M " + kBunny + " - | TMPDIR=/nonexistent/tmp " + MESHSTREAM_BINARY +
-                       " -q decimate - " + glb + " -r 0.01",
+                       " decimate - " + glb + " -r 0.01",
                    "TMPDIR=/nonexistent/tmp");
     ASSERT_EQ(r.code, 0) << r.err;
     EXPECT_NE(r.err.find("sorted along x (ascending)"), std::string::npos) << r.err;
@@ -350,4 +350,43 @@ TEST(CliConvert, GltfAndDracoKeepTheirChannelsAndSayWhatTheyDrop) {
     cli_test::CliRun tetra_glb = run("convert " + tetra + " " + dir / "t.glb");
     EXPECT_NE(tetra_glb.err.find("vertex property 'id'"), std::string::npos) << tetra_glb.err;
     EXPECT_EQ(tetra_glb.err.find("colour"), std::string::npos) << tetra_glb.err;
+}
+
+// The progress bar, on a terminal (script(1) gives the command one): percent and ETA from the
+// bytes read of the file, so also for a gzip-compressed ASCII STL, which states no count; the
+// line is cleared at the end; -q draws nothing.
+TEST(CliProgress, PercentFromTheFilesBytesAndClearedAtTheEnd) {
+    TempDir dir;
+    const std::string gz = std::string(MESHSTREAM_FIXTURES_DIR) + "/gearwheel.ascii.stl.gz";
+    const auto on_terminal = [&](const std::string& args) {
+        const std::string out = dir / "tty.txt";
+        const std::string cmd = "TERM=xterm script -qec \"" + std::string(MESHSTREAM_BINARY) + " " + args + "\" /dev/null > " + out;
+        EXPECT_EQ(std::system(cmd.c_str()), 0) << cmd;
+        return slurp(out);
+    };
+    for (const std::string cmd : {"convert", "decimate -r 0.5", "sort --axis z"}) {
+        SCOPED_TRACE(cmd);
+        const std::string tty = on_terminal(cmd + " " + gz + " " + dir / "out.stl");
+        EXPECT_NE(tty.find("100.0% 2444 triangles"), std::string::npos) << tty;
+        EXPECT_NE(tty.find("ETA"), std::string::npos) << tty;
+        // Every frame is cleared: nothing of a bar after the last clear.
+        const size_t cleared = tty.rfind("\r\x1b[K");
+        ASSERT_NE(cleared, std::string::npos) << tty;
+        EXPECT_EQ(tty.find("ETA", cleared), std::string::npos) << tty;
+        const std::string quiet = on_terminal("-q " + cmd + " " + gz + " " + dir / "out.stl");
+        EXPECT_EQ(quiet.find("\x1b[K"), std::string::npos) << quiet;
+    }
+}
+
+// -q silences summaries, not warnings.
+TEST(CliProgress, QuietKeepsWarnings) {
+    TempDir dir;
+    const std::string coloured = std::string(MESHSTREAM_FIXTURES_DIR) + "/ply/cactus_vcolor.binary_le.ply";
+    const cli_test::CliRun loud = run("decimate -r 0.5 " + coloured + " " + dir / "d.ply");
+    EXPECT_NE(loud.err.find("triangles in 1236, out 618"), std::string::npos) << loud.err;
+    for (const std::string q : {"-q decimate", "decimate -q"}) {
+        const cli_test::CliRun quiet = run(q + " -r 0.5 " + coloured + " " + dir / "d.ply");
+        EXPECT_EQ(quiet.code, 0);
+        EXPECT_EQ(quiet.err, "meshstream: warning: colours dropped: decimate keeps positions only\n");
+    }
 }

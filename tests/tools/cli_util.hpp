@@ -34,13 +34,14 @@ struct CliRun {
     std::string err;
 };
 
-// Runs `prefix meshstream -q ARGS` through /bin/sh (prefix: e.g. "ulimit -f 64;"); stderr is
-// captured in a file outside `dir`, so `dir` holds exactly what the command left.
+// Runs `prefix meshstream ARGS` through /bin/sh (prefix: e.g. "ulimit -f 64;"); stderr is
+// captured in a file outside `dir`, so `dir` holds exactly what the command left (and, not
+// being a terminal, gets no progress bar; summaries are there unless ARGS has -q).
 inline CliRun run(const std::string& args, const std::string& prefix = "") {
     char err_path[] = "/tmp/meshstream_cli_err-XXXXXX";
     int fd = ::mkstemp(err_path);
     ::close(fd);
-    std::string cmd = prefix + " " + MESHSTREAM_BINARY + " -q " + args + " 2> " + err_path;
+    std::string cmd = prefix + " " + MESHSTREAM_BINARY + " " + args + " 2> " + err_path;
     int status = std::system(("exec >/dev/null; " + cmd).c_str());
     CliRun r{WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status), slurp(err_path)};
     ::unlink(err_path);

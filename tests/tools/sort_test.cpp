@@ -42,7 +42,7 @@ struct CliRun {
 
 // Runs `meshstream ARGS` through the shell; `args` may contain pipes and redirections of stdin.
 CliRun run(const std::string& args, const TempDir& dir) {
-    std::string cmd = std::string(MESHSTREAM_BINARY) + " -q " + args + " > " + dir / "stdout.txt" + " 2> " + dir / "stderr.txt";
+    std::string cmd = std::string(MESHSTREAM_BINARY) + " " + args + " > " + dir / "stdout.txt" + " 2> " + dir / "stderr.txt";
     int status = std::system(cmd.c_str());
     CliRun r{WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(dir / "stdout.txt"), slurp(dir / "stderr.txt")};
     fs::remove(dir / "stdout.txt");
