@@ -184,17 +184,20 @@ private:
     bool released_ = false;
 };
 
-// The decimator's options from the command line and the input's header. Options that cannot
-// work with this input are UsageErrors (exit 2).
-decimate::Options decimation_options(const DecimateOptions& opt, const io::MeshHeader& header, const std::string& name) {
+// The decimator's options from the command line and the input's header. `input_count` is the
+// header's triangle count, or the one a first pass counted. Options that cannot work with this
+// input are UsageErrors (exit 2).
+decimate::Options decimation_options(const DecimateOptions& opt, const io::MeshHeader& header, const std::string& name,
+                                     std::string_view format, std::optional<uint64_t> input_count) {
     decimate::Options options;
     if (opt.target) {
-        if (!header.triangle_count)
-            throw UsageError(name + ": --target needs the input triangle count, which this format does "
-                                    "not state up front (binary STL, Draco and glTF do); use --ratio");
-        if (*opt.target > *header.triangle_count)
+        if (!input_count)
+            throw UsageError(name + ": --target needs the input triangle count, which " + std::string(format) +
+                             " does not state up front (binary STL, Draco and glTF do), and a stream cannot be "
+                             "read twice to count it: give the input as a file, or use --ratio");
+        if (*opt.target > *input_count)
             throw UsageError(name + ": --target " + std::to_string(*opt.target) + " is more than the " +
-                             std::to_string(*header.triangle_count) +
+                             std::to_string(*input_count) +
                              " triangles of the input (decimation only removes triangles)");
         options.target = *opt.target;
     } else {
@@ -208,6 +211,27 @@ decimate::Options decimation_options(const DecimateOptions& opt, const io::MeshH
     // by triangle minimum. A --sorted-axis of the user's own says less: the key is not known.
     options.sorted_by_minimum = header.sorted_axis && options.sorted_axis == header.sorted_axis;
     return options;
+}
+
+// --target for a file whose header states no triangle count (OBJ, ASCII STL, PLY, whose faces
+// may be polygons): the triangles decimate can use, counted in a first pass with the same
+// read loop (positions only), handed to the decimator as promised with none dropped; and what
+// the pass cost.
+struct CountPass {
+    io::InputCount count;
+    double seconds = 0;
+};
+
+CountPass count_usable_triangles(const DecimateOptions& opt, const io::ReadOptions& read) {
+    const auto start = std::chrono::steady_clock::now();
+    io::TriangleInput in = open_triangle_input(opt.input, opt.read, read, Command::kDecimate);
+    io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, io::Channels{});
+    Progress progress("counting triangles for --target", std::nullopt);
+    while (in.next(chunk)) progress.update(in.count().read, in.source());
+    CountPass pass;
+    pass.count.promised = in.count().passed();
+    pass.seconds = seconds_since(start);
+    return pass;
 }
 
 std::unique_ptr<decimate::StreamDecimator> make_decimator(const decimate::Options& options, const io::InputCount& count) {
@@ -357,17 +381,27 @@ void run_decimate(const DecimateOptions& opt) {
     io::ReadOptions read = opt.read.options();
     read.channels = io::ChannelKinds::none();
     io::TriangleInput in = open_triangle_input(opt.input, opt.read, read, Command::kDecimate);
+    std::optional<CountPass> counted;
+    if (opt.target && !in.header().triangle_count && is_regular_file(opt.input)) {
+        in.close();  // one reader at a time: PLY and OBJ keep vertex tables
+        counted = count_usable_triangles(opt, read);
+        in = open_triangle_input(opt.input, opt.read, read, Command::kDecimate);
+    }
+    // The count the decimator works from: the header's, or the first pass's.
+    const auto decimator_count = [&](const io::InputCount& read_loop) -> const io::InputCount& {
+        return counted ? counted->count : read_loop;
+    };
     const io::MeshHeader header = in.header();
     const std::string input_name = in.name();
     const RunFile input_file{opt.input, std::string(in.format().name), in.source().gzip()};
-    const decimate::Options options = decimation_options(opt, header, input_name);
+    const std::optional<uint64_t> input_count = counted ? counted->count.promised : header.triangle_count;
+    const decimate::Options options = decimation_options(opt, header, input_name, in.format().name, input_count);
 
     io::WriteOptions wo = opt.write.options(opt.read);
     // The output count, for whole-mesh writers to refuse a --memory too small before the work.
-    if (header.triangle_count)
+    if (input_count)
         wo.expected_triangle_count =
-            options.target ? *options.target
-                           : decimate::StreamDecimator::expected_output(options.ratio, *header.triangle_count);
+            options.target ? *options.target : decimate::StreamDecimator::expected_output(options.ratio, *input_count);
     // No output count is promised to the writer: the decimator lands on round(p·N_in) except
     // when the in-core rest is closed and one triangle too many is left (collapses remove two
     // faces; it then ends one over, with a warning), and skipped input triangles change N_in.
@@ -391,7 +425,7 @@ void run_decimate(const DecimateOptions& opt) {
     // to a quarter of --memory (60 bytes a triangle with vertex ids).
     HeldOutput gate(*out, out->sink->in_place() && may_restart ? std::max<uint64_t>(budget / 4 / 60, 1) : 0);
     const decimate::Emit emit = [&gate](const io::TriangleChunk& chunk) { gate.write(chunk); };
-    Progress progress(sort_first ? "reading" : "decimating", header.triangle_count);
+    Progress progress(sort_first ? "reading" : "decimating", input_count);
 
     SortOutcome outcome;
     outcome.requested = sort_first;
@@ -399,7 +433,7 @@ void run_decimate(const DecimateOptions& opt) {
     decimate::Options used = options;
     std::optional<SortedInput> sorted;
     if (!sort_first) {
-        decimator = make_decimator(options, in.count());
+        decimator = make_decimator(options, decimator_count(in.count()));
         const auto attempt = std::chrono::steady_clock::now();
         const ChunkSource next = [&](io::TriangleChunk& chunk) {
             if (!in.next(chunk)) return false;
@@ -455,7 +489,7 @@ void run_decimate(const DecimateOptions& opt) {
             outcome.temp_bytes = sorted->temp_bytes;
             used.sorted_axis = sorted->axis;
             used.sorted_by_minimum = true;
-            decimator = make_decimator(used, sorted->count);
+            decimator = make_decimator(used, decimator_count(sorted->count));
             progress.phase("decimating the sorted input", sorted->count.passed());
             uint64_t done = 0;
             const ChunkSource next = [&](io::TriangleChunk& chunk) {
@@ -466,8 +500,8 @@ void run_decimate(const DecimateOptions& opt) {
             decimate_pass(next, *decimator, emit, [&] { progress.update(done); }, {});
         } else {
             in = open_triangle_input(opt.input, opt.read, read, Command::kDecimate);
-            decimator = make_decimator(options, in.count());
-            progress.phase("decimating", header.triangle_count);
+            decimator = make_decimator(options, decimator_count(in.count()));
+            progress.phase("decimating", input_count);
             decimate_pass([&](io::TriangleChunk& chunk) { return in.next(chunk); }, *decimator, emit,
                           [&] { progress.update(in.count().read, in.source()); }, {});
         }
@@ -493,6 +527,7 @@ void run_decimate(const DecimateOptions& opt) {
     facts.skipped = sorted ? sorted->count.dropped : in.count().dropped;
     facts.input_name = input_name;
     facts.sort = outcome;
+    if (counted) facts.count_pass_seconds = counted->seconds;
     if (!opt.json && !global().quiet) print_decimate_summary(facts, opt.output, seconds);
 
     Warnings warnings;
@@ -531,7 +566,7 @@ void add_decimate(CLI::App& app) {
     cmd->add_option("output", opt->output, "Output mesh ('-' = stdout: a pipe gets meshstream's triangle stream, anything else needs --to)")->required();
     auto* ratio = cmd->add_option("-r,--ratio", opt->ratio, "Fraction of input triangles to keep, in (0, 1] (default 0.1)")
                       ->check(open_unit_interval());
-    cmd->add_option("--target", opt->target, "Exact output triangle count (needs a format that states the input count)")
+    cmd->add_option("--target", opt->target, "Exact output triangle count (an input that states no count is counted in a first pass; not from a pipe)")
         ->excludes(ratio)
         ->check(whole_number(1, "a whole number of triangles"));
     cmd->add_option("--buffer", opt->buffer, "In-core buffer capacity in triangles (memory is fixed by it)")

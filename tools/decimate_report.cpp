@@ -119,6 +119,14 @@ void note_decimate_warnings(const DecimateFacts& f, Warnings& warnings) {
                       " in): the output is empty; give a larger --ratio or --target");
 }
 
+std::string count_pass_notice(uint64_t triangles, double seconds) {
+    char line[160];
+    std::snprintf(line, sizeof line,
+                  "counted %llu input triangles in a first pass for --target (the input states no count): %.2f s",
+                  (unsigned long long)triangles, seconds);
+    return line;
+}
+
 std::string sort_notice(const SortOutcome& sort) {
     if (sort.kind != SortOutcome::Kind::kSorted) return {};
     char cost[160];
@@ -153,6 +161,7 @@ nlohmann::ordered_json decimate_details_json(const DecimateFacts& f) {
     j["sorted_axis"] = f.used_axis ? nlohmann::ordered_json(std::string(1, axis_name(*f.used_axis)))
                                    : nlohmann::ordered_json(nullptr);
     if (f.weld_eps > 0) j["weld"] = {{"size", f.weld_eps}, {"vertices_merged", s.vertices_merged}};
+    if (f.count_pass_seconds) j["count_pass_seconds"] = *f.count_pass_seconds;
     if (f.sort.kind == SortOutcome::Kind::kSorted)
         j["sorted_first"] = {{"axis", std::string(1, axis_name(f.sort.axis))},
                              {"requested", f.sort.requested},
@@ -165,6 +174,8 @@ void print_decimate_summary(const DecimateFacts& f, const std::string& output, d
     const decimate::Stats& s = f.stats;
     std::fprintf(stderr, "decimated %s -> %s\n", f.input_name.c_str(), output.c_str());
     if (const std::string notice = sort_notice(f.sort); !notice.empty()) std::fprintf(stderr, "  %s\n", notice.c_str());
+    if (f.count_pass_seconds)
+        std::fprintf(stderr, "  %s\n", count_pass_notice(f.stats.triangles_in, *f.count_pass_seconds).c_str());
     std::fprintf(stderr, "  triangles in %llu, out %llu (target %llu, ratio %.6g)\n",
                  (unsigned long long)s.triangles_in, (unsigned long long)s.triangles_out,
                  (unsigned long long)s.target_triangles, f.ratio);

@@ -45,6 +45,8 @@ struct DecimateFacts {
     uint64_t skipped = 0;           // input triangles the read loop dropped
     std::string input_name;
     SortOutcome sort;
+    // --target with an input that states no count: the first pass that counted it.
+    std::optional<double> count_pass_seconds;
 };
 
 // The warnings about the decimation itself (not the read loop's or the writer's, which the
@@ -57,6 +59,9 @@ std::string sort_notice(const SortOutcome& sort);
 // The decimation's own figures for --json (run_report.hpp): target, ratio, buffer and its peak
 // fill, collapses, forced writes, the sweep axis, the weld and a sort done first.
 nlohmann::ordered_json decimate_details_json(const DecimateFacts& facts);
+
+// "counted N input triangles in a first pass for --target (...): 0.12 s".
+std::string count_pass_notice(uint64_t triangles, double seconds);
 
 // The summary lines on stderr after a run (triangles, time, buffer, weld, sweep, sort).
 void print_decimate_summary(const DecimateFacts& facts, const std::string& output, double seconds);

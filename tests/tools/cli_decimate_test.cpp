@@ -280,3 +280,39 @@ TEST(CliDecimate, TheMemoryAskedForAPlainGltfSuffices) {
     };
     EXPECT_GT(asked_for("- --to gltf"), asked_for(dir / "out.glb"));
 }
+
+// --target with an input that states no count (ASCII STL, OBJ, PLY): a file is counted in a
+// first pass, which the summary names, and comes out as the same mesh as from a binary STL
+// copy, which states its count; a pipe is refused (above, CommandLinesThatCannotWork...).
+TEST(CliDecimate, TargetCountsAFileThatStatesNoCount) {
+    TempDir dir;
+    const std::string ascii = std::string(MESHSTREAM_FIXTURES_DIR) + "/gearwheel.ascii.stl";
+    const std::string binary = dir / "gear.stl";
+    ASSERT_EQ(run("convert " + ascii + " " + binary).code, 0);
+    const CliRun counted = run("decimate --target 1000 " + ascii + " " + dir / "a.stl");
+    ASSERT_EQ(counted.code, 0) << counted.err;
+    EXPECT_NE(counted.err.find("counted 2444 input triangles in a first pass for --target"), std::string::npos)
+        << counted.err;
+    EXPECT_NE(counted.err.find("triangles in 2444, out 1000 (target 1000"), std::string::npos) << counted.err;
+    const CliRun stated = run("decimate --target 1000 " + binary + " " + dir / "b.stl");
+    ASSERT_EQ(stated.code, 0) << stated.err;
+    EXPECT_EQ(stated.err.find("first pass"), std::string::npos) << stated.err;
+    EXPECT_EQ(cli_test::slurp(dir / "a.stl"), cli_test::slurp(dir / "b.stl"));
+    // PLY (faces may be polygons, so no triangle count up front) and OBJ.
+    const std::string ply = std::string(MESHSTREAM_FIXTURES_DIR) + "/ply/cactus_vcolor.binary_le.ply";
+    const CliRun p = run("decimate --target 600 " + ply + " " + dir / "p.stl");
+    ASSERT_EQ(p.code, 0) << p.err;
+    EXPECT_NE(p.err.find("counted 1236 input triangles in a first pass"), std::string::npos) << p.err;
+    EXPECT_NE(p.err.find("out 600 (target 600"), std::string::npos) << p.err;
+    const std::string obj = dir / "gear.obj";
+    ASSERT_EQ(run("convert " + binary + " " + obj).code, 0);
+    const CliRun o = run("decimate --json --target 1000 " + obj + " " + dir / "o.stl > " + dir / "o.json");
+    ASSERT_EQ(o.code, 0) << o.err;
+    const std::string json = cli_test::slurp(dir / "o.json");
+    EXPECT_NE(json.find("\"triangles_out\":1000"), std::string::npos) << json;
+    EXPECT_NE(json.find("\"count_pass_seconds\":"), std::string::npos) << json;
+    // More than the input holds: said with the counted figure.
+    const CliRun over = run("decimate --target 3000 " + ascii + " " + dir / "c.stl");
+    EXPECT_EQ(over.code, 2);
+    EXPECT_NE(over.err.find("--target 3000 is more than the 2444 triangles of the input"), std::string::npos) << over.err;
+}
