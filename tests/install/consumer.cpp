@@ -1,7 +1,15 @@
 // Reads a mesh through the installed io library and decimates it with the installed decimator:
-// prints "<input triangles> <output triangles>".
-#include "decimate/stream_decimator.hpp"
-#include "io/format.hpp"
+// prints "<input triangles> <output triangles>". It includes every public entry header, so
+// an installed header that includes one the install left out fails this build.
+#include <meshstream/compare/metro.hpp>
+#include <meshstream/compare/order.hpp>
+#include <meshstream/compare/topology.hpp>
+#include <meshstream/decimate/stream_decimator.hpp>
+#include <meshstream/io/error.hpp>
+#include <meshstream/io/format.hpp>
+#include <meshstream/io/mesh_index.hpp>
+#include <meshstream/io/triangle_input.hpp>
+#include <meshstream/sort/external_sort.hpp>
 
 #include <cstdio>
 
