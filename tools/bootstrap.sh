@@ -4,6 +4,7 @@
 #   tools/bootstrap.sh test   install what is missing, build, run the whole test suite (ctest)
 #   tools/bootstrap.sh build  install what is missing and build only
 # Idempotent: packages already installed and an up-to-date build are not redone.
+# MESHSTREAM_CMAKE_ARGS adds configure options to a new build (CI: -DMESHSTREAM_WERROR=ON).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -43,7 +44,9 @@ for pkg in gltf-validator@2.0.0-dev.3.10 three@0.170.0 gltfpack@0.18.0; do
 done
 
 if [ ! -f "$build_dir/CMakeCache.txt" ]; then
-  cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release -DMESHSTREAM_TOOLS_DIR="$tools_dir" >/dev/null
+  # shellcheck disable=SC2086  # MESHSTREAM_CMAKE_ARGS is a list of options
+  cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release -DMESHSTREAM_TOOLS_DIR="$tools_dir" \
+    ${MESHSTREAM_CMAKE_ARGS:-} >/dev/null
 fi
 cmake --build "$build_dir" -j"$jobs"
 

@@ -63,7 +63,7 @@ TEST(Collapse, OctahedronCollapseRemovesTwoFacesAndStaysClosed) {
     apply_collapse(buffer, h);
     EXPECT_EQ(buffer.face_count(), 6u);
     EXPECT_TRUE(buffer_consistent(buffer));
-    for (const uint32_t h : live_half_edges(buffer)) EXPECT_TRUE(is_half_edge(buffer.twin(h)));
+    for (const uint32_t e : live_half_edges(buffer)) EXPECT_TRUE(is_half_edge(buffer.twin(e)));
     EXPECT_EQ(buffer.vertex(east).face_count, 4u);  // 4 - 2 removed + 2 inherited from top
 }
 
