@@ -37,15 +37,6 @@ inline bool same_position(const float* a, const float* b) {
     return weld_bits(a[0]) == weld_bits(b[0]) && weld_bits(a[1]) == weld_bits(b[1]) && weld_bits(a[2]) == weld_bits(b[2]);
 }
 
-uint64_t hash_bytes(const std::byte* p, size_t n, uint64_t h) {
-    for (size_t i = 0; i < n; i += 8) {
-        uint64_t w = 0;
-        std::memcpy(&w, p + i, std::min<size_t>(8, n - i));
-        h = mix64(h ^ w);
-    }
-    return h;
-}
-
 // Non-finite values become 0; returns how many there were.
 template <class T>
 uint64_t zero_non_finite(T* v, size_t n) {

@@ -19,16 +19,6 @@
 namespace meshstream::io {
 namespace {
 
-uint64_t hash_bytes(const std::byte* p, size_t n) {
-    uint64_t h = 0x9e3779b97f4a7c15ULL;
-    for (size_t i = 0; i < n; i += 8) {
-        uint64_t w = 0;
-        std::memcpy(&w, p + i, std::min<size_t>(8, n - i));
-        h = mix64(h ^ w);
-    }
-    return h;
-}
-
 // Key = bit pattern of the position, then the corner's attribute record (N bytes, zero padded
 // past the layout's size): corners of one position with different attributes (UV or normal
 // seams) stay different vertices.
