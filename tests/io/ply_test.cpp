@@ -94,7 +94,7 @@ Full read_full(const std::string& path, size_t capacity = io::TriangleChunk::kDe
 // descriptions); vertex ids too when `ids`.
 void expect_same(const Full& a, const Full& b, bool ids = true) {
     auto same_bits = [](const std::vector<float>& x, const std::vector<float>& y) {
-        return x.size() == y.size() && std::memcmp(x.data(), y.data(), x.size() * sizeof(float)) == 0;
+        return x.size() == y.size() && (x.empty() || std::memcmp(x.data(), y.data(), x.size() * sizeof(float)) == 0);
     };
     EXPECT_TRUE(same_bits(a.xyz, b.xyz));
     EXPECT_TRUE(same_bits(a.normals, b.normals));
