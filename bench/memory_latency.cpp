@@ -30,8 +30,7 @@ struct alignas(64) Line {
 };
 
 double ns_per_step(std::chrono::steady_clock::time_point t0, size_t steps) {
-    return std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - t0).count() /
-           double(steps);
+    return std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - t0).count() / double(steps);
 }
 
 // K chases in lockstep through the same ring, started K equal steps apart: ns per line
@@ -66,8 +65,9 @@ int main(int argc, char** argv) {
         sizes.push_back(mib);
     }
     if (sizes.empty()) sizes = {1, 2, 4, 16, 64, 256};
-    std::printf("working set   dependent   per line with 8, 16 and 32 chases in lockstep   "
-                "per pair with 8: one line, both\n");
+    std::printf(
+        "working set   dependent   per line with 8, 16 and 32 chases in lockstep   "
+        "per pair with 8: one line, both\n");
     for (const size_t mib : sizes) {
         const size_t n = mib * (size_t{1} << 20) / sizeof(Line);
         // 2 MiB aligned and advised as huge pages, like the decimator's pools (so that TLB

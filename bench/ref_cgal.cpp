@@ -95,7 +95,8 @@ int main(int argc, char** argv) {
         if (!chunk.empty()) o.write(chunk);
         o.finish();
         double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        std::fprintf(stderr, "ref_cgal: in %zu out %zu seconds %.3f\n", in_count, size_t(mesh.number_of_faces()), seconds);
+        std::fprintf(stderr, "ref_cgal: in %zu out %zu seconds %.3f\n", in_count, size_t(mesh.number_of_faces()),
+                     seconds);
     } catch (const std::exception& e) {
         std::fprintf(stderr, "ref_cgal: error: %s\n", e.what());
         return 1;

@@ -37,7 +37,8 @@ int main(int argc, char** argv) {
         }
         size_t corners = soup.size() / 3;
         std::vector<unsigned int> remap(corners);
-        size_t vertex_count = meshopt_generateVertexRemap(remap.data(), nullptr, corners, soup.data(), corners, 3 * sizeof(float));
+        size_t vertex_count =
+            meshopt_generateVertexRemap(remap.data(), nullptr, corners, soup.data(), corners, 3 * sizeof(float));
         std::vector<float> vertices(3 * vertex_count);
         meshopt_remapVertexBuffer(vertices.data(), soup.data(), corners, 3 * sizeof(float), remap.data());
         soup = {};

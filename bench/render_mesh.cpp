@@ -74,9 +74,19 @@ void write_png(const std::string& path, int w, int h, const std::vector<unsigned
     if (!f) throw meshstream::io::Error(path, "cannot create file");
     const unsigned char sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
     std::fwrite(sig, 1, 8, f);
-    std::vector<unsigned char> ihdr = {uint8_t(w >> 24), uint8_t(w >> 16), uint8_t(w >> 8), uint8_t(w),
-                                       uint8_t(h >> 24), uint8_t(h >> 16), uint8_t(h >> 8), uint8_t(h),
-                                       8, 2, 0, 0, 0};  // 8-bit RGB
+    std::vector<unsigned char> ihdr = {uint8_t(w >> 24),
+                                       uint8_t(w >> 16),
+                                       uint8_t(w >> 8),
+                                       uint8_t(w),
+                                       uint8_t(h >> 24),
+                                       uint8_t(h >> 16),
+                                       uint8_t(h >> 8),
+                                       uint8_t(h),
+                                       8,
+                                       2,
+                                       0,
+                                       0,
+                                       0};  // 8-bit RGB
     put_chunk(f, "IHDR", ihdr);
     put_chunk(f, "IDAT", z);
     put_chunk(f, "IEND", {});
@@ -93,13 +103,18 @@ int main(int argc, char** argv) {
     bool wire = false;
     for (int i = 1; i < argc; ++i) {
         std::string a = argv[i];
-        if (a == "--size" && i + 1 < argc) size = std::atoi(argv[++i]);
-        else if (a == "--frame" && i + 1 < argc) frame = argv[++i];
-        else if (a == "--wire") wire = true;
+        if (a == "--size" && i + 1 < argc)
+            size = std::atoi(argv[++i]);
+        else if (a == "--frame" && i + 1 < argc)
+            frame = argv[++i];
+        else if (a == "--wire")
+            wire = true;
         else if (a == "--view" && i + 1 < argc) {
             if (std::sscanf(argv[++i], "%lf,%lf,%lf", &view[0], &view[1], &view[2]) != 3) return 2;
-        } else if (in_path.empty()) in_path = a;
-        else if (out_path.empty()) out_path = a;
+        } else if (in_path.empty())
+            in_path = a;
+        else if (out_path.empty())
+            out_path = a;
         else {
             std::fprintf(stderr, "usage: render_mesh IN OUT.png [--size W] [--view X,Y,Z] [--frame REF] [--wire]\n");
             return 2;

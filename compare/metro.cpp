@@ -170,8 +170,9 @@ std::vector<BvhNode> build_bvh(uint32_t n, BoxFn box, uint32_t leaf_size, std::v
         for (int a = 1; a < 3; ++a)
             if (chi[a] - clo[a] > chi[axis] - clo[axis]) axis = a;
         uint32_t mid = job.begin + (job.end - job.begin) / 2;
-        std::nth_element(order.begin() + job.begin, order.begin() + mid, order.begin() + job.end,
-                         [&](uint32_t x, uint32_t y) { return centroid[3 * size_t{x} + axis] < centroid[3 * size_t{y} + axis]; });
+        std::nth_element(
+            order.begin() + job.begin, order.begin() + mid, order.begin() + job.end,
+            [&](uint32_t x, uint32_t y) { return centroid[3 * size_t{x} + axis] < centroid[3 * size_t{y} + axis]; });
         uint32_t left = static_cast<uint32_t>(nodes.size());
         node.first = left;
         node.count = 0;
@@ -302,14 +303,16 @@ struct SampleIndex {
     // Lowers best2 of every sample that triangle t (absolute bounding box abs_lo..abs_hi) is
     // closer to.
     void update(const float* t, const float abs_lo[3], const float abs_hi[3]) {
-        lower_within(abs_lo, abs_hi, [&](const double p[3], double so_far) { return std::min(so_far, point_triangle_dist2(p, t)); });
+        lower_within(abs_lo, abs_hi,
+                     [&](const double p[3], double so_far) { return std::min(so_far, point_triangle_dist2(p, t)); });
     }
     // The same for every triangle of `chunk` (abs_lo..abs_hi bounds them all), through its BVH:
     // for samples far from the streamed surface, which a triangle at a time would meet once for
     // every triangle within reach.
     void update(const TriangleIndex& chunk, const float abs_lo[3], const float abs_hi[3]) {
         lower_within(abs_lo, abs_hi, [&](const double p[3], double so_far) {
-            return bvh_nearest(chunk.nodes, p, so_far, [&](uint32_t k) { return point_triangle_dist2(p, &chunk.xyz[9 * size_t{k}]); });
+            return bvh_nearest(chunk.nodes, p, so_far,
+                               [&](uint32_t k) { return point_triangle_dist2(p, &chunk.xyz[9 * size_t{k}]); });
         });
     }
 
@@ -664,8 +667,9 @@ CompareResult compare_meshes(const MeshSource& a, const MeshSource& b, const Com
         });
         flush();
         if (check.triangles != streamed_summary.triangles || check.area != streamed_summary.area)
-            throw io::Error(streamed.name, "changed between the two passes (" + std::to_string(streamed_summary.triangles) +
-                                               " triangles, then " + std::to_string(check.triangles) + ")");
+            throw io::Error(streamed.name, "changed between the two passes (" +
+                                               std::to_string(streamed_summary.triangles) + " triangles, then " +
+                                               std::to_string(check.triangles) + ")");
     }
     StatsAccumulator held_stats;
     for (double d2 : samples.best2) held_stats.add(d2);

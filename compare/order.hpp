@@ -42,10 +42,10 @@ namespace meshstream::compare {
 
 struct OrderReport {
     uint64_t triangles = 0;
-    uint64_t width = 0;          // estimate; exact when sample_rate == 1
-    double width_error = 0;      // ≈95% half-width of the estimate (0 when exact)
-    double sample_rate = 1;      // fraction of triangles tracked (a power of 1/2)
-    uint64_t width_at = 0;       // triangle index at which the width is reached
+    uint64_t width = 0;                  // estimate; exact when sample_rate == 1
+    double width_error = 0;              // ≈95% half-width of the estimate (0 when exact)
+    double sample_rate = 1;              // fraction of triangles tracked (a power of 1/2)
+    uint64_t width_at = 0;               // triangle index at which the width is reached
     std::array<uint64_t, 3> descents{};  // times the sort key (minimum x, y, z) decreased
     bool exact() const { return sample_rate == 1.0; }
     // The axis whose key decreased least often (the likely sort axis), 0..2.

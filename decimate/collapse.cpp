@@ -26,7 +26,9 @@ constexpr double kMinShapeQuality = 1e-8;
 constexpr uint32_t kMaxRing = 32;
 
 void sub(const double a[3], const double b[3], double out[3]) {
-    out[0] = a[0] - b[0]; out[1] = a[1] - b[1]; out[2] = a[2] - b[2];
+    out[0] = a[0] - b[0];
+    out[1] = a[1] - b[1];
+    out[2] = a[2] - b[2];
 }
 void cross(const double a[3], const double b[3], double out[3]) {
     out[0] = a[1] * b[2] - a[2] * b[1];
@@ -54,8 +56,8 @@ Edge edge_of(const HalfEdgeBuffer& buffer, uint32_t h) {
 
 }  // namespace
 
-bool moves_keep_faces_valid(const HalfEdgeBuffer& buffer, uint32_t v, const double from[3],
-                            const double to[3], uint32_t skip0, uint32_t skip1) {
+bool moves_keep_faces_valid(const HalfEdgeBuffer& buffer, uint32_t v, const double from[3], const double to[3],
+                            uint32_t skip0, uint32_t skip1) {
     // Face (v, a, b) with e = b − a: its normal is (a − v) × e, before (v = from) and after
     // (v = to), and its squared edge lengths sum to 2·(|a − v|² + (a − v)·e + |e|²).
     // `fan` sums the sound faces' old normals; the new normals wait in `moved` (past its size,
@@ -111,8 +113,10 @@ bool moves_keep_faces_valid(const HalfEdgeBuffer& buffer, uint32_t v, const doub
         }
         // Sound after the move (a degenerate face too: a sliver turned over must not become a
         // real face upside down): checked against the fan below.
-        if (moved_count < kMaxMoved) std::copy(n.n_new, n.n_new + 3, moved[moved_count++]);
-        else overflow = true;
+        if (moved_count < kMaxMoved)
+            std::copy(n.n_new, n.n_new + 3, moved[moved_count++]);
+        else
+            overflow = true;
     }
     // cos(angle to the fan's normal) > kMinFanCos, without a square root. A fan whose normals
     // nearly cancel (a knife edge, a thin plate's rim) has no direction to keep: then only the
@@ -217,7 +221,8 @@ bool pinches_link(HalfEdgeBuffer& buffer, const Edge& e) {
     // with p's fan however many faces q has.
     auto next_to_q = [&](uint32_t x) {
         for (uint32_t c = buffer.vertex(x).first_corner; c != kNoIndex; c = buffer.next_corner(c))
-            if (buffer.corner_vertex(next_in_face(c)) == e.q || buffer.corner_vertex(prev_in_face(c)) == e.q) return true;
+            if (buffer.corner_vertex(next_in_face(c)) == e.q || buffer.corner_vertex(prev_in_face(c)) == e.q)
+                return true;
         return false;
     };
     for (uint32_t c = vp.first_corner; c != kNoIndex; c = buffer.next_corner(c)) {
@@ -237,7 +242,8 @@ bool may_double_written_edge(const HalfEdgeBuffer& buffer, const Edge& e) {
         return y != e.q && y != e.r && y != e.s && (buffer.vertex(y).flags & kFrozen) != 0;
     };
     for (uint32_t c = buffer.vertex(e.p).first_corner; c != kNoIndex; c = buffer.next_corner(c))
-        if (written_other(buffer.corner_vertex(next_in_face(c))) || written_other(buffer.corner_vertex(prev_in_face(c))))
+        if (written_other(buffer.corner_vertex(next_in_face(c))) ||
+            written_other(buffer.corner_vertex(prev_in_face(c))))
             return true;
     return false;
 }
@@ -245,9 +251,13 @@ bool may_double_written_edge(const HalfEdgeBuffer& buffer, const Edge& e) {
 }  // namespace
 
 bool shares_apex(const HalfEdgeBuffer& buffer, uint32_t h) { return shares_apex(edge_of(buffer, h)); }
-bool collapses_tetrahedron(const HalfEdgeBuffer& buffer, uint32_t h) { return collapses_tetrahedron(buffer, edge_of(buffer, h)); }
+bool collapses_tetrahedron(const HalfEdgeBuffer& buffer, uint32_t h) {
+    return collapses_tetrahedron(buffer, edge_of(buffer, h));
+}
 bool pinches_link(HalfEdgeBuffer& buffer, uint32_t h) { return pinches_link(buffer, edge_of(buffer, h)); }
-bool may_double_written_edge(const HalfEdgeBuffer& buffer, uint32_t h) { return may_double_written_edge(buffer, edge_of(buffer, h)); }
+bool may_double_written_edge(const HalfEdgeBuffer& buffer, uint32_t h) {
+    return may_double_written_edge(buffer, edge_of(buffer, h));
+}
 
 bool collapse_valid(HalfEdgeBuffer& buffer, uint32_t h) {
     double to[3];
@@ -258,7 +268,8 @@ bool collapse_valid(HalfEdgeBuffer& buffer, uint32_t h) {
 bool collapse_valid(HalfEdgeBuffer& buffer, uint32_t h, const double target[3]) {
     const PhaseTimer timer(Phase::kValidate);
     const Edge e = edge_of(buffer, h);
-    if (shares_apex(e) || collapses_tetrahedron(buffer, e) || pinches_link(buffer, e) || may_double_written_edge(buffer, e))
+    if (shares_apex(e) || collapses_tetrahedron(buffer, e) || pinches_link(buffer, e) ||
+        may_double_written_edge(buffer, e))
         return false;
     const uint32_t skip1 = e.boundary ? kNoIndex : face_of(e.t);
     double from_p[3], from_q[3];

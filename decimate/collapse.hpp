@@ -45,8 +45,7 @@ inline bool collapse_eligible(const HalfEdgeBuffer& buffer, uint32_t h) {
 // kMaxMovedFaces faces.
 inline bool collapse_target_free(const HalfEdgeBuffer& buffer, uint32_t h) {
     const Vertex& q = buffer.vertex(buffer.corner_vertex(next_in_face(h)));
-    return (q.flags & (kInHash | kFrozen | kNonManifold)) == 0 && q.open_edges == 0 &&
-           q.face_count <= kMaxMovedFaces;
+    return (q.flags & (kInHash | kFrozen | kNonManifold)) == 0 && q.open_edges == 0 && q.face_count <= kMaxMovedFaces;
 }
 
 // The quadric error of collapsing h = p→q without moving q: (Q_p + Q_q) evaluated at q.
@@ -93,8 +92,8 @@ bool collapse_valid(HalfEdgeBuffer& buffer, uint32_t h);
 // (turns measured against each face's own normal add up over successive collapses), and must
 // not become a needle or cap. Faces that were already degenerate are ignored unless they come
 // out sound and facing against the fan.
-bool moves_keep_faces_valid(const HalfEdgeBuffer& buffer, uint32_t v, const double from[3],
-                            const double to[3], uint32_t skip0, uint32_t skip1);
+bool moves_keep_faces_valid(const HalfEdgeBuffer& buffer, uint32_t v, const double from[3], const double to[3],
+                            uint32_t skip0, uint32_t skip1);
 
 // Performs the collapse p→q: removes the one or two faces on the edge, re-links their outer
 // neighbours, moves p's corners to q and adds Q_p to Q_q, frees p, and moves q to `target`

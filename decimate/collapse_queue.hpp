@@ -82,8 +82,8 @@ private:
     RawArray<uint32_t> free_chunks_;
     size_t free_chunk_count_ = 0;
     uint32_t chunk_high_ = 0;
-    uint32_t head_[kBuckets];       // newest chunk of each bucket (kNone: empty)
-    uint8_t fill_[kBuckets];        // entries in the head chunk
+    uint32_t head_[kBuckets];  // newest chunk of each bucket (kNone: empty)
+    uint8_t fill_[kBuckets];   // entries in the head chunk
     uint64_t nonempty_[kBuckets / 64];
     uint64_t nonempty_words_[kBuckets / 64 / 64];
     size_t entries_ = 0;

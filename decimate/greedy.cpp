@@ -35,8 +35,10 @@ void rate_edge(HalfEdgeBuffer& buffer, CollapseQueue& queue, uint32_t h) {
     }
     const double e_forward = forward ? collapse_placement(buffer, h).error : INFINITY;
     const double e_backward = backward ? collapse_placement(buffer, t).error : INFINITY;
-    if (e_backward < e_forward) queue.push(buffer, h, true, e_backward);
-    else queue.push(buffer, h, false, e_forward);
+    if (e_backward < e_forward)
+        queue.push(buffer, h, true, e_backward);
+    else
+        queue.push(buffer, h, false, e_forward);
 }
 
 namespace {
@@ -109,7 +111,8 @@ bool collapse_cheapest(HalfEdgeBuffer& buffer, CollapseQueue& queue) {
         for (uint32_t c = buffer.vertex(q).first_corner; c != kNoIndex; c = buffer.next_corner(c)) {
             for (const uint32_t e : {c, prev_in_face(c)}) {
                 const uint32_t t = buffer.twin(e);
-                const bool queued = buffer.queue_key(e) != kNotQueued || (is_half_edge(t) && buffer.queue_key(t) != kNotQueued);
+                const bool queued =
+                    buffer.queue_key(e) != kNotQueued || (is_half_edge(t) && buffer.queue_key(t) != kNotQueued);
                 if (!queued) {
                     rate_edge(buffer, queue, e);
                     continue;
@@ -164,7 +167,8 @@ bool collapse_one_boundary_edge(HalfEdgeBuffer& buffer) {
         if (!buffer.face_alive(f)) continue;
         for (uint32_t k = 0; k < 3; ++k) {
             const uint32_t h = half_edge(f, k);
-            if (buffer.twin(h) == kOpenEdge && collapse_eligible(buffer, h)) all.push_back({h, collapse_error(buffer, h)});
+            if (buffer.twin(h) == kOpenEdge && collapse_eligible(buffer, h))
+                all.push_back({h, collapse_error(buffer, h)});
         }
     }
     // Stable: ties keep buffer order, so the result is deterministic. Every candidate is tried

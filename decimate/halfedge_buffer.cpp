@@ -309,8 +309,7 @@ constexpr uint32_t kLongCornerList = 64;
 HalfEdgeBuffer::Added HalfEdgeBuffer::add_triangle(const float tri[9], const uint64_t hashes[3]) {
     assert(!full() && free_vertex_count() >= 3);
     Added added;
-    for (int k = 0; k < 3; ++k)
-        added.vertex[k] = weld(tri + 3 * k, hashes ? hashes[k] : weld_hash(tri + 3 * k));
+    for (int k = 0; k < 3; ++k) added.vertex[k] = weld(tri + 3 * k, hashes ? hashes[k] : weld_hash(tri + 3 * k));
     const uint32_t* v = added.vertex;
     if (!origin_set_) {
         for (int i = 0; i < 3; ++i) origin_[i] = tri[i];
@@ -351,7 +350,7 @@ HalfEdgeBuffer::Added HalfEdgeBuffer::add_triangle(const float tri[9], const uin
                 const Face& face = faces_[face_of(c)];
                 const uint32_t j = corner_of(c);
                 const uint32_t w = face.vertex[j == 2 ? 0 : j + 1];
-                if (w == to_next && same[k] == kNoIndex) same[k] = c;               // v[k]→v[k+1]
+                if (w == to_next && same[k] == kNoIndex) same[k] = c;                    // v[k]→v[k+1]
                 if (w == to_prev && opposite[k_prev] == kNoIndex) opposite[k_prev] = c;  // v[k]→v[k−1]
                 c = face.next[j];
             }
@@ -372,10 +371,10 @@ HalfEdgeBuffer::Added HalfEdgeBuffer::add_triangle(const float tri[9], const uin
                 auto first = [](uint32_t& found, uint32_t h) {
                     if (found == kNoIndex) found = h;
                 };
-                if (after == v[k_next]) first(same[k], c);               // v[k]→v[k+1]
-                if (after == v[k_prev]) first(opposite[k_prev], c);      // v[k]→v[k−1]
-                if (before == v[k_next]) first(opposite[k], into);       // v[k+1]→v[k]
-                if (before == v[k_prev]) first(same[k_prev], into);      // v[k−1]→v[k]
+                if (after == v[k_next]) first(same[k], c);           // v[k]→v[k+1]
+                if (after == v[k_prev]) first(opposite[k_prev], c);  // v[k]→v[k−1]
+                if (before == v[k_next]) first(opposite[k], into);   // v[k+1]→v[k]
+                if (before == v[k_prev]) first(same[k_prev], into);  // v[k−1]→v[k]
                 c = face.next[j];
             }
         }
@@ -474,8 +473,10 @@ void HalfEdgeBuffer::unlink_corner(uint32_t v, uint32_t c) {
     Vertex& x = slots_[v].vertex;
     const Face& face = faces_[face_of(c)];
     const uint32_t next = face.next[corner_of(c)], prev = face.prev[corner_of(c)];
-    if (prev == kNoIndex) x.first_corner = next;
-    else faces_[face_of(prev)].next[corner_of(prev)] = next;
+    if (prev == kNoIndex)
+        x.first_corner = next;
+    else
+        faces_[face_of(prev)].next[corner_of(prev)] = next;
     if (next != kNoIndex) faces_[face_of(next)].prev[corner_of(next)] = prev;
     --x.face_count;
 }

@@ -63,26 +63,26 @@ inline uint32_t next_in_face(uint32_t h) { return h + kToNextInFace[h & 3]; }
 inline uint32_t prev_in_face(uint32_t h) { return h + kToPrevInFace[h & 3]; }
 
 // Vertex flags.
-inline constexpr uint16_t kInHash = 1;        // open towards unread input: on P_in
-inline constexpr uint16_t kFrozen = 2;        // written (on P_out): position final, id assigned
-inline constexpr uint16_t kNonManifold = 4;   // touches a non-manifold edge: never collapsed
-inline constexpr uint16_t kWeldMerged = 8;    // absorbed another input position (--weld)
+inline constexpr uint16_t kInHash = 1;       // open towards unread input: on P_in
+inline constexpr uint16_t kFrozen = 2;       // written (on P_out): position final, id assigned
+inline constexpr uint16_t kNonManifold = 4;  // touches a non-manifold edge: never collapsed
+inline constexpr uint16_t kWeldMerged = 8;   // absorbed another input position (--weld)
 inline constexpr uint16_t kAlive = 16;
-inline constexpr uint16_t kHasPartner = 32;   // partner_position() holds a collapsed edge's far end
-inline constexpr uint16_t kPending = 64;      // listed for take_pending()
-inline constexpr uint16_t kBlocked = 128;     // a collapse at it was refused (collapse.hpp)
-inline constexpr uint16_t kManyFans = 256;    // its faces are not one fan (two fans touch here)
+inline constexpr uint16_t kHasPartner = 32;  // partner_position() holds a collapsed edge's far end
+inline constexpr uint16_t kPending = 64;     // listed for take_pending()
+inline constexpr uint16_t kBlocked = 128;    // a collapse at it was refused (collapse.hpp)
+inline constexpr uint16_t kManyFans = 256;   // its faces are not one fan (two fans touch here)
 
 struct Vertex {
     float pos[3];           // input position, moved by collapses and once when written (§4.4)
     uint32_t first_corner;  // head of the corner list (kNoIndex when no face)
     uint32_t face_count;
-    uint32_t open_edges;    // incident half-edges without partner (kOpenEdge), also written ones
-    uint32_t generation;    // bumped at every allocation (stale references detect reuse)
+    uint32_t open_edges;  // incident half-edges without partner (kOpenEdge), also written ones
+    uint32_t generation;  // bumped at every allocation (stale references detect reuse)
     uint16_t flags;
     union {
-        uint64_t id;               // output vertex id, valid once kFrozen
-        float partner_xy[2];       // before freezing: see HalfEdgeBuffer::partner_position
+        uint64_t id;          // output vertex id, valid once kFrozen
+        float partner_xy[2];  // before freezing: see HalfEdgeBuffer::partner_position
     };
 };
 
@@ -93,9 +93,11 @@ struct Vertex {
 struct FreeDeleter {
     void operator()(void* p) const { std::free(p); }
 };
-template <class T> using RawArray = std::unique_ptr<T[], FreeDeleter>;
+template <class T>
+using RawArray = std::unique_ptr<T[], FreeDeleter>;
 void* allocate_pool(size_t bytes);  // throws std::bad_alloc
-template <class T> RawArray<T> raw_array(size_t n) {
+template <class T>
+RawArray<T> raw_array(size_t n) {
     return RawArray<T>(static_cast<T*>(allocate_pool(n * sizeof(T))));
 }
 
@@ -105,13 +107,13 @@ inline constexpr uint16_t kNotQueued = 0xFFFF;
 // Everything about one face, in one cache line. Corner k of face f is corner 4·f + k, which is
 // also the half-edge from corner k to corner (k+1) mod 3.
 struct alignas(64) Face {
-    uint32_t vertex[3];     // corner → vertex
-    uint32_t twin[3];       // half-edge → twin half-edge or marker
-    uint32_t next[3];       // corner → next corner of the same vertex (kNoIndex: last)
-    uint32_t prev[3];       // corner → previous corner of the same vertex (kNoIndex: first)
-    uint32_t born;          // creation serial: tells a reused slot from the face listed before
-    uint16_t key[3];        // collapse queue key of half-edge k's edge, or kNotQueued
-    uint8_t pin_count;      // vertices on P_in
+    uint32_t vertex[3];  // corner → vertex
+    uint32_t twin[3];    // half-edge → twin half-edge or marker
+    uint32_t next[3];    // corner → next corner of the same vertex (kNoIndex: last)
+    uint32_t prev[3];    // corner → previous corner of the same vertex (kNoIndex: first)
+    uint32_t born;       // creation serial: tells a reused slot from the face listed before
+    uint16_t key[3];     // collapse queue key of half-edge k's edge, or kNotQueued
+    uint8_t pin_count;   // vertices on P_in
     uint8_t alive;
 };
 static_assert(sizeof(Face) == 64);
@@ -138,7 +140,7 @@ public:
     bool face_alive(uint32_t f) const { return faces_[f].alive != 0; }
 
     struct Added {
-        uint32_t face;     // kNoIndex when degenerate (two corners welded to one vertex)
+        uint32_t face;  // kNoIndex when degenerate (two corners welded to one vertex)
         uint32_t vertex[3];
     };
     // READ(1) of §4.2: welds the corners, accumulates quadrics, connects the new face to
@@ -184,11 +186,14 @@ public:
         Vertex& x = slots_[v].vertex;
         if (x.flags & kPending) return;
         x.flags |= kPending;
-        if (pending_count_ < vertex_capacity_) pending_[pending_count_++] = v;
-        else pending_overflow_ = true;  // take_pending() then scans every vertex
+        if (pending_count_ < vertex_capacity_)
+            pending_[pending_count_++] = v;
+        else
+            pending_overflow_ = true;  // take_pending() then scans every vertex
     }
     // Calls f(v) for each marked vertex still alive, unmarking it, and empties the list.
-    template <class F> void take_pending(F&& f) {
+    template <class F>
+    void take_pending(F&& f) {
         auto take = [&](uint32_t v) {
             Vertex& x = slots_[v].vertex;
             if ((x.flags & (kPending | kAlive)) != (kPending | kAlive)) return;
@@ -312,7 +317,7 @@ private:
     uint64_t weld_hash(const float p[3]) const {
         if (weld_eps_ == 0) {
             const uint64_t xy = uint64_t{float_key(p[0])} | uint64_t{float_key(p[1])} << 32;
-            uint64_t h = xy * 0x9e3779b97f4a7c15ull ^ uint64_t{float_key(p[2])} * 0xc2b2ae3d27d4eb4full;
+            uint64_t h = xy * 0x9e3779b97f4a7c15ull ^ uint64_t { float_key(p[2]) } * 0xc2b2ae3d27d4eb4full;
             h ^= h >> 32;
             h *= 0xd6e8feb86659fd93ull;
             return h ^ (h >> 32);
@@ -378,7 +383,9 @@ private:
     RawArray<uint32_t> hash_scratch_;
     size_t hash_mask_, hash_max_slots_, hash_count_ = 0;
 
-    struct Stub { uint32_t a, gen_a, b, gen_b; };
+    struct Stub {
+        uint32_t a, gen_a, b, gen_b;
+    };
     RawArray<Stub> stubs_;  // a == kNoIndex: empty; linear probing
     size_t stub_mask_, stub_count_ = 0;
 

@@ -1,8 +1,8 @@
 // Garland–Heckbert plane quadrics (Garland & Heckbert 1997), as used by Wu & Kobbelt 2003,
 // §4.2 (each incoming triangle adds its weighted squared plane equation to its three
-// vertices; weighted by the square root of its area, as meshoptimizer's simplifier does), §4.3 (a half-edge collapse p→q is rated by (Q_p + Q_q)(q)) and §4.4 (a written
-// vertex moves once to the minimum of its quadric). Coordinates are relative to an origin
-// chosen by the caller so that large scan coordinates do not cancel catastrophically.
+// vertices; weighted by the square root of its area, as meshoptimizer's simplifier does), §4.3 (a half-edge collapse
+// p→q is rated by (Q_p + Q_q)(q)) and §4.4 (a written vertex moves once to the minimum of its quadric). Coordinates are
+// relative to an origin chosen by the caller so that large scan coordinates do not cancel catastrophically.
 #pragma once
 
 #include <cmath>
@@ -27,8 +27,16 @@ struct Quadric {
     static constexpr double kBoundaryWeight = 1.0;
 
     Quadric& operator+=(const Quadric& o) {
-        a00 += o.a00; a01 += o.a01; a02 += o.a02; a11 += o.a11; a12 += o.a12; a22 += o.a22;
-        b0 += o.b0; b1 += o.b1; b2 += o.b2; c += o.c;
+        a00 += o.a00;
+        a01 += o.a01;
+        a02 += o.a02;
+        a11 += o.a11;
+        a12 += o.a12;
+        a22 += o.a22;
+        b0 += o.b0;
+        b1 += o.b1;
+        b2 += o.b2;
+        c += o.c;
         return *this;
     }
     friend Quadric operator+(Quadric a, const Quadric& b) { return a += b; }
@@ -65,7 +73,9 @@ struct Quadric {
         const double r1 = (c01 * b0 + c11 * b1 + c12 * b2) * inv;
         const double r2 = (c02 * b0 + c12 * b1 + c22 * b2) * inv;
         if (!std::isfinite(r0) || !std::isfinite(r1) || !std::isfinite(r2)) return false;
-        x[0] = r0; x[1] = r1; x[2] = r2;
+        x[0] = r0;
+        x[1] = r1;
+        x[2] = r2;
         return true;
     }
 

@@ -27,8 +27,7 @@ inline double resolution_budget(double ratio, uint64_t triangles_in, uint64_t tr
 }
 
 // The in-core resolution level R of §4.1 (infinity before anything stands for input).
-inline double resolution_level(double ratio, size_t current, uint64_t triangles_in,
-                               uint64_t triangles_out) {
+inline double resolution_level(double ratio, size_t current, uint64_t triangles_in, uint64_t triangles_out) {
     const double represented = double(triangles_in) - double(triangles_out) / ratio;
     return represented > 0 ? double(current) / represented : INFINITY;
 }
@@ -40,8 +39,7 @@ struct RoomPlan {
 
 // What to do when the buffer of `capacity` triangles is full (hysteresis: refill to 100 %,
 // work down to 50 %).
-inline RoomPlan plan_full_buffer(size_t capacity, double ratio, uint64_t triangles_in,
-                                 uint64_t triangles_out) {
+inline RoomPlan plan_full_buffer(size_t capacity, double ratio, uint64_t triangles_in, uint64_t triangles_out) {
     const size_t half = capacity / 2;
     const double budget = resolution_budget(ratio, triangles_in, triangles_out);
     const size_t decimate_to =

@@ -31,7 +31,8 @@ const Options& checked(const Options& options, std::optional<uint64_t> input_cou
     if (options.target && *options.target > *input_count) refuse("target is more than the input triangle count");
     if (options.sorted_by_minimum && !options.sorted_axis) refuse("sorted_by_minimum needs sorted_axis");
     if (options.buffer_triangles < 16) refuse("buffer_triangles must be at least 16");
-    if (options.sorted_axis && (*options.sorted_axis < 0 || *options.sorted_axis > 2)) refuse("sorted_axis must be 0, 1 or 2");
+    if (options.sorted_axis && (*options.sorted_axis < 0 || *options.sorted_axis > 2))
+        refuse("sorted_axis must be 0, 1 or 2");
     if (options.output_chunk_triangles == 0) refuse("output_chunk_triangles must be at least 1");
     return options;
 }
@@ -166,8 +167,10 @@ void StreamDecimator::track_sweep(const float tri[9]) {
     lo_max_ = std::max(lo_max_, lo);
     hi_min_ = std::min(hi_min_, hi);
     if (stats_.sweep_direction == 0) {
-        if (lo_max_ - first_hi_ > 2 * sweep_margin_) stats_.sweep_direction = 1;
-        else if (first_lo_ - hi_min_ > 2 * sweep_margin_) stats_.sweep_direction = -1;
+        if (lo_max_ - first_hi_ > 2 * sweep_margin_)
+            stats_.sweep_direction = 1;
+        else if (first_lo_ - hi_min_ > 2 * sweep_margin_)
+            stats_.sweep_direction = -1;
     }
 }
 
@@ -255,13 +258,12 @@ void StreamDecimator::follow_dropped() {
 void StreamDecimator::make_room(const Emit& out) {
     follow_dropped();
     if (options_.sorted_axis) sweep();
-    const RoomPlan plan = plan_full_buffer(buffer_.face_capacity(), ratio_, stats_.triangles_in,
-                                           output_.triangle_count());
+    const RoomPlan plan =
+        plan_full_buffer(buffer_.face_capacity(), ratio_, stats_.triangles_in, output_.triangle_count());
     rate_pending(buffer_, queue_);
     while (buffer_.face_count() > plan.decimate_to && collapse_cheapest(buffer_, queue_)) ++stats_.collapses;
     while (buffer_.face_count() > plan.write_to) {
-        const double budget =
-            resolution_budget(ratio_, stats_.triangles_in, output_.triangle_count());
+        const double budget = resolution_budget(ratio_, stats_.triangles_in, output_.triangle_count());
         // Early when above the level planned, the budget rounded up (each write lowers both).
         if (double(buffer_.face_count()) > std::ceil(budget)) ++stats_.premature_writes;
         write_one(out, true);
@@ -275,8 +277,7 @@ void StreamDecimator::finish(const Emit& out) {
     finished_ = true;
     // No more input: whatever is still open is true boundary.
     buffer_.finalize_all();
-    const uint64_t target = options_.target ? *options_.target
-                                            : final_triangle_count(ratio_, stats_.triangles_in);
+    const uint64_t target = options_.target ? *options_.target : final_triangle_count(ratio_, stats_.triangles_in);
     stats_.target_triangles = target;
     const size_t budget = final_budget(target, output_.triangle_count());
     rate_pending(buffer_, queue_);

@@ -26,12 +26,12 @@
 namespace meshstream::decimate {
 
 struct Options {
-    double ratio = 0.1;                 // p in (0, 1]: output = round(p · input)
-    std::optional<uint64_t> target;     // exact output triangle count instead of ratio
-    size_t buffer_triangles = 400000;   // N_max, in-core capacity (≥ 16)
-    uint64_t seed = 1;                  // draws the candidates of forced writes
-    double weld_eps = 0;                // 0: exact welding; > 0: grid cell size (absolute)
-    std::optional<int> sorted_axis;     // 0,1,2 when the input is sorted on it (either direction)
+    double ratio = 0.1;                // p in (0, 1]: output = round(p · input)
+    std::optional<uint64_t> target;    // exact output triangle count instead of ratio
+    size_t buffer_triangles = 400000;  // N_max, in-core capacity (≥ 16)
+    uint64_t seed = 1;                 // draws the candidates of forced writes
+    double weld_eps = 0;               // 0: exact welding; > 0: grid cell size (absolute)
+    std::optional<int> sorted_axis;    // 0,1,2 when the input is sorted on it (either direction)
     // The order is known exactly: ascending by each triangle's minimum coordinate along
     // sorted_axis, as `meshstream sort` writes it (the file's own flag says so). The sweep then
     // needs no margin, and one triangle whose minimum descends shows the order is not that.
@@ -42,23 +42,23 @@ struct Options {
 struct Stats {
     uint64_t triangles_in = 0;
     uint64_t triangles_out = 0;
-    uint64_t target_triangles = 0;       // round(p·N_in) or --target (known at finish)
+    uint64_t target_triangles = 0;  // round(p·N_in) or --target (known at finish)
     size_t buffer_capacity = 0;
     size_t peak_buffer_triangles = 0;
     size_t peak_vertices = 0;
     uint64_t collapses = 0;
-    uint64_t forced_writes = 0;          // written while touching P_in (buffer stuck)
-    uint64_t premature_writes = 0;       // written before R reached p (decimation stalled)
-    uint64_t degenerate_passed = 0;      // repeated corners in the input: passed through
-    uint64_t weld_dropped = 0;           // distinct corners that --weld merged: dropped
-    uint64_t nonmanifold_edges = 0;      // half-edges frozen as non-manifold
-    uint64_t boundary_edges = 0;         // edges without a partner: holes, borders, cracks
-    uint64_t vertices_merged = 0;        // vertices that absorbed other positions (--weld)
+    uint64_t forced_writes = 0;      // written while touching P_in (buffer stuck)
+    uint64_t premature_writes = 0;   // written before R reached p (decimation stalled)
+    uint64_t degenerate_passed = 0;  // repeated corners in the input: passed through
+    uint64_t weld_dropped = 0;       // distinct corners that --weld merged: dropped
+    uint64_t nonmanifold_edges = 0;  // half-edges frozen as non-manifold
+    uint64_t boundary_edges = 0;     // edges without a partner: holes, borders, cracks
+    uint64_t vertices_merged = 0;    // vertices that absorbed other positions (--weld)
     uint64_t vertices_finalized_by_sweep = 0;
-    int sweep_direction = 0;             // sorted input: +1 ascending, −1 descending, 0 not yet seen
-    uint64_t sort_violations = 0;        // triangles reaching behind the sweep (sweep then stops)
+    int sweep_direction = 0;       // sorted input: +1 ascending, −1 descending, 0 not yet seen
+    uint64_t sort_violations = 0;  // triangles reaching behind the sweep (sweep then stops)
     uint64_t orphans_evicted = 0;
-    uint64_t vertices_moved = 0;         // moved to their quadric optimum when written
+    uint64_t vertices_moved = 0;          // moved to their quadric optimum when written
     bool no_valid_collapse_left = false;  // the end's scan of every half-edge found none valid
 };
 
@@ -105,8 +105,8 @@ private:
     void follow_dropped();
 
     Options options_;
-    io::InputCount own_count_;         // the count given to the first constructor
-    const io::InputCount* input_;      // own_count_ or the caller's read loop's
+    io::InputCount own_count_;     // the count given to the first constructor
+    const io::InputCount* input_;  // own_count_ or the caller's read loop's
     double ratio_;
     HalfEdgeBuffer buffer_;
     CollapseQueue queue_;

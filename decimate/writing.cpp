@@ -7,14 +7,15 @@
 
 namespace meshstream::decimate {
 
-TriangleOutput::TriangleOutput(size_t chunk_triangles)
-    : chunk_(chunk_triangles, io::Channels::ids_only()) {}
+TriangleOutput::TriangleOutput(size_t chunk_triangles) : chunk_(chunk_triangles, io::Channels::ids_only()) {}
 
 void TriangleOutput::emit(const float xyz[9], const uint64_t ids[3], const Emit& out) {
     float* slot = chunk_.push_slot();
     std::copy(xyz, xyz + 9, slot);
     uint64_t* id = chunk_.id_at(chunk_.size() - 1);
-    id[0] = ids[0]; id[1] = ids[1]; id[2] = ids[2];
+    id[0] = ids[0];
+    id[1] = ids[1];
+    id[2] = ids[2];
     ++triangle_count_;
     if (chunk_.full()) flush(out);
 }
@@ -65,12 +66,11 @@ bool place_vertex(HalfEdgeBuffer& buffer, uint32_t v) {
     for (uint32_t c = x.first_corner; c != kNoIndex; c = buffer.next_corner(c)) {
         double w[3];
         buffer.position(buffer.corner_vertex(next_in_face(c)), w);
-        const double d2 = (w[0] - old[0]) * (w[0] - old[0]) + (w[1] - old[1]) * (w[1] - old[1]) +
-                          (w[2] - old[2]) * (w[2] - old[2]);
+        const double d2 =
+            (w[0] - old[0]) * (w[0] - old[0]) + (w[1] - old[1]) * (w[1] - old[1]) + (w[2] - old[2]) * (w[2] - old[2]);
         reach2 = std::max(reach2, d2);
     }
-    const double move2 = (best[0] - old[0]) * (best[0] - old[0]) +
-                         (best[1] - old[1]) * (best[1] - old[1]) +
+    const double move2 = (best[0] - old[0]) * (best[0] - old[0]) + (best[1] - old[1]) * (best[1] - old[1]) +
                          (best[2] - old[2]) * (best[2] - old[2]);
     if (move2 > reach2) return false;
     if (!(q.error(best) <= q.error(old))) return false;
@@ -79,8 +79,7 @@ bool place_vertex(HalfEdgeBuffer& buffer, uint32_t v) {
     return true;
 }
 
-int write_face(HalfEdgeBuffer& buffer, uint32_t f, uint64_t& next_id, TriangleOutput& output,
-                const Emit& out) {
+int write_face(HalfEdgeBuffer& buffer, uint32_t f, uint64_t& next_id, TriangleOutput& output, const Emit& out) {
     float xyz[9];
     uint64_t ids[3];
     uint32_t v[3];
@@ -94,7 +93,9 @@ int write_face(HalfEdgeBuffer& buffer, uint32_t f, uint64_t& next_id, TriangleOu
     }
     for (int k = 0; k < 3; ++k) {
         const Vertex& x = buffer.vertex(v[k]);
-        xyz[3 * k] = x.pos[0]; xyz[3 * k + 1] = x.pos[1]; xyz[3 * k + 2] = x.pos[2];
+        xyz[3 * k] = x.pos[0];
+        xyz[3 * k + 1] = x.pos[1];
+        xyz[3 * k + 2] = x.pos[2];
         ids[k] = x.id;
     }
     output.emit(xyz, ids, out);
@@ -103,8 +104,7 @@ int write_face(HalfEdgeBuffer& buffer, uint32_t f, uint64_t& next_id, TriangleOu
         const uint32_t t = buffer.twin(h);
         if (is_half_edge(t)) {
             buffer.set_twin(t, kWrittenEdge);  // the neighbour now borders P_out
-        } else if (t == kOpenEdge &&
-                   ((buffer.vertex(v[k]).flags | buffer.vertex(v[(k + 1) % 3]).flags) & kInHash)) {
+        } else if (t == kOpenEdge && ((buffer.vertex(v[k]).flags | buffer.vertex(v[(k + 1) % 3]).flags) & kInHash)) {
             // A forced write of a face still open towards the input: remember the edge so the
             // partner arriving later closes it against P_out.
             buffer.add_written_stub(v[k], v[(k + 1) % 3]);
@@ -113,20 +113,21 @@ int write_face(HalfEdgeBuffer& buffer, uint32_t f, uint64_t& next_id, TriangleOu
     buffer.detach_face(f);
     for (int k = 0; k < 3; ++k) {
         const Vertex& x = buffer.vertex(v[k]);
-        if ((x.flags & kAlive) && x.face_count == 0 && (x.flags & kInHash) == 0)
-            buffer.free_vertex(v[k]);
+        if ((x.flags & kAlive) && x.face_count == 0 && (x.flags & kInHash) == 0) buffer.free_vertex(v[k]);
     }
     return moved;
 }
 
-void pass_through(HalfEdgeBuffer& buffer, const uint32_t vertex[3], uint64_t& next_id,
-                  TriangleOutput& output, const Emit& out) {
+void pass_through(HalfEdgeBuffer& buffer, const uint32_t vertex[3], uint64_t& next_id, TriangleOutput& output,
+                  const Emit& out) {
     float xyz[9];
     uint64_t ids[3];
     for (int k = 0; k < 3; ++k) {
         const Vertex& x = buffer.vertex(vertex[k]);
         if ((x.flags & kFrozen) == 0) buffer.freeze(vertex[k], next_id++);
-        xyz[3 * k] = x.pos[0]; xyz[3 * k + 1] = x.pos[1]; xyz[3 * k + 2] = x.pos[2];
+        xyz[3 * k] = x.pos[0];
+        xyz[3 * k + 1] = x.pos[1];
+        xyz[3 * k + 2] = x.pos[2];
         ids[k] = x.id;
     }
     output.emit(xyz, ids, out);

@@ -49,12 +49,11 @@ bool place_vertex(HalfEdgeBuffer& buffer, uint32_t v);
 // Writes face f: places and freezes its vertices (ids from `next_id`), emits it, marks its
 // neighbours' edges as P_out and removes it from the buffer. Returns how many of its
 // vertices moved to their quadric minimum.
-int write_face(HalfEdgeBuffer& buffer, uint32_t f, uint64_t& next_id, TriangleOutput& output,
-                const Emit& out);
+int write_face(HalfEdgeBuffer& buffer, uint32_t f, uint64_t& next_id, TriangleOutput& output, const Emit& out);
 
 // Passes a triangle whose corners welded together (degenerate) straight through: its
 // vertices are frozen where they are (they are on P_in) and it is emitted as read.
-void pass_through(HalfEdgeBuffer& buffer, const uint32_t vertex[3], uint64_t& next_id,
-                  TriangleOutput& output, const Emit& out);
+void pass_through(HalfEdgeBuffer& buffer, const uint32_t vertex[3], uint64_t& next_id, TriangleOutput& output,
+                  const Emit& out);
 
 }  // namespace meshstream::decimate

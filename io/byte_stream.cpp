@@ -4,19 +4,19 @@
 
 #include "io/error.hpp"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+#include <zlib.h>
 #include <atomic>
 #include <cassert>
 #include <cerrno>
 #include <csignal>
 #include <cstdlib>
 #include <cstring>
-#include <fcntl.h>
 #include <filesystem>
 #include <optional>
 #include <string_view>
-#include <sys/stat.h>
-#include <unistd.h>
-#include <zlib.h>
 
 namespace meshstream::io {
 namespace {
@@ -29,11 +29,16 @@ public:
         struct stat st;
         if (fstat(fd_, &st) == 0 && S_ISREG(st.st_mode)) size_ = static_cast<uint64_t>(st.st_size);
     }
-    ~FdInput() override { if (owned_) ::close(fd_); }
+    ~FdInput() override {
+        if (owned_) ::close(fd_);
+    }
     size_t read(void* dst, size_t n) override {
         for (;;) {
             ssize_t got = ::read(fd_, dst, n);
-            if (got >= 0) { pos_ += static_cast<uint64_t>(got); return static_cast<size_t>(got); }
+            if (got >= 0) {
+                pos_ += static_cast<uint64_t>(got);
+                return static_cast<size_t>(got);
+            }
             if (errno == EINTR) continue;
             throw Error(name_, pos_, 0, "read failed: " + errno_text());
         }
@@ -76,8 +81,7 @@ public:
                 size_t got = raw_->read(in_.get(), kInBytes);
                 if (got == 0) {
                     if (member_started_)
-                        throw Error(name_, compressed_, 0,
-                                    "gzip stream is truncated (ends inside a compressed block)");
+                        throw Error(name_, compressed_, 0, "gzip stream is truncated (ends inside a compressed block)");
                     done_ = true;  // clean end after a complete member
                     break;
                 }
@@ -279,7 +283,10 @@ size_t ByteSource::read(void* dst, size_t n) {
             // Large reads bypass the buffer.
             if (n - done >= kBufferBytes && !eof_) {
                 size_t got = raw_->read(out + done, n - done);
-                if (got == 0) { eof_ = true; break; }
+                if (got == 0) {
+                    eof_ = true;
+                    break;
+                }
                 done += got;
                 offset_ += got;
                 continue;
@@ -333,8 +340,10 @@ namespace {
 // The descriptor that /dev/stdout, /dev/stderr, /dev/fd/N or /proc/self/fd/N names, if open.
 std::optional<int> inherited_fd(const std::string& path) {
     int fd = -1;
-    if (path == "/dev/stdout") fd = 1;
-    else if (path == "/dev/stderr") fd = 2;
+    if (path == "/dev/stdout")
+        fd = 1;
+    else if (path == "/dev/stderr")
+        fd = 2;
     else
         for (std::string_view dir : {"/dev/fd/", "/proc/self/fd/"})
             if (path.starts_with(dir) && path.size() > dir.size() && path.size() - dir.size() <= 9 &&

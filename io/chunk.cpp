@@ -91,7 +91,7 @@ CornerLayout::CornerLayout(const Channels& channels) : channels_(channels) {
     if (channels_.color) {
         color_bytes_ = channels_.color->type == ScalarType::kUInt8    ? 1
                        : channels_.color->type == ScalarType::kUInt16 ? 2
-                                                                       : 4;
+                                                                      : 4;
         bytes_ += (channels_.color->alpha ? 4 : 3) * color_bytes_;
     }
     bytes_ += size_t(channels_.uv_sets) * 2 * sizeof(float);
@@ -247,8 +247,8 @@ void CornerLayout::unpack(const std::byte* src, TriangleChunk& chunk, size_t i, 
         scalars = scalars_small;
         if (ns > 16) scalars_big.resize(ns), scalars = scalars_big.data();
     }
-    unpack_values(src, has.normal ? chunk.normal_at(i) + 3 * k : nullptr, has.color ? chunk.color_at(i) + 4 * k : nullptr,
-                  uv, scalars);
+    unpack_values(src, has.normal ? chunk.normal_at(i) + 3 * k : nullptr,
+                  has.color ? chunk.color_at(i) + 4 * k : nullptr, uv, scalars);
     for (int s = 0; s < std::min(channels_.uv_sets, has.uv_sets); ++s)
         std::memcpy(chunk.uv_at(i, s) + 2 * k, uv + 2 * s, 2 * sizeof(float));
     if (want_scalars)

@@ -50,11 +50,11 @@ inline constexpr int kMaxUvSets = 4;
 
 struct Channels {
     // Per corner.
-    bool normal = false;               // 3 × float
-    std::optional<ColorFormat> color;  // 4 × float (RGBA)
-    int uv_sets = 0;                   // 2 × float each (TEXCOORD_0, ...), 0..kMaxUvSets
+    bool normal = false;                        // 3 × float
+    std::optional<ColorFormat> color;           // 4 × float (RGBA)
+    int uv_sets = 0;                            // 2 × float each (TEXCOORD_0, ...), 0..kMaxUvSets
     std::vector<ScalarChannel> vertex_scalars;  // 1 × double each
-    bool vertex_id = false;            // 1 × uint64; equal ids mean the same vertex
+    bool vertex_id = false;                     // 1 × uint64; equal ids mean the same vertex
     // Per triangle.
     bool material = false;                    // 1 × uint32, an index into the material table
     std::vector<ScalarChannel> face_scalars;  // 1 × double each
@@ -150,7 +150,9 @@ public:
     float* normal_at(size_t i) { return channels_.normal ? &normal_[9 * i] : nullptr; }
     float* color_at(size_t i) { return channels_.color ? &color_[12 * i] : nullptr; }  // 3 corners × RGBA
     // Set `set` of slot i: 3 corners × (u, v). Null when the chunk has fewer sets.
-    float* uv_at(size_t i, int set) { return set < channels_.uv_sets ? &uv_[(size_t(set) * capacity_ + i) * 6] : nullptr; }
+    float* uv_at(size_t i, int set) {
+        return set < channels_.uv_sets ? &uv_[(size_t(set) * capacity_ + i) * 6] : nullptr;
+    }
     // Vertex scalar channel `c` of slot i: 3 corners.
     double* vertex_scalar_at(size_t i, size_t c) { return &vscalar_[(c * capacity_ + i) * 3]; }
     double* face_scalar_at(size_t i, size_t c) { return &fscalar_[c * capacity_ + i]; }
@@ -208,11 +210,11 @@ private:
     std::vector<float> xyz_;
     std::vector<float> normal_;
     std::vector<float> color_;
-    std::vector<float> uv_;         // set-major: set s, slot i at (s × capacity + i) × 6
-    std::vector<double> vscalar_;   // channel-major, as uv_
+    std::vector<float> uv_;        // set-major: set s, slot i at (s × capacity + i) × 6
+    std::vector<double> vscalar_;  // channel-major, as uv_
     std::vector<uint64_t> id_;
     std::vector<uint32_t> material_;
-    std::vector<double> fscalar_;   // channel-major
+    std::vector<double> fscalar_;  // channel-major
 };
 
 inline void TriangleChunk::clear_channels(size_t i) {
@@ -222,7 +224,8 @@ inline void TriangleChunk::clear_channels(size_t i) {
         for (int k = 0; k < 3; ++k) c[4 * k] = c[4 * k + 1] = c[4 * k + 2] = 0.0f, c[4 * k + 3] = 1.0f;
     }
     for (int s = 0; s < channels_.uv_sets; ++s) std::memset(uv_at(i, s), 0, 6 * sizeof(float));
-    for (size_t c = 0; c < channels_.vertex_scalars.size(); ++c) vertex_scalar_at(i, c)[0] = vertex_scalar_at(i, c)[1] = vertex_scalar_at(i, c)[2] = 0.0;
+    for (size_t c = 0; c < channels_.vertex_scalars.size(); ++c)
+        vertex_scalar_at(i, c)[0] = vertex_scalar_at(i, c)[1] = vertex_scalar_at(i, c)[2] = 0.0;
     if (channels_.vertex_id) std::memset(&id_[3 * i], 0, 3 * sizeof(uint64_t));
     if (channels_.material) material_[i] = 0;
     for (size_t c = 0; c < channels_.face_scalars.size(); ++c) *face_scalar_at(i, c) = 0.0;

@@ -71,13 +71,41 @@ int add_attribute(draco::Mesh& mesh, draco::GeometryAttribute::Type kind, int co
             const double x = double(values[size_t{v} * components + c]) * scale;
             uint8_t* dst = &raw[size_t(c) * bytes];
             switch (type) {
-                case draco::DT_INT8: { int8_t y = to_component<int8_t>(x); std::memcpy(dst, &y, 1); break; }
-                case draco::DT_UINT8: { uint8_t y = to_component<uint8_t>(x); std::memcpy(dst, &y, 1); break; }
-                case draco::DT_INT16: { int16_t y = to_component<int16_t>(x); std::memcpy(dst, &y, 2); break; }
-                case draco::DT_UINT16: { uint16_t y = to_component<uint16_t>(x); std::memcpy(dst, &y, 2); break; }
-                case draco::DT_INT32: { int32_t y = to_component<int32_t>(x); std::memcpy(dst, &y, 4); break; }
-                case draco::DT_UINT32: { uint32_t y = to_component<uint32_t>(x); std::memcpy(dst, &y, 4); break; }
-                default: { float y = to_component<float>(x); std::memcpy(dst, &y, 4); break; }
+                case draco::DT_INT8: {
+                    int8_t y = to_component<int8_t>(x);
+                    std::memcpy(dst, &y, 1);
+                    break;
+                }
+                case draco::DT_UINT8: {
+                    uint8_t y = to_component<uint8_t>(x);
+                    std::memcpy(dst, &y, 1);
+                    break;
+                }
+                case draco::DT_INT16: {
+                    int16_t y = to_component<int16_t>(x);
+                    std::memcpy(dst, &y, 2);
+                    break;
+                }
+                case draco::DT_UINT16: {
+                    uint16_t y = to_component<uint16_t>(x);
+                    std::memcpy(dst, &y, 2);
+                    break;
+                }
+                case draco::DT_INT32: {
+                    int32_t y = to_component<int32_t>(x);
+                    std::memcpy(dst, &y, 4);
+                    break;
+                }
+                case draco::DT_UINT32: {
+                    uint32_t y = to_component<uint32_t>(x);
+                    std::memcpy(dst, &y, 4);
+                    break;
+                }
+                default: {
+                    float y = to_component<float>(x);
+                    std::memcpy(dst, &y, 4);
+                    break;
+                }
             }
         }
         mesh.attribute(id)->SetAttributeValue(draco::AttributeValueIndex(v), raw.data());
@@ -117,7 +145,8 @@ public:
         IndexedMesh mesh = indexer_.take();
         if (options_.strict)
             if (const int64_t t = first_repeated_vertex(mesh.indices); t >= 0)
-                throw Error(sink_.name(), "triangle " + std::to_string(t) + " has two corners at one vertex, which "
+                throw Error(sink_.name(), "triangle " + std::to_string(t) +
+                                              " has two corners at one vertex, which "
                                               "Draco's encoder drops (--strict)");
         std::vector<uint32_t> all(mesh.vertex_count());
         std::iota(all.begin(), all.end(), 0u);
@@ -132,7 +161,8 @@ public:
         DracoEncoded encoded = encode_draco(mesh.positions, mesh.indices, values, channels, options_, sink_.name());
         sink_.write(encoded.bytes.data(), encoded.bytes.size());
         notes_ = indexer_.notes();
-        for (std::string& note : draco_notes(encoded, mesh.triangle_count(), options_)) notes_.push_back(std::move(note));
+        for (std::string& note : draco_notes(encoded, mesh.triangle_count(), options_))
+            notes_.push_back(std::move(note));
     }
     std::vector<std::string> notes() const override {
         std::vector<std::string> out;
@@ -167,8 +197,9 @@ public:
         while (size_t n = source.read(buf, sizeof buf)) {
             bytes.insert(bytes.end(), buf, buf + n);
             if (bytes.size() > options.memory_budget_bytes)
-                throw Error(source.name(), "Draco decodes whole files in memory and this one is over the memory budget of " +
-                                               binary_size(options.memory_budget_bytes) + "; raise --memory");
+                throw Error(source.name(),
+                            "Draco decodes whole files in memory and this one is over the memory budget of " +
+                                binary_size(options.memory_budget_bytes) + "; raise --memory");
         }
         mesh_ = decode_draco(bytes, source.name());
         header_.triangle_count = mesh_.indices.size() / 3;
@@ -192,10 +223,11 @@ public:
             if (att.kind == DracoAttribute::kNormal && normal_ < 0 && att.components == 3) {
                 normal_ = int(a);
                 ch.normal = true;
-            } else if (att.kind == DracoAttribute::kColor && color_ < 0 && (att.components == 3 || att.components == 4)) {
+            } else if (att.kind == DracoAttribute::kColor && color_ < 0 &&
+                       (att.components == 3 || att.components == 4)) {
                 color_ = int(a);
                 ColorFormat f;
-                f.type = att.type == ScalarType::kUInt8 ? ScalarType::kUInt8
+                f.type = att.type == ScalarType::kUInt8    ? ScalarType::kUInt8
                          : att.type == ScalarType::kUInt16 ? ScalarType::kUInt16
                                                            : ScalarType::kFloat32;
                 f.alpha = att.components == 4;
@@ -246,7 +278,8 @@ public:
                     for (int c = 0; c < 2; ++c) chunk.uv_at(i, s)[2 * k + c] = float(value(uvs_[s], p, c));
                 for (size_t c = 0; c < scalar_map.size(); ++c)
                     if (scalar_map[c] >= 0)
-                        chunk.vertex_scalar_at(i, c)[k] = value(scalars_[scalar_map[c]].first, p, scalars_[scalar_map[c]].second);
+                        chunk.vertex_scalar_at(i, c)[k] =
+                            value(scalars_[scalar_map[c]].first, p, scalars_[scalar_map[c]].second);
             }
             ++next_;
         }
@@ -281,8 +314,15 @@ Channels drc_keep_channels(const Channels& in, const WriteOptions& options) {
 }  // namespace
 
 const Format kDracoFormat = {
-    "draco", "drc", "Draco compressed mesh (whole mesh in memory)", &probe_draco, &open_draco_reader, &open_draco_writer,
-    Format::kAlwaysDraco, nullptr, &drc_keep_channels,
+    "draco",
+    "drc",
+    "Draco compressed mesh (whole mesh in memory)",
+    &probe_draco,
+    &open_draco_reader,
+    &open_draco_writer,
+    Format::kAlwaysDraco,
+    nullptr,
+    &drc_keep_channels,
 };
 
 bool probe_draco(std::span<const std::byte> head, std::optional<uint64_t>) {
@@ -309,9 +349,9 @@ uint64_t draco_table_bytes(const WriteOptions& options) {
     const uint64_t per_value = options.draco_level < 9 ? 4 : options.draco_position_bits < 30 ? 12 : 24;
     const Channels& ch = options.channels;
     const bool float_colors = ch.color && ch.color->type == ScalarType::kFloat32;
-    const bool float_scalars = std::any_of(ch.vertex_scalars.begin(), ch.vertex_scalars.end(), [](const ScalarChannel& s) {
-        return s.type == ScalarType::kFloat32 || s.type == ScalarType::kFloat64;
-    });
+    const bool float_scalars = std::any_of(
+        ch.vertex_scalars.begin(), ch.vertex_scalars.end(),
+        [](const ScalarChannel& s) { return s.type == ScalarType::kFloat32 || s.type == ScalarType::kFloat64; });
     return per_value * (uint64_t{1} << options.draco_position_bits) +
            (options.normals || ch.normal ? 4 * (uint64_t{1} << options.draco_normal_bits) : 0) +
            (ch.uv_sets > 0 ? 4 * (uint64_t{1} << options.draco_texcoord_bits) : 0) +
@@ -345,15 +385,15 @@ void check_draco_settings(const std::string& file, const WriteOptions& options) 
         throw Error(file, "--draco-cl must be 0-10, got " + std::to_string(options.draco_level));
     const uint64_t tables = draco_table_bytes(options);
     if (tables <= options.memory_budget_bytes) return;
-    throw Error(file, "Draco's coding tables for --draco-qp " + std::to_string(options.draco_position_bits) +
-                          (options.normals || options.channels.normal
-                               ? " and --draco-qn " + std::to_string(options.draco_normal_bits)
-                               : "") +
-                          " at --draco-cl " + std::to_string(options.draco_level) + " take about " +
-                          binary_size(tables) + " (they double with each bit), over the memory budget of " +
-                          binary_size(options.memory_budget_bytes) +
-                          ": give fewer bits (float positions hold 24) or --memory " +
-                          std::to_string((tables >> 20) + 1) + "M or more");
+    throw Error(
+        file,
+        "Draco's coding tables for --draco-qp " + std::to_string(options.draco_position_bits) +
+            (options.normals || options.channels.normal ? " and --draco-qn " + std::to_string(options.draco_normal_bits)
+                                                        : "") +
+            " at --draco-cl " + std::to_string(options.draco_level) + " take about " + binary_size(tables) +
+            " (they double with each bit), over the memory budget of " + binary_size(options.memory_budget_bytes) +
+            ": give fewer bits (float positions hold 24) or --memory " + std::to_string((tables >> 20) + 1) +
+            "M or more");
 }
 
 int64_t first_repeated_vertex(const std::vector<uint32_t>& indices) {
@@ -393,8 +433,9 @@ DracoEncoded encode_draco(const std::vector<float>& positions, const std::vector
         for (int a = 0; a < 3; ++a) range = std::max(range, box.max[a] - box.min[a]);
         const float max_q = float((uint32_t{1} << options.draco_position_bits) - 1);
         if (!std::isfinite(range))
-            throw Error(file_name, "the mesh is wider along an axis than a float can hold (3.4e38): Draco cannot "
-                                   "quantize it; write it without Draco (--compress none for glTF, or another format)");
+            throw Error(file_name,
+                        "the mesh is wider along an axis than a float can hold (3.4e38): Draco cannot "
+                        "quantize it; write it without Draco (--compress none for glTF, or another format)");
         if (range > 0 && !std::isfinite(max_q / range)) {
             std::string extent;
             append_number(extent, range);
@@ -406,8 +447,8 @@ DracoEncoded encode_draco(const std::vector<float>& positions, const std::vector
     const size_t n = positions.size() / 3;
     draco::Mesh dm;
     dm.set_num_points(static_cast<uint32_t>(n));
-    const int pos_att =
-        add_attribute(dm, draco::GeometryAttribute::POSITION, 3, draco::DT_FLOAT32, false, std::span<const float>(positions));
+    const int pos_att = add_attribute(dm, draco::GeometryAttribute::POSITION, 3, draco::DT_FLOAT32, false,
+                                      std::span<const float>(positions));
     DracoEncoded out;
     std::vector<int> atts;  // attribute ids of what follows, to read back their unique ids
     int nrm_att = -1, col_att = -1;
@@ -429,13 +470,14 @@ DracoEncoded encode_draco(const std::vector<float>& positions, const std::vector
         std::vector<float> uv(values.uvs[s]);
         if (flip_v)
             for (size_t v = 0; v < n; ++v) uv[2 * v + 1] = 1.0f - uv[2 * v + 1];
-        uv_atts.push_back(
-            add_attribute(dm, draco::GeometryAttribute::TEX_COORD, 2, draco::DT_FLOAT32, false, std::span<const float>(uv)));
+        uv_atts.push_back(add_attribute(dm, draco::GeometryAttribute::TEX_COORD, 2, draco::DT_FLOAT32, false,
+                                        std::span<const float>(uv)));
     }
     std::vector<int> generic_atts;
     for (size_t c = 0; c < channels.vertex_scalars.size(); ++c) {
-        const int id = add_attribute(dm, draco::GeometryAttribute::GENERIC, 1, draco_type(channels.vertex_scalars[c].type),
-                                     false, std::span<const double>(values.scalars[c]));
+        const int id =
+            add_attribute(dm, draco::GeometryAttribute::GENERIC, 1, draco_type(channels.vertex_scalars[c].type), false,
+                          std::span<const double>(values.scalars[c]));
         // Draco's tools name generic attributes by a "name" metadata entry.
         auto metadata = std::make_unique<draco::AttributeMetadata>();
         metadata->AddEntryString("name", channels.vertex_scalars[c].name);
@@ -536,12 +578,36 @@ double component_value(const uint8_t* p, draco::DataType type) {
     switch (type) {
         case draco::DT_INT8: return double(int8_t(p[0]));
         case draco::DT_UINT8: return double(p[0]);
-        case draco::DT_INT16: { int16_t v; std::memcpy(&v, p, 2); return v; }
-        case draco::DT_UINT16: { uint16_t v; std::memcpy(&v, p, 2); return v; }
-        case draco::DT_INT32: { int32_t v; std::memcpy(&v, p, 4); return v; }
-        case draco::DT_UINT32: { uint32_t v; std::memcpy(&v, p, 4); return v; }
-        case draco::DT_FLOAT32: { float v; std::memcpy(&v, p, 4); return v; }
-        case draco::DT_FLOAT64: { double v; std::memcpy(&v, p, 8); return v; }
+        case draco::DT_INT16: {
+            int16_t v;
+            std::memcpy(&v, p, 2);
+            return v;
+        }
+        case draco::DT_UINT16: {
+            uint16_t v;
+            std::memcpy(&v, p, 2);
+            return v;
+        }
+        case draco::DT_INT32: {
+            int32_t v;
+            std::memcpy(&v, p, 4);
+            return v;
+        }
+        case draco::DT_UINT32: {
+            uint32_t v;
+            std::memcpy(&v, p, 4);
+            return v;
+        }
+        case draco::DT_FLOAT32: {
+            float v;
+            std::memcpy(&v, p, 4);
+            return v;
+        }
+        case draco::DT_FLOAT64: {
+            double v;
+            std::memcpy(&v, p, 8);
+            return v;
+        }
         default: return 0;
     }
 }
@@ -556,9 +622,10 @@ DracoDecoded decode_draco(std::span<const std::byte> bytes, const std::string& f
     if (!bytes.empty() && bytes.size() < 5 && std::memcmp(bytes.data(), kMagic, bytes.size()) == 0)
         throw Error(file_name, base_offset + bytes.size(), 0, "bitstream ends inside its 5-byte magic 'DRACO'");
     if (bytes.size() < 5 || std::memcmp(bytes.data(), kMagic, 5) != 0)
-        throw Error(file_name, base_offset, 0, "not a Draco bitstream (expected magic 'DRACO', found " +
-                                                   quote_token({reinterpret_cast<const char*>(bytes.data()),
-                                                                std::min<size_t>(bytes.size(), 5)}) + ")");
+        throw Error(file_name, base_offset, 0,
+                    "not a Draco bitstream (expected magic 'DRACO', found " +
+                        quote_token({reinterpret_cast<const char*>(bytes.data()), std::min<size_t>(bytes.size(), 5)}) +
+                        ")");
     draco::DracoHeader header;
     {
         draco::DecoderBuffer header_buffer;
@@ -585,8 +652,9 @@ DracoDecoded decode_draco(std::span<const std::byte> bytes, const std::string& f
         throw Error(file_name, base_offset, 0, "Draco decoding failed: " + decoded.status().error_msg_string());
     std::unique_ptr<draco::Mesh> mesh = std::move(decoded).value();
 
-    const draco::PointAttribute* pos = position_id >= 0 ? mesh->GetAttributeByUniqueId(static_cast<uint32_t>(position_id))
-                                                        : mesh->GetNamedAttribute(draco::GeometryAttribute::POSITION);
+    const draco::PointAttribute* pos = position_id >= 0
+                                           ? mesh->GetAttributeByUniqueId(static_cast<uint32_t>(position_id))
+                                           : mesh->GetNamedAttribute(draco::GeometryAttribute::POSITION);
     if (!pos)
         throw Error(file_name, base_offset, 0,
                     position_id >= 0 ? "Draco data has no attribute with id " + std::to_string(position_id)
@@ -604,7 +672,8 @@ DracoDecoded decode_draco(std::span<const std::byte> bytes, const std::string& f
         if (!q.InitFromAttribute(*pos)) throw Error(file_name, base_offset, 0, "bad Draco quantization data");
         out.position_bits = q.quantization_bits();
         dequantized = std::make_unique<draco::PointAttribute>();
-        dequantized->Init(draco::GeometryAttribute::POSITION, pos->num_components(), draco::DT_FLOAT32, false, pos->size());
+        dequantized->Init(draco::GeometryAttribute::POSITION, pos->num_components(), draco::DT_FLOAT32, false,
+                          pos->size());
         if (!q.InverseTransformAttribute(*pos, dequantized.get()))
             throw Error(file_name, base_offset, 0, "Draco position dequantization failed");
         values = dequantized.get();
@@ -636,7 +705,8 @@ DracoDecoded decode_draco(std::span<const std::byte> bytes, const std::string& f
         d.unique_id = static_cast<int>(att->unique_id());
         d.components = att->num_components();
         d.type = scalar_type_of(att->data_type());
-        if (const draco::AttributeMetadata* md = mesh->GetAttributeMetadataByAttributeId(a)) md->GetEntryString("name", &d.name);
+        if (const draco::AttributeMetadata* md = mesh->GetAttributeMetadataByAttributeId(a))
+            md->GetEntryString("name", &d.name);
         const size_t bytes_per = draco::DataTypeLength(att->data_type());
         if (d.components < 1 || bytes_per == 0 || d.kind == DracoAttribute::kOther) {
             out.attributes.push_back(std::move(d));
@@ -650,8 +720,9 @@ DracoDecoded decode_draco(std::span<const std::byte> bytes, const std::string& f
         for (uint32_t p = 0; p < points; ++p) {
             const draco::AttributeValueIndex avi = att->mapped_index(draco::PointIndex(p));
             if (avi.value() >= att->size())
-                throw Error(file_name, base_offset, 0, "Draco " + std::string(kind_name(d.kind)) + " attribute of point " +
-                                                           std::to_string(p) + " is unreadable");
+                throw Error(file_name, base_offset, 0,
+                            "Draco " + std::string(kind_name(d.kind)) + " attribute of point " + std::to_string(p) +
+                                " is unreadable");
             att->GetValue(avi, raw.data());
             for (int c = 0; c < d.components; ++c)
                 d.values[size_t{p} * d.components + c] = component_value(&raw[c * bytes_per], att->data_type()) / scale;
@@ -665,8 +736,9 @@ DracoDecoded decode_draco(std::span<const std::byte> bytes, const std::string& f
         for (int k = 0; k < 3; ++k) {
             uint32_t v = face[k].value();
             if (v >= points)
-                throw Error(file_name, base_offset, 0, "Draco face " + std::to_string(f) + " references point " +
-                                                           std::to_string(v) + " of " + std::to_string(points));
+                throw Error(file_name, base_offset, 0,
+                            "Draco face " + std::to_string(f) + " references point " + std::to_string(v) + " of " +
+                                std::to_string(points));
             out.indices[3 * size_t{f} + k] = v;
         }
     }

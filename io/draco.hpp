@@ -50,17 +50,17 @@ void check_draco_settings(const std::string& file, const WriteOptions& options);
 Channels draco_keep_channels(const Channels& in, const WriteOptions& options, bool gltf);
 
 struct DracoEncoded {
-    std::vector<char> bytes;       // the Draco bitstream
-    uint64_t point_count = 0;      // vertices the decoder will produce (Draco may split some)
-    uint64_t face_count = 0;       // triangles the decoder will produce
-    int position_id = -1;          // attribute unique ids (for KHR_draco_mesh_compression)
-    int normal_id = -1;            // -1 when absent
+    std::vector<char> bytes;   // the Draco bitstream
+    uint64_t point_count = 0;  // vertices the decoder will produce (Draco may split some)
+    uint64_t face_count = 0;   // triangles the decoder will produce
+    int position_id = -1;      // attribute unique ids (for KHR_draco_mesh_compression)
+    int normal_id = -1;        // -1 when absent
     int color_id = -1;
     std::vector<int> texcoord_ids;  // per uv set
     std::vector<int> generic_ids;   // per vertex scalar channel
-    Bounds decoded_bounds;         // exact min/max of the dequantized positions
-    uint64_t flattened = 0;        // triangles of nonzero area whose dequantized corners have none
-    uint64_t dropped = 0;          // triangles the encoder left out (a repeated vertex)
+    Bounds decoded_bounds;          // exact min/max of the dequantized positions
+    uint64_t flattened = 0;         // triangles of nonzero area whose dequantized corners have none
+    uint64_t dropped = 0;           // triangles the encoder left out (a repeated vertex)
 };
 // The notes a writer gives for what the encoding lost (flattened or dropped triangles), each
 // a sentence; empty when nothing was.
@@ -91,12 +91,12 @@ struct DracoAttribute {
 };
 
 struct DracoDecoded {
-    std::vector<float> positions;   // xyz per point, dequantized exactly as Draco does
-    std::vector<uint32_t> indices;  // 3 per face
+    std::vector<float> positions;            // xyz per point, dequantized exactly as Draco does
+    std::vector<uint32_t> indices;           // 3 per face
     std::vector<DracoAttribute> attributes;  // in the bitstream's order
     int version_major = 0, version_minor = 0;
     bool edgebreaker = false;
-    int position_bits = 0;          // 0: positions not quantized
+    int position_bits = 0;  // 0: positions not quantized
 };
 
 // Decodes a Draco mesh bitstream. `position_id` selects the position attribute by unique id

@@ -6,8 +6,7 @@
 namespace meshstream::io {
 namespace {
 
-std::string format_what(const std::string& file, uint64_t byte_offset, uint64_t line,
-                        const std::string& message) {
+std::string format_what(const std::string& file, uint64_t byte_offset, uint64_t line, const std::string& message) {
     std::string out = file.empty() ? std::string("<input>") : file;
     // Appended piece by piece: `"literal" + std::string` trips GCC 12's -Wrestrict here.
     if (line != 0) {
@@ -27,7 +26,10 @@ std::string format_what(const std::string& file, uint64_t byte_offset, uint64_t 
 
 Error::Error(std::string file, uint64_t byte_offset, uint64_t line, std::string message)
     : std::runtime_error(format_what(file, byte_offset, line, message)),
-      file_(std::move(file)), byte_offset_(byte_offset), line_(line), message_(std::move(message)) {}
+      file_(std::move(file)),
+      byte_offset_(byte_offset),
+      line_(line),
+      message_(std::move(message)) {}
 
 Error::Error(std::string file, std::string message) : Error(std::move(file), kNoOffset, 0, std::move(message)) {}
 
@@ -35,7 +37,10 @@ std::string printable(std::string_view text, size_t max_chars) {
     std::string out;
     size_t n = 0;
     for (char c : text) {
-        if (++n > max_chars) { out += "..."; break; }
+        if (++n > max_chars) {
+            out += "...";
+            break;
+        }
         unsigned char u = static_cast<unsigned char>(c);
         if (u >= 0x20 && u < 0x7f) {
             out += c;

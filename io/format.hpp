@@ -66,14 +66,14 @@ struct MeshHeader {
     // Where the count is not stated up front: about this many (PLY: its faces, each counted as
     // one triangle, as the header cannot tell polygons). A hint, e.g. for which mesh to hold.
     std::optional<uint64_t> triangle_estimate;
-    std::optional<uint64_t> vertex_count;    // indexed formats
-    std::optional<int> sorted_axis;          // 0,1,2 when the file says it is sorted (meshstream sort)
-    Channels channels;                       // channels the reader will fill
+    std::optional<uint64_t> vertex_count;  // indexed formats
+    std::optional<int> sorted_axis;        // 0,1,2 when the file says it is sorted (meshstream sort)
+    Channels channels;                     // channels the reader will fill
     // The table the material channel indexes. A reader may append to it while reading (OBJ: a
     // `usemtl` name that no MTL file defines, met after the first face); entries already in it
     // never change, so the table as it stands after the last next() holds every index read.
     std::vector<Material> materials;
-    std::string variant;                     // e.g. "binary", "ascii", "binary_big_endian"
+    std::string variant;                                     // e.g. "binary", "ascii", "binary_big_endian"
     std::vector<std::pair<std::string, std::string>> notes;  // extra facts for `info`
     // Files besides the input that the reader read (a .gltf's buffer files, an OBJ's .mtl and
     // textures), so the commands can refuse an output that would overwrite one of them.
@@ -178,8 +178,8 @@ struct WriteOptions {
     // count, decimate's target): whole-mesh writers (Draco, glTF) then refuse a memory budget
     // that cannot hold them at once, instead of failing part way through a long run.
     std::optional<uint64_t> expected_triangle_count;
-    std::optional<int> sorted_axis;          // recorded in the header when the format has room
-    std::string comment;                     // free text for formats with comments
+    std::optional<int> sorted_axis;  // recorded in the header when the format has room
+    std::string comment;             // free text for formats with comments
     // --strict: a writer that cannot hold something it is given (a degenerate triangle Draco
     // drops, a NaN no quantization holds) throws io::Error instead of a counted note.
     bool strict = false;
@@ -213,8 +213,8 @@ struct Format {
     std::unique_ptr<Writer> (*open_writer)(ByteSink& sink, const WriteOptions& options);
     // What the writer keeps or does beyond positions, for the commands' checks and warnings.
     enum Trait : uint8_t {
-        kAlwaysDraco = 2,      // Draco-compressed (reorders triangles; takes --draco-* and --normals)
-        kDracoUnlessOff = 4,   // the same unless --compress meshopt|none (glTF; takes --compress)
+        kAlwaysDraco = 2,     // Draco-compressed (reorders triangles; takes --draco-* and --normals)
+        kDracoUnlessOff = 4,  // the same unless --compress meshopt|none (glTF; takes --compress)
     };
     uint8_t traits = 0;
     // For formats without magic bytes: a weaker test, tried only when no probe and no
@@ -272,7 +272,7 @@ struct Output {
 const Format& output_format(const std::string& path, std::string_view to);
 // Opens `path` ("-" = stdout) as format `to` (empty: by extension). gzip_level applies when
 // the path ends in ".gz" (or always when force_gzip). Throws io::Error.
-Output open_output(const std::string& path, std::string_view to, const WriteOptions& options,
-                   int gzip_level = 6, bool force_gzip = false);
+Output open_output(const std::string& path, std::string_view to, const WriteOptions& options, int gzip_level = 6,
+                   bool force_gzip = false);
 
 }  // namespace meshstream::io

@@ -11,13 +11,27 @@ namespace meshstream::io {
 using gltf_detail::kGlbMagic;
 
 const Format kGlbFormat = {
-    "glb", "glb", "binary glTF 2.0 (Draco by default; whole mesh in memory)", &probe_glb, &gltf_detail::open_gltf_reader,
-    &gltf_detail::open_glb_writer, Format::kDracoUnlessOff, nullptr, &gltf_detail::gltf_keep_channels,
+    "glb",
+    "glb",
+    "binary glTF 2.0 (Draco by default; whole mesh in memory)",
+    &probe_glb,
+    &gltf_detail::open_gltf_reader,
+    &gltf_detail::open_glb_writer,
+    Format::kDracoUnlessOff,
+    nullptr,
+    &gltf_detail::gltf_keep_channels,
 };
 
 const Format kGltfFormat = {
-    "gltf", "gltf", "glTF 2.0 JSON + .bin (Draco by default; whole mesh in memory)", &probe_gltf_json, &gltf_detail::open_gltf_reader,
-    &gltf_detail::open_gltf_writer, Format::kDracoUnlessOff, nullptr, &gltf_detail::gltf_keep_channels,
+    "gltf",
+    "gltf",
+    "glTF 2.0 JSON + .bin (Draco by default; whole mesh in memory)",
+    &probe_gltf_json,
+    &gltf_detail::open_gltf_reader,
+    &gltf_detail::open_gltf_writer,
+    Format::kDracoUnlessOff,
+    nullptr,
+    &gltf_detail::gltf_keep_channels,
     &gltf_detail::gltf_side_files,
 };
 

@@ -34,9 +34,9 @@
 // materials (name, base colour factor, base colour texture with its image bytes), and a
 // vertex id per (instance, primitive, vertex); a channel some primitives lack gets its default
 // there (normal 0, colour opaque white, uv 0; glTF's default material). Images are kept as bytes,
-// never decoded: the whole document is held anyway, external images on top. TRIANGLES, TRIANGLE_STRIP and TRIANGLE_FAN are read (with or without indices,
-// Draco or plain accessors, KHR_mesh_quantization's integer positions, EXT_meshopt_compression
-// bufferViews decoded with libmeshoptimizer and its filters); points and lines, sparse
+// never decoded: the whole document is held anyway, external images on top. TRIANGLES, TRIANGLE_STRIP and TRIANGLE_FAN
+// are read (with or without indices, Draco or plain accessors, KHR_mesh_quantization's integer positions,
+// EXT_meshopt_compression bufferViews decoded with libmeshoptimizer and its filters); points and lines, sparse
 // accessors and other required extensions are refused with an io::Error naming the file and
 // the mesh, primitive or extension, as are compressed bufferViews whose parameters the spec
 // forbids or whose streams do not decode; JSON nested deeper than 512 arrays and objects, or

@@ -13,9 +13,10 @@
 #endif
 
 #include <meshoptimizer.h>
-#include <nlohmann/json.hpp>
 #include <tiny_gltf.h>
+#include <nlohmann/json.hpp>
 
+#include <sys/stat.h>
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -24,7 +25,6 @@
 #include <memory>
 #include <set>
 #include <string_view>
-#include <sys/stat.h>
 
 namespace meshstream::io::gltf_detail {
 namespace {
@@ -121,9 +121,9 @@ struct AccessorView {
 struct PrimitiveGeometry {
     std::vector<float> positions;
     std::vector<uint32_t> triangles;
-    std::vector<float> normals;               // 3 per vertex
-    std::vector<float> colors;                // 4 per vertex, RGBA 0..1
-    std::vector<std::vector<float>> uvs;      // per set: 2 per vertex, glTF's (v down)
+    std::vector<float> normals;           // 3 per vertex
+    std::vector<float> colors;            // 4 per vertex, RGBA 0..1
+    std::vector<std::vector<float>> uvs;  // per set: 2 per vertex, glTF's (v down)
 };
 
 struct Instance {
@@ -157,9 +157,9 @@ void local_matrix(const tinygltf::Node& node, double* m) {
         for (int i = 0; i < 3; ++i) s[i] = node.scale[i];
     const double x = q[0], y = q[1], z = q[2], w = q[3];
     // Rotation matrix of the unit quaternion (x, y, z, w), columns scaled: M = T · R · S.
-    const double r[9] = {1 - 2 * (y * y + z * z), 2 * (x * y + z * w), 2 * (x * z - y * w),
-                         2 * (x * y - z * w), 1 - 2 * (x * x + z * z), 2 * (y * z + x * w),
-                         2 * (x * z + y * w), 2 * (y * z - x * w), 1 - 2 * (x * x + y * y)};
+    const double r[9] = {1 - 2 * (y * y + z * z), 2 * (x * y + z * w),     2 * (x * z - y * w),
+                         2 * (x * y - z * w),     1 - 2 * (x * x + z * z), 2 * (y * z + x * w),
+                         2 * (x * z + y * w),     2 * (y * z - x * w),     1 - 2 * (x * x + y * y)};
     for (int c = 0; c < 3; ++c) {
         for (int row = 0; row < 3; ++row) m[c * 4 + row] = r[c * 3 + row] * s[c];
         m[c * 4 + 3] = 0;
@@ -171,7 +171,8 @@ void local_matrix(const tinygltf::Node& node, double* m) {
 }
 
 double det3(const double* m) {
-    return m[0] * (m[5] * m[10] - m[9] * m[6]) - m[4] * (m[1] * m[10] - m[9] * m[2]) + m[8] * (m[1] * m[6] - m[5] * m[2]);
+    return m[0] * (m[5] * m[10] - m[9] * m[6]) - m[4] * (m[1] * m[10] - m[9] * m[2]) +
+           m[8] * (m[1] * m[6] - m[5] * m[2]);
 }
 
 // Required extensions listed in the raw JSON, for a clear refusal when tinygltf itself fails
@@ -209,30 +210,34 @@ void check_json_nesting(std::string_view json, uint64_t offset, const std::strin
     for (size_t i = 0; i < json.size(); ++i) {
         const char c = json[i];
         if (in_string) {
-            if (c == '\\') ++i;  // the escaped character, which may be a quote
-            else if (c == '"') in_string = false;
+            if (c == '\\')
+                ++i;  // the escaped character, which may be a quote
+            else if (c == '"')
+                in_string = false;
         } else if (c == '"') {
             in_string = true;
         } else if (c == '[' || c == '{') {
             if (++depth > kMaxJsonDepth)
-                throw Error(file, offset + i, 0, "JSON nested deeper than " + std::to_string(kMaxJsonDepth) +
-                                                     " arrays and objects (a glTF document needs about 10)");
+                throw Error(file, offset + i, 0,
+                            "JSON nested deeper than " + std::to_string(kMaxJsonDepth) +
+                                " arrays and objects (a glTF document needs about 10)");
         } else if ((c == ']' || c == '}') && depth > 0) {
             --depth;
         }
     }
     if (in_string || depth > 0)
-        throw Error(file, offset + json.size(), 0, std::string(container) + " ends inside the JSON document (" +
-                                                       (in_string ? "in a string, " : "") + std::to_string(depth) +
-                                                       (depth == 1 ? " array or object" : " arrays or objects") +
-                                                       " still open)");
+        throw Error(file, offset + json.size(), 0,
+                    std::string(container) + " ends inside the JSON document (" + (in_string ? "in a string, " : "") +
+                        std::to_string(depth) + (depth == 1 ? " array or object" : " arrays or objects") +
+                        " still open)");
 }
 
 // Whether some "uri" of the document names something other than a data: URI (a file).
 bool names_files(std::string_view json) {
     for (size_t at = json.find("\"uri\""); at != std::string_view::npos; at = json.find("\"uri\"", at + 5)) {
         size_t v = at + 5;
-        while (v < json.size() && (json[v] == ' ' || json[v] == '\t' || json[v] == '\r' || json[v] == '\n' || json[v] == ':'))
+        while (v < json.size() &&
+               (json[v] == ' ' || json[v] == '\t' || json[v] == '\r' || json[v] == '\n' || json[v] == ':'))
             ++v;
         if (json.substr(v, 6) != "\"data:") return true;
     }
@@ -299,8 +304,9 @@ public:
         while (size_t n = source.read(buf, sizeof buf)) {
             bytes.insert(bytes.end(), buf, buf + n);
             if (bytes.size() > options.memory_budget_bytes)
-                throw Error(name_, "glTF documents are read whole into memory and this one is over the memory budget of " +
-                                       binary_size(options.memory_budget_bytes) + "; raise --memory");
+                throw Error(name_,
+                            "glTF documents are read whole into memory and this one is over the memory budget of " +
+                                binary_size(options.memory_budget_bytes) + "; raise --memory");
         }
         // A cut inside the magic ("g" of "glTF") is a GLB cut short too: no JSON starts so.
         const bool glb = !bytes.empty() && std::memcmp(bytes.data(), kGlbMagic, std::min<size_t>(bytes.size(), 4)) == 0;
@@ -310,8 +316,9 @@ public:
             if (bytes.size() < 12) throw Error(name_, bytes.size(), 0, "file ends inside the 12-byte GLB header");
             uint32_t stated = get_u32(&bytes[8]);
             if (stated != bytes.size())
-                throw Error(name_, 8, 0, "GLB header states " + std::to_string(stated) + " bytes, the file holds " +
-                                             std::to_string(bytes.size()));
+                throw Error(name_, 8, 0,
+                            "GLB header states " + std::to_string(stated) + " bytes, the file holds " +
+                                std::to_string(bytes.size()));
         } else {
             size_t first = 0;
             while (first < bytes.size() && std::isspace(bytes[first])) ++first;
@@ -333,9 +340,11 @@ public:
         rewrite_for_tinygltf(bytes, glb);
         if (const uint64_t external = external_buffer_bytes(json_text(bytes, glb));
             bytes.size() + external > options.memory_budget_bytes)
-            throw Error(name_, "glTF documents are read whole into memory with their buffers: this one and its buffer "
-                               "files take " + binary_size(bytes.size() + external) + ", over the memory budget of " +
-                               binary_size(options.memory_budget_bytes) + "; raise --memory");
+            throw Error(name_,
+                        "glTF documents are read whole into memory with their buffers: this one and its buffer "
+                        "files take " +
+                            binary_size(bytes.size() + external) + ", over the memory budget of " +
+                            binary_size(options.memory_budget_bytes) + "; raise --memory");
 
         tinygltf::TinyGLTF gltf;
         ImageBytes images;
@@ -344,7 +353,8 @@ public:
         const std::string base_dir = parent_dir(source.name());  // "." for stdin: the current directory
         DocumentDir files{base_dir.ends_with('/') ? base_dir : base_dir + "/", {}, {}};
         gltf.SetFsCallbacks({&document_file_exists, &unexpanded_path, &read_document_file, nullptr, &files});
-        bool ok = glb ? gltf.LoadBinaryFromMemory(&model_, &err, &warn, bytes.data(), static_cast<unsigned>(bytes.size()), base_dir)
+        bool ok = glb ? gltf.LoadBinaryFromMemory(&model_, &err, &warn, bytes.data(),
+                                                  static_cast<unsigned>(bytes.size()), base_dir)
                       : gltf.LoadASCIIFromString(&model_, &err, &warn, reinterpret_cast<const char*>(bytes.data()),
                                                  static_cast<unsigned>(bytes.size()), base_dir);
         if (!ok) {
@@ -379,7 +389,8 @@ public:
         // Draco settings, from the first Draco primitive of the scene (decoded now, then cached).
         for (const Instance& inst : instances_) {
             const auto& prims = model_.meshes[inst.mesh].primitives;
-            auto it = std::find_if(prims.begin(), prims.end(), [this](const tinygltf::Primitive& p) { return is_draco(p); });
+            auto it =
+                std::find_if(prims.begin(), prims.end(), [this](const tinygltf::Primitive& p) { return is_draco(p); });
             if (it == prims.end()) continue;
             geometry(inst.mesh, static_cast<int>(it - prims.begin()));
             header_.notes.emplace_back("draco", draco_settings_);
@@ -400,7 +411,8 @@ private:
     [[noreturn]] void throw_unsupported_extension(const std::string& ext) const {
 #if !MESHSTREAM_WITH_DRACO
         if (ext == kDracoExtension)
-            throw Error(name_, "requires extension KHR_draco_mesh_compression, but this meshstream was built without Draco");
+            throw Error(name_,
+                        "requires extension KHR_draco_mesh_compression, but this meshstream was built without Draco");
 #endif
         throw Error(name_, "requires extension " + ext + ", which meshstream does not support");
     }
@@ -444,9 +456,9 @@ private:
     std::vector<Instance> instances_;
     std::map<std::pair<int, int>, std::shared_ptr<const PrimitiveGeometry>> draco_cache_;
     std::map<std::pair<int, int>, int> draco_indices_;  // (mesh, primitive) -> hidden indices accessor
-    std::string draco_settings_;  // of the first Draco primitive decoded, for `info`
-    std::optional<uint64_t> bin_offset_;  // file offset of a GLB's BIN chunk data (buffer 0)
-    std::set<int> fallback_buffers_;      // EXT_meshopt_compression fallback buffers, which hold no data
+    std::string draco_settings_;                        // of the first Draco primitive decoded, for `info`
+    std::optional<uint64_t> bin_offset_;                // file offset of a GLB's BIN chunk data (buffer 0)
+    std::set<int> fallback_buffers_;                    // EXT_meshopt_compression fallback buffers, which hold no data
     // EXT_meshopt_compression bufferViews decoded so far, and their bytes (held to --memory).
     mutable std::map<int, std::vector<unsigned char>> meshopt_views_;
     mutable uint64_t meshopt_bytes_ = 0;
@@ -552,7 +564,8 @@ namespace {
 
 // An unsigned integer member of an extension object, `fallback` when absent; nullopt when
 // present but not a non-negative integer.
-std::optional<uint64_t> unsigned_member(const tinygltf::Value& object, const char* key, std::optional<uint64_t> fallback) {
+std::optional<uint64_t> unsigned_member(const tinygltf::Value& object, const char* key,
+                                        std::optional<uint64_t> fallback) {
     if (!object.Has(key)) return fallback;
     const tinygltf::Value& v = object.Get(key);
     if (v.IsInt() && v.Get<int>() >= 0) return uint64_t(v.Get<int>());
@@ -576,23 +589,27 @@ const std::vector<unsigned char>& GltfReader::meshopt_view(int index, const std:
     const std::string at = what + ": bufferView " + std::to_string(index) + " (EXT_meshopt_compression)";
     if (!ext.IsObject()) throw Error(name_, at + " is not a JSON object");
     const auto buffer = unsigned_member(ext, "buffer", std::nullopt);
-    const auto offset = unsigned_member(ext, "byteOffset", 0), length = unsigned_member(ext, "byteLength", std::nullopt);
-    const auto stride = unsigned_member(ext, "byteStride", std::nullopt), count = unsigned_member(ext, "count", std::nullopt);
-    for (const auto& [value, key] : {std::pair{buffer, "buffer"}, std::pair{offset, "byteOffset"},
-                                     std::pair{length, "byteLength"}, std::pair{stride, "byteStride"},
-                                     std::pair{count, "count"}})
+    const auto offset = unsigned_member(ext, "byteOffset", 0),
+               length = unsigned_member(ext, "byteLength", std::nullopt);
+    const auto stride = unsigned_member(ext, "byteStride", std::nullopt),
+               count = unsigned_member(ext, "count", std::nullopt);
+    for (const auto& [value, key] :
+         {std::pair{buffer, "buffer"}, std::pair{offset, "byteOffset"}, std::pair{length, "byteLength"},
+          std::pair{stride, "byteStride"}, std::pair{count, "count"}})
         if (!value) throw Error(name_, at + " needs '" + key + "' as a non-negative integer");
     const std::string mode = ext.Get("mode").IsString() ? ext.Get("mode").Get<std::string>() : std::string();
-    const std::string filter = !ext.Has("filter") ? std::string("NONE")
+    const std::string filter = !ext.Has("filter")             ? std::string("NONE")
                                : ext.Get("filter").IsString() ? ext.Get("filter").Get<std::string>()
                                                               : std::string("?");
     if (mode != "ATTRIBUTES" && mode != "TRIANGLES" && mode != "INDICES")
         throw Error(name_, at + " has mode '" + printable(mode, 40) + "' (one of ATTRIBUTES, TRIANGLES, INDICES)");
     if (filter != "NONE" && filter != "OCTAHEDRAL" && filter != "QUATERNION" && filter != "EXPONENTIAL")
-        throw Error(name_, at + " has filter '" + printable(filter, 40) + "' (one of NONE, OCTAHEDRAL, QUATERNION, EXPONENTIAL)");
+        throw Error(name_, at + " has filter '" + printable(filter, 40) +
+                               "' (one of NONE, OCTAHEDRAL, QUATERNION, EXPONENTIAL)");
     // The spec's limits, which are also libmeshoptimizer's preconditions (asserted there).
     if (mode == "ATTRIBUTES" && (*stride == 0 || *stride > 256 || *stride % 4 != 0))
-        throw Error(name_, at + ": ATTRIBUTES with byteStride " + std::to_string(*stride) + " (must be a multiple of 4, 4-256)");
+        throw Error(name_, at + ": ATTRIBUTES with byteStride " + std::to_string(*stride) +
+                               " (must be a multiple of 4, 4-256)");
     if (mode != "ATTRIBUTES" && *stride != 2 && *stride != 4)
         throw Error(name_, at + ": " + mode + " with byteStride " + std::to_string(*stride) + " (must be 2 or 4)");
     if (mode == "TRIANGLES" && *count % 3 != 0)
@@ -607,8 +624,9 @@ const std::vector<unsigned char>& GltfReader::meshopt_view(int index, const std:
                                std::to_string(bv.byteStride));
     uint64_t decoded_bytes = 0;
     if (__builtin_mul_overflow(*count, *stride, &decoded_bytes) || decoded_bytes != bv.byteLength)
-        throw Error(name_, at + " decodes to count " + std::to_string(*count) + " x byteStride " + std::to_string(*stride) +
-                               " bytes, but its bufferView's byteLength is " + std::to_string(bv.byteLength));
+        throw Error(name_, at + " decodes to count " + std::to_string(*count) + " x byteStride " +
+                               std::to_string(*stride) + " bytes, but its bufferView's byteLength is " +
+                               std::to_string(bv.byteLength));
     if (*buffer >= model_.buffers.size())
         throw Error(name_, at + " refers to buffer " + std::to_string(*buffer) + ", which does not exist");
     if (fallback_buffers_.count(int(*buffer)))
@@ -624,26 +642,34 @@ const std::vector<unsigned char>& GltfReader::meshopt_view(int index, const std:
     std::vector<unsigned char> out(decoded_bytes);
     const unsigned char* src = data.data() + *offset;
     int rc = 0;
-    if (mode == "ATTRIBUTES") rc = meshopt_decodeVertexBuffer(out.data(), *count, *stride, src, *length);
-    else if (mode == "TRIANGLES") rc = meshopt_decodeIndexBuffer(out.data(), *count, *stride, src, *length);
-    else rc = meshopt_decodeIndexSequence(out.data(), *count, *stride, src, *length);
+    if (mode == "ATTRIBUTES")
+        rc = meshopt_decodeVertexBuffer(out.data(), *count, *stride, src, *length);
+    else if (mode == "TRIANGLES")
+        rc = meshopt_decodeIndexBuffer(out.data(), *count, *stride, src, *length);
+    else
+        rc = meshopt_decodeIndexSequence(out.data(), *count, *stride, src, *length);
     if (rc != 0) {
         // Where the compressed bytes start: in the file for a GLB's own buffer, else in the buffer.
         const bool in_file = *buffer == 0 && bin_offset_ && model_.buffers[0].uri.empty();
-        const std::string where = in_file ? std::string() : " (bytes " + std::to_string(*offset) + " to " +
-                                                                sum_text(*offset, *length) + " of buffer " +
-                                                                std::to_string(*buffer) + ")";
+        const std::string where = in_file ? std::string()
+                                          : " (bytes " + std::to_string(*offset) + " to " + sum_text(*offset, *length) +
+                                                " of buffer " + std::to_string(*buffer) + ")";
         throw Error(name_, in_file ? *bin_offset_ + *offset : 0, 0,
-                    at + where + ": the compressed " + (mode == "ATTRIBUTES" ? "vertex" : "index") + " data is corrupt or cut short (" +
-                        std::to_string(*length) + " bytes for " + std::to_string(*count) + " " +
-                        (mode == "ATTRIBUTES" ? "elements" : "indices") + " of " + std::to_string(*stride) +
-                        " bytes; libmeshoptimizer's " +
-                        (mode == "ATTRIBUTES" ? "meshopt_decodeVertexBuffer" : mode == "TRIANGLES" ? "meshopt_decodeIndexBuffer" : "meshopt_decodeIndexSequence") +
+                    at + where + ": the compressed " + (mode == "ATTRIBUTES" ? "vertex" : "index") +
+                        " data is corrupt or cut short (" + std::to_string(*length) + " bytes for " +
+                        std::to_string(*count) + " " + (mode == "ATTRIBUTES" ? "elements" : "indices") + " of " +
+                        std::to_string(*stride) + " bytes; libmeshoptimizer's " +
+                        (mode == "ATTRIBUTES"  ? "meshopt_decodeVertexBuffer"
+                         : mode == "TRIANGLES" ? "meshopt_decodeIndexBuffer"
+                                               : "meshopt_decodeIndexSequence") +
                         " returned " + std::to_string(rc) + ")");
     }
-    if (filter == "OCTAHEDRAL") meshopt_decodeFilterOct(out.data(), *count, *stride);
-    else if (filter == "QUATERNION") meshopt_decodeFilterQuat(out.data(), *count, *stride);
-    else if (filter == "EXPONENTIAL") meshopt_decodeFilterExp(out.data(), *count, *stride);
+    if (filter == "OCTAHEDRAL")
+        meshopt_decodeFilterOct(out.data(), *count, *stride);
+    else if (filter == "QUATERNION")
+        meshopt_decodeFilterQuat(out.data(), *count, *stride);
+    else if (filter == "EXPONENTIAL")
+        meshopt_decodeFilterExp(out.data(), *count, *stride);
     meshopt_bytes_ += decoded_bytes;
     return meshopt_views_.emplace(index, std::move(out)).first->second;
 }
@@ -691,14 +717,16 @@ void GltfReader::collect_instances() {
 void GltfReader::visit(int node, const double* parent, int depth) {
     if (node < 0 || node >= static_cast<int>(model_.nodes.size()))
         throw Error(name_, "scene refers to node " + std::to_string(node) + ", which does not exist");
-    if (depth > static_cast<int>(model_.nodes.size())) throw Error(name_, "node hierarchy has a cycle at node " + std::to_string(node));
+    if (depth > static_cast<int>(model_.nodes.size()))
+        throw Error(name_, "node hierarchy has a cycle at node " + std::to_string(node));
     const tinygltf::Node& n = model_.nodes[node];
     double local[16], world[16];
     local_matrix(n, local);
     mat_mul(parent, local, world);
     if (n.mesh >= 0) {
         if (n.mesh >= static_cast<int>(model_.meshes.size()))
-            throw Error(name_, "node " + std::to_string(node) + " refers to mesh " + std::to_string(n.mesh) + ", which does not exist");
+            throw Error(name_, "node " + std::to_string(node) + " refers to mesh " + std::to_string(n.mesh) +
+                                   ", which does not exist");
         Instance inst;
         // glTF 2.0 §3.7.3.3: a skinned mesh ignores its node's transform (only joints move it).
         // Joint transforms are not applied: the mesh is read in its bind pose, as stored.
@@ -763,8 +791,9 @@ void GltfReader::describe_channels(const ImageBytes& images) {
             if (ext != pbr.baseColorTexture.extensions.end() && ext->second.IsObject()) {
                 const tinygltf::Value& x = ext->second;
                 auto number = [](const tinygltf::Value& v, size_t k, double fallback) {
-                    return v.IsArray() && v.ArrayLen() > k && v.Get(int(k)).IsNumber() ? v.Get(int(k)).GetNumberAsDouble()
-                                                                                        : fallback;
+                    return v.IsArray() && v.ArrayLen() > k && v.Get(int(k)).IsNumber()
+                               ? v.Get(int(k)).GetNumberAsDouble()
+                               : fallback;
                 };
                 const double ox = number(x.Get("offset"), 0, 0), oy = number(x.Get("offset"), 1, 0);
                 const double sx = number(x.Get("scale"), 0, 1), sy = number(x.Get("scale"), 1, 1);
@@ -797,8 +826,10 @@ std::optional<Texture> GltfReader::texture_of(const tinygltf::TextureInfo& info,
     if (t.mime_type.empty()) {
         std::string lower = image.uri;
         for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-        if (lower.ends_with(".png")) t.mime_type = "image/png";
-        else if (lower.ends_with(".jpg") || lower.ends_with(".jpeg")) t.mime_type = "image/jpeg";
+        if (lower.ends_with(".png"))
+            t.mime_type = "image/png";
+        else if (lower.ends_with(".jpg") || lower.ends_with(".jpeg"))
+            t.mime_type = "image/jpeg";
     }
     if (image.bufferView >= 0) {
         if (image.bufferView >= int(model_.bufferViews.size())) return t;
@@ -839,7 +870,9 @@ uint64_t GltfReader::primitive_triangle_count(int mesh, int prim) const {
         throw Error(name_, where(mesh, prim) + " refers to accessor " + std::to_string(acc) + ", which does not exist");
     uint64_t n = model_.accessors[acc].count;
     if (mode == TINYGLTF_MODE_TRIANGLES) {
-        if (n % 3) throw Error(name_, where(mesh, prim) + ": TRIANGLES with " + std::to_string(n) + " vertices, not a multiple of 3");
+        if (n % 3)
+            throw Error(name_,
+                        where(mesh, prim) + ": TRIANGLES with " + std::to_string(n) + " vertices, not a multiple of 3");
         return n / 3;
     }
     return n >= 3 ? n - 2 : 0;
@@ -858,8 +891,8 @@ AccessorView GltfReader::view(int accessor, const std::string& what) const {
     v.normalized = a.normalized;
     size_t csize = component_size(a.componentType);
     if (csize == 0 || v.components == 0)
-        throw Error(name_, where_acc + " has unsupported component type " + std::to_string(a.componentType) + " / type " +
-                               std::to_string(a.type));
+        throw Error(name_, where_acc + " has unsupported component type " + std::to_string(a.componentType) +
+                               " / type " + std::to_string(a.type));
     if (a.bufferView < 0) {
         // All zeros: nothing is stored, so only the count bounds what is decoded (4 bytes a
         // component), and a 200-byte file could ask for 8 GB, or for 2^64 / 3 + 1 vertices,
@@ -871,7 +904,8 @@ AccessorView GltfReader::view(int accessor, const std::string& what) const {
         return v;
     }
     if (a.bufferView >= static_cast<int>(model_.bufferViews.size()))
-        throw Error(name_, where_acc + " refers to bufferView " + std::to_string(a.bufferView) + ", which does not exist");
+        throw Error(name_,
+                    where_acc + " refers to bufferView " + std::to_string(a.bufferView) + ", which does not exist");
     const tinygltf::BufferView& bv = model_.bufferViews[a.bufferView];
     const bool meshopt = bv.extensions.count(kMeshoptExtension) > 0;
     if (!meshopt && (bv.buffer < 0 || bv.buffer >= static_cast<int>(model_.buffers.size())))
@@ -880,7 +914,8 @@ AccessorView GltfReader::view(int accessor, const std::string& what) const {
         throw Error(name_, where_acc + ": bufferView " + std::to_string(a.bufferView) + " lies in buffer " +
                                std::to_string(bv.buffer) + ", an EXT_meshopt_compression fallback buffer without data");
     // A compressed view is decoded whole; its bytes then stand for the view (offset 0).
-    const std::vector<unsigned char>& data = meshopt ? meshopt_view(a.bufferView, where_acc) : model_.buffers[bv.buffer].data;
+    const std::vector<unsigned char>& data =
+        meshopt ? meshopt_view(a.bufferView, where_acc) : model_.buffers[bv.buffer].data;
     const size_t elem = csize * v.components;
     // glTF 2.0 §3.6.2.4: a stride spaces elements apart, it never overlaps them (the validator's
     // ACCESSOR_SMALL_BYTESTRIDE); byteStride 4 under VEC3 floats read each from the last one's y.
@@ -894,14 +929,15 @@ AccessorView GltfReader::view(int accessor, const std::string& what) const {
     const uint64_t view_offset = meshopt ? 0 : bv.byteOffset, view_length = bv.byteLength;
     if (view_offset > data.size() || view_length > data.size() - view_offset)
         throw Error(name_, where_acc + ": bufferView " + std::to_string(a.bufferView) + " ends at byte " +
-                               sum_text(view_offset, view_length) + ", past the end of buffer " + std::to_string(bv.buffer) +
-                               " (" + std::to_string(data.size()) + " bytes)");
+                               sum_text(view_offset, view_length) + ", past the end of buffer " +
+                               std::to_string(bv.buffer) + " (" + std::to_string(data.size()) + " bytes)");
     uint64_t end = a.byteOffset, span = 0;  // the end of the last element, from the view's start
-    const bool wraps = a.count > 0 && (__builtin_mul_overflow(uint64_t{a.count - 1}, uint64_t{v.stride}, &span) ||
-                                       __builtin_add_overflow(span, uint64_t{elem}, &span) ||
-                                       __builtin_add_overflow(end, span, &end));
+    const bool wraps =
+        a.count > 0 && (__builtin_mul_overflow(uint64_t{a.count - 1}, uint64_t{v.stride}, &span) ||
+                        __builtin_add_overflow(span, uint64_t{elem}, &span) || __builtin_add_overflow(end, span, &end));
     if (wraps || end > view_length)
-        throw Error(name_, where_acc + " reaches byte " + (wraps ? std::string("2^64 or more") : sum_text(view_offset, end)) +
+        throw Error(name_, where_acc + " reaches byte " +
+                               (wraps ? std::string("2^64 or more") : sum_text(view_offset, end)) +
                                " of a buffer view ending at " + std::to_string(view_offset + view_length));
     v.base = data.data() + view_offset + a.byteOffset;
     return v;
@@ -923,12 +959,14 @@ std::shared_ptr<const PrimitiveGeometry> GltfReader::geometry(int mesh, int prim
             throw Error(name_, at + ": KHR_draco_mesh_compression needs an integer bufferView and attributes.POSITION");
         int bvi = bvv.Get<int>();
         if (bvi < 0 || bvi >= static_cast<int>(model_.bufferViews.size()))
-            throw Error(name_, at + ": KHR_draco_mesh_compression refers to bufferView " + std::to_string(bvi) + ", which does not exist");
+            throw Error(name_, at + ": KHR_draco_mesh_compression refers to bufferView " + std::to_string(bvi) +
+                                   ", which does not exist");
         const tinygltf::BufferView& bv = model_.bufferViews[bvi];
         if (bv.buffer < 0 || bv.buffer >= static_cast<int>(model_.buffers.size()) ||
             bv.byteOffset > model_.buffers[bv.buffer].data.size() ||
             bv.byteLength > model_.buffers[bv.buffer].data.size() - bv.byteOffset)  // no sum to wrap
-            throw Error(name_, at + ": KHR_draco_mesh_compression bufferView " + std::to_string(bvi) + " lies outside its buffer");
+            throw Error(name_, at + ": KHR_draco_mesh_compression bufferView " + std::to_string(bvi) +
+                                   " lies outside its buffer");
         const auto* start = reinterpret_cast<const std::byte*>(model_.buffers[bv.buffer].data.data() + bv.byteOffset);
         DracoDecoded d;
         try {
@@ -938,13 +976,14 @@ std::shared_ptr<const PrimitiveGeometry> GltfReader::geometry(int mesh, int prim
         }
         uint64_t stated = primitive_triangle_count(mesh, prim);
         if (d.indices.size() / 3 != stated)
-            throw Error(name_, at + ": accessors state " + std::to_string(stated) + " triangles, the Draco data holds " +
-                                   std::to_string(d.indices.size() / 3));
+            throw Error(name_, at + ": accessors state " + std::to_string(stated) +
+                                   " triangles, the Draco data holds " + std::to_string(d.indices.size() / 3));
         if (draco_settings_.empty())
-            draco_settings_ = "bitstream " + std::to_string(d.version_major) + "." + std::to_string(d.version_minor) + ", " +
-                              (d.edgebreaker ? "edgebreaker" : "sequential") + " connectivity, positions " +
-                              (d.position_bits ? std::to_string(d.position_bits) + " bits" : std::string("not quantized")) +
-                              " (" + at + ")";
+            draco_settings_ =
+                "bitstream " + std::to_string(d.version_major) + "." + std::to_string(d.version_minor) + ", " +
+                (d.edgebreaker ? "edgebreaker" : "sequential") + " connectivity, positions " +
+                (d.position_bits ? std::to_string(d.position_bits) + " bits" : std::string("not quantized")) + " (" +
+                at + ")";
         geo->positions = std::move(d.positions);
         geo->triangles = std::move(d.indices);
         // The other attributes the extension maps (semantic -> Draco unique id), per point.
@@ -958,7 +997,8 @@ std::shared_ptr<const PrimitiveGeometry> GltfReader::geometry(int mesh, int prim
             if (it == d.attributes.end())
                 throw Error(name_, at + ": KHR_draco_mesh_compression maps " + semantic + " to Draco attribute " +
                                        std::to_string(id.Get<int>()) + ", which the Draco data does not hold");
-            if (it->components < min_components || it->components > max_components || it->values.size() != points * it->components)
+            if (it->components < min_components || it->components > max_components ||
+                it->values.size() != points * it->components)
                 throw Error(name_, at + ": the Draco attribute of " + semantic + " has " +
                                        std::to_string(it->components) + " components");
             out.assign(points * per, 1.0f);
@@ -978,9 +1018,10 @@ std::shared_ptr<const PrimitiveGeometry> GltfReader::geometry(int mesh, int prim
     AccessorView pos = view(p.attributes.at("POSITION"), at + " POSITION");
     if (pos.components != 3) throw Error(name_, at + " POSITION is not VEC3");
     if (pos.component_type != TINYGLTF_COMPONENT_TYPE_FLOAT) {
-        bool quantized = std::find(model_.extensionsUsed.begin(), model_.extensionsUsed.end(), kQuantizationExtension) !=
-                         model_.extensionsUsed.end();
-        bool integer = pos.component_type != TINYGLTF_COMPONENT_TYPE_INT && pos.component_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
+        bool quantized = std::find(model_.extensionsUsed.begin(), model_.extensionsUsed.end(),
+                                   kQuantizationExtension) != model_.extensionsUsed.end();
+        bool integer = pos.component_type != TINYGLTF_COMPONENT_TYPE_INT &&
+                       pos.component_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
         if (!quantized || !integer)
             throw Error(name_, at + " POSITION has component type " + std::to_string(pos.component_type) +
                                    " (allowed: FLOAT, or 8/16-bit integers with KHR_mesh_quantization)");
@@ -1007,8 +1048,8 @@ std::shared_ptr<const PrimitiveGeometry> GltfReader::geometry(int mesh, int prim
         for (size_t i = 0; i < idx.count; ++i) {
             double v = idx.get(i, 0);
             if (v >= static_cast<double>(pos.count))
-                throw Error(name_, at + " index " + std::to_string(i) + " is " + std::to_string(uint64_t(v)) + ", but POSITION has " +
-                                       std::to_string(pos.count) + " vertices");
+                throw Error(name_, at + " index " + std::to_string(i) + " is " + std::to_string(uint64_t(v)) +
+                                       ", but POSITION has " + std::to_string(pos.count) + " vertices");
             order[i] = static_cast<uint32_t>(v);
         }
     } else {
@@ -1084,7 +1125,8 @@ void GltfReader::load_current() {
     for (size_t i = 0; i < src.size(); i += 3) {
         double x = src[i], y = src[i + 1], z = src[i + 2];
         if (!morphed.empty()) x = morphed[i], y = morphed[i + 1], z = morphed[i + 2];
-        for (int r = 0; r < 3; ++r) world_[i + r] = static_cast<float>(m[r] * x + m[4 + r] * y + m[8 + r] * z + m[12 + r]);
+        for (int r = 0; r < 3; ++r)
+            world_[i + r] = static_cast<float>(m[r] * x + m[4 + r] * y + m[8 + r] * z + m[12 + r]);
     }
     // Normals go through the inverse transpose of the transform's 3 × 3 part: its cofactor
     // matrix, over the sign of its determinant (the length is normalised away).
@@ -1115,9 +1157,10 @@ void GltfReader::load_current() {
     // Texture coordinates: the material's KHR_texture_transform, then v flipped (glTF's v runs
     // down the image, the chunk's up).
     material_ = p.material >= 0 ? uint32_t(p.material) : default_material_;
-    const UvTransform* transform = p.material >= 0 && size_t(p.material) < uv_transforms_.size() && uv_transforms_[p.material]
-                                       ? &*uv_transforms_[p.material]
-                                       : nullptr;
+    const UvTransform* transform =
+        p.material >= 0 && size_t(p.material) < uv_transforms_.size() && uv_transforms_[p.material]
+            ? &*uv_transforms_[p.material]
+            : nullptr;
     chunk_uvs_.assign(current_->uvs.size(), {});
     for (size_t s = 0; s < current_->uvs.size(); ++s) {
         const auto& uv = current_->uvs[s];
@@ -1166,10 +1209,13 @@ bool GltfReader::next(TriangleChunk& chunk) {
                 const size_t x = v[k];
                 std::memcpy(dst + 3 * k, &world_[3 * x], 3 * sizeof(float));
                 if (normals) std::memcpy(chunk.normal_at(i) + 3 * k, &world_normals_[3 * x], 3 * sizeof(float));
-                if (colors) std::memcpy(chunk.color_at(i) + 4 * k, &current_->colors[4 * x], 4 * sizeof(float));
-                else if (want.color) std::fill_n(chunk.color_at(i) + 4 * k, 4, 1.0f);  // glTF: no colour is white
+                if (colors)
+                    std::memcpy(chunk.color_at(i) + 4 * k, &current_->colors[4 * x], 4 * sizeof(float));
+                else if (want.color)
+                    std::fill_n(chunk.color_at(i) + 4 * k, 4, 1.0f);  // glTF: no colour is white
                 for (int s = 0; s < uv_sets; ++s)
-                    if (!chunk_uvs_[s].empty()) std::memcpy(chunk.uv_at(i, s) + 2 * k, &chunk_uvs_[s][2 * x], 2 * sizeof(float));
+                    if (!chunk_uvs_[s].empty())
+                        std::memcpy(chunk.uv_at(i, s) + 2 * k, &chunk_uvs_[s][2 * x], 2 * sizeof(float));
                 if (want.vertex_id) chunk.id_at(i)[k] = id_base_ + x;
             }
             if (want.material) *chunk.material_at(i) = material_;
@@ -1182,7 +1228,6 @@ bool GltfReader::next(TriangleChunk& chunk) {
     }
     return !chunk.empty();
 }
-
 
 }  // namespace
 

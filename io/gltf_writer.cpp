@@ -17,6 +17,7 @@
 #include <meshoptimizer.h>
 #include <nlohmann/json.hpp>
 
+#include <sys/stat.h>
 #include <algorithm>
 #include <bit>
 #include <cctype>
@@ -27,7 +28,6 @@
 #include <memory>
 #include <numeric>
 #include <set>
-#include <sys/stat.h>
 
 #ifndef MESHSTREAM_VERSION
 #define MESHSTREAM_VERSION "unknown"
@@ -190,7 +190,7 @@ void pad4(std::vector<unsigned char>& bin) {
 
 // Bytes one vertex takes in the output buffer with these channels (plain accessors).
 uint64_t vertex_out_bytes(const Channels& ch, bool normals) {
-    const uint64_t color = !ch.color ? 0
+    const uint64_t color = !ch.color                                ? 0
                            : ch.color->type == ScalarType::kFloat32 ? (ch.color->alpha ? 16 : 12)
                            : ch.color->type == ScalarType::kUInt16  ? 8
                                                                     : 4;
@@ -203,8 +203,8 @@ struct Stream {
     int component_type = kFloat;
     const char* type = "VEC3";
     bool normalized = false;
-    size_t element_bytes = 12;  // the accessor's element
-    size_t stride = 12;         // a multiple of 4 (glTF's vertex attribute alignment)
+    size_t element_bytes = 12;     // the accessor's element
+    size_t stride = 12;            // a multiple of 4 (glTF's vertex attribute alignment)
     const char* filter = nullptr;  // meshopt filter, or null
     std::vector<unsigned char> data;
     Json min, max;  // POSITION's bounds
@@ -257,8 +257,12 @@ struct Document {
             packed.resize(meshopt_encodeVertexBuffer(packed.data(), packed.size(), data.data(), count, stride));
         }
         pad4(bin);
-        Json ext = {{"buffer", 0}, {"byteOffset", bin.size()}, {"byteLength", packed.size()}, {"byteStride", stride},
-                    {"mode", indices ? "TRIANGLES" : "ATTRIBUTES"}, {"count", count}};
+        Json ext = {{"buffer", 0},
+                    {"byteOffset", bin.size()},
+                    {"byteLength", packed.size()},
+                    {"byteStride", stride},
+                    {"mode", indices ? "TRIANGLES" : "ATTRIBUTES"},
+                    {"count", count}};
         if (filter) ext["filter"] = filter;
         bin.insert(bin.end(), packed.begin(), packed.end());
         fallback_bytes = (fallback_bytes + 3) / 4 * 4;
@@ -445,7 +449,8 @@ class GltfWriter final : public Writer {
     // values), the output buffer; meshopt adds its optimizer's tables and the compressed copy.
     static uint64_t plain_need(uint64_t vertices, uint64_t triangles, const WriteOptions& options) {
         const uint64_t out = buffer_bytes(vertices, triangles, options);
-        return indexed_mesh_bytes(vertices, triangles, options.channels) + 4 * std::bit_ceil(std::max<uint64_t>(2 * vertices, 1024)) +
+        return indexed_mesh_bytes(vertices, triangles, options.channels) +
+               4 * std::bit_ceil(std::max<uint64_t>(2 * vertices, 1024)) +
                vertices * (4 + 2 * uint64_t(CornerLayout(options.channels).bytes())) + triangles * 12 + out +
                (options.compression == WriteOptions::Compression::kMeshopt ? out + vertices * 16 + triangles * 12 : 0);
     }
@@ -468,7 +473,9 @@ class GltfWriter final : public Writer {
 
 public:
     GltfWriter(ByteSink& sink, const WriteOptions& options, bool binary)
-        : sink_(sink), options_(options), binary_(binary),
+        : sink_(sink),
+          options_(options),
+          binary_(binary),
           indexer_(sink.name(), "glTF", options.channels, options.strict) {
 #if !MESHSTREAM_WITH_DRACO
         if (options_.compression == WriteOptions::Compression::kDraco)
@@ -483,7 +490,9 @@ public:
         // own that a .bin could sit beside: the buffer goes inside, as a data URI.
         inline_buffer_ = !binary_ && sink.in_place();
         budget_check_up_front(sink.name(), options_, kWhy,
-                              draco_ ? draco_need : inline_buffer_ ? plain_stdout_need : plain_need);
+                              draco_           ? draco_need
+                              : inline_buffer_ ? plain_stdout_need
+                                               : plain_need);
         if (!binary_ && !inline_buffer_) check_side_files(sink.name(), side_files_of(sink.name(), options_));
     }
 
@@ -497,8 +506,8 @@ public:
             // The tables now, plus what finish() adds: the per-primitive copies, the output
             // buffer (and its compressed or base64 copies).
             const uint64_t out = buffer_bytes(v, f, options_);
-            need = indexer_.memory_bytes() + v * (4 + 2 * uint64_t(CornerLayout(options_.channels).bytes())) +
-                   f * 12 + out + (meshopt_ ? out + v * 16 + f * 12 : 0) + (inline_buffer_ ? 6 * out : 0);
+            need = indexer_.memory_bytes() + v * (4 + 2 * uint64_t(CornerLayout(options_.channels).bytes())) + f * 12 +
+                   out + (meshopt_ ? out + v * 16 + f * 12 : 0) + (inline_buffer_ ? 6 * out : 0);
         }
         budget_check(sink_.name(), options_, kWhy, indexer_.input_triangle_count(), need);
     }
@@ -552,13 +561,14 @@ void GltfWriter::add_materials(Document& doc, const std::vector<MeshPart>& parts
                 image["bufferView"] = doc.add_view(m.texture->bytes.data(), m.texture->bytes.size(), 0, 0);
                 image["mimeType"] = mime;
             } else if (inline_buffer_) {
-                image["uri"] = "data:" + mime + ";base64," +
-                               base64(reinterpret_cast<const unsigned char*>(m.texture->bytes.data()),
-                                      m.texture->bytes.size());
+                image["uri"] =
+                    "data:" + mime + ";base64," +
+                    base64(reinterpret_cast<const unsigned char*>(m.texture->bytes.data()), m.texture->bytes.size());
             } else {
                 image["uri"] = uri_encode(base_name(image_files[1 + file_of.at(part.material)]));
             }
-            if (!m.texture->uri.empty() && !m.texture->uri.starts_with("data:")) image["name"] = base_name(m.texture->uri);
+            if (!m.texture->uri.empty() && !m.texture->uri.starts_with("data:"))
+                image["name"] = base_name(m.texture->uri);
             doc.images.push_back(image);
             doc.textures.push_back({{"source", doc.images.size() - 1}});
             pbr["baseColorTexture"] = {{"index", doc.textures.size() - 1}};
@@ -574,10 +584,12 @@ void GltfWriter::add_materials(Document& doc, const std::vector<MeshPart>& parts
         material_json_[part.material] = int(doc.materials.size()) - 1;
     }
     if (unreadable)
-        notes_.push_back(std::to_string(unreadable) + " texture image(s) the input named could not be read: their "
+        notes_.push_back(std::to_string(unreadable) +
+                         " texture image(s) the input named could not be read: their "
                          "materials are written without them");
     if (unsupported)
-        notes_.push_back(std::to_string(unsupported) + " texture image(s) are neither PNG nor JPEG, which glTF holds: "
+        notes_.push_back(std::to_string(unsupported) +
+                         " texture image(s) are neither PNG nor JPEG, which glTF holds: "
                          "their materials are written without them");
 }
 
@@ -586,8 +598,8 @@ Json GltfWriter::plain_primitive(Document& doc, PartData& d, const Channels& ch,
     for (Stream& s : vertex_streams(d, ch, normals, meshopt_, q)) {
         const size_t n = d.vertex_count();
         const int view = meshopt_ ? doc.add_meshopt_view(s.data, n, s.stride, false, s.filter)
-                                  : doc.add_view(s.data.data(), s.data.size(), s.stride != s.element_bytes ? s.stride : 0,
-                                                 kArrayBuffer);
+                                  : doc.add_view(s.data.data(), s.data.size(),
+                                                 s.stride != s.element_bytes ? s.stride : 0, kArrayBuffer);
         Json accessor = {{"bufferView", view}, {"componentType", s.component_type}, {"count", n}, {"type", s.type}};
         if (s.normalized) accessor["normalized"] = true;
         if (!s.min.is_null()) {
@@ -607,15 +619,14 @@ Json GltfWriter::plain_primitive(Document& doc, PartData& d, const Channels& ch,
     const int view = meshopt_ ? doc.add_meshopt_view(idx, d.indices.size(), index_size, true, nullptr)
                               : doc.add_view(idx.data(), idx.size(), 0, kElementArrayBuffer);
     Json prim = {{"attributes", attributes}};
-    prim["indices"] = doc.add_accessor({{"bufferView", view}, {"componentType", component}, {"count", d.indices.size()},
-                                        {"type", "SCALAR"}});
+    prim["indices"] = doc.add_accessor(
+        {{"bufferView", view}, {"componentType", component}, {"count", d.indices.size()}, {"type", "SCALAR"}});
     return prim;
 }
 
 #if MESHSTREAM_WITH_DRACO
 Json GltfWriter::draco_primitive(Document& doc, PartData& d, const Channels& ch, DracoEncoded* sums) {
-    DracoEncoded enc =
-        encode_draco(d.positions, d.indices, d.values, ch, options_, sink_.name(), /*flip_v=*/true);
+    DracoEncoded enc = encode_draco(d.positions, d.indices, d.values, ch, options_, sink_.name(), /*flip_v=*/true);
     sums->dropped += enc.dropped;
     sums->flattened += enc.flattened;
     sums->face_count += enc.face_count;
@@ -638,7 +649,9 @@ Json GltfWriter::draco_primitive(Document& doc, PartData& d, const Channels& ch,
     if (enc.color_id >= 0) {
         const ScalarType t = ch.color->type;
         accessor("COLOR_0", enc.color_id,
-                 t == ScalarType::kUInt8 ? kUnsignedByte : t == ScalarType::kUInt16 ? kUnsignedShort : kFloat,
+                 t == ScalarType::kUInt8    ? kUnsignedByte
+                 : t == ScalarType::kUInt16 ? kUnsignedShort
+                                            : kFloat,
                  ch.color->alpha ? "VEC4" : "VEC3", t != ScalarType::kFloat32);
     }
     for (size_t s = 0; s < enc.texcoord_ids.size(); ++s)
@@ -663,7 +676,8 @@ void GltfWriter::finish_output() {
 #if MESHSTREAM_WITH_DRACO
         if (draco_ && options_.strict)
             if (const int64_t t = first_repeated_vertex(mesh.indices); t >= 0)
-                throw Error(sink_.name(), "triangle " + std::to_string(t) + " has two corners at one vertex, which "
+                throw Error(sink_.name(), "triangle " + std::to_string(t) +
+                                              " has two corners at one vertex, which "
                                               "Draco's encoder drops (--strict)");
 #endif
         // --normals adds smooth normals to a mesh that has none of its own.
@@ -681,8 +695,9 @@ void GltfWriter::finish_output() {
             float extent = 0;
             for (int a = 0; a < 3; ++a) q.offset[a] = b.min[a], extent = std::max(extent, b.max[a] - b.min[a]);
             if (!std::isfinite(extent))
-                throw Error(sink_.name(), "the mesh is wider along an axis than a float can hold (3.4e38): it cannot be "
-                                          "quantized for meshopt; write it with --compress none");
+                throw Error(sink_.name(),
+                            "the mesh is wider along an axis than a float can hold (3.4e38): it cannot be "
+                            "quantized for meshopt; write it with --compress none");
             q.scale = extent > 0 ? extent : 1.0f;
         }
 #if MESHSTREAM_WITH_DRACO
@@ -706,7 +721,8 @@ void GltfWriter::finish_output() {
         }
 #if MESHSTREAM_WITH_DRACO
         if (draco_)
-            for (std::string& note : draco_notes(sums, mesh.triangle_count(), options_)) notes_.push_back(std::move(note));
+            for (std::string& note : draco_notes(sums, mesh.triangle_count(), options_))
+                notes_.push_back(std::move(note));
 #endif
         Json node = {{"mesh", 0}};
         if (meshopt_) {
@@ -768,7 +784,8 @@ void GltfWriter::finish_output() {
                 }) == doc.images.end())
                 continue;  // a material no triangle uses
             sides.push_back(ByteSink::open(path));
-            sides.back()->write(options_.materials[m].texture->bytes.data(), options_.materials[m].texture->bytes.size());
+            sides.back()->write(options_.materials[m].texture->bytes.data(),
+                                options_.materials[m].texture->bytes.size());
         }
         sides.push_back(ByteSink::open(bin_path));
         sides.back()->write(doc.bin.data(), doc.bin.size());
@@ -805,7 +822,8 @@ std::string GltfWriter::document_json(const Document& doc, const Json& nodes, co
         buffers.push_back(buffer);
     }
     if (doc.fallback_bytes > 0)
-        buffers.push_back({{"byteLength", doc.fallback_bytes}, {"extensions", {{kMeshoptExtension, {{"fallback", true}}}}}});
+        buffers.push_back(
+            {{"byteLength", doc.fallback_bytes}, {"extensions", {{kMeshoptExtension, {{"fallback", true}}}}}});
     if (!buffers.empty()) out["buffers"] = buffers;
     return out.dump(binary_ ? -1 : 2) + (binary_ ? "" : "\n");
 }

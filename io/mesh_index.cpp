@@ -34,7 +34,8 @@ inline uint64_t hash_position(const float* p) {
 }
 
 inline bool same_position(const float* a, const float* b) {
-    return weld_bits(a[0]) == weld_bits(b[0]) && weld_bits(a[1]) == weld_bits(b[1]) && weld_bits(a[2]) == weld_bits(b[2]);
+    return weld_bits(a[0]) == weld_bits(b[0]) && weld_bits(a[1]) == weld_bits(b[1]) &&
+           weld_bits(a[2]) == weld_bits(b[2]);
 }
 
 // Non-finite values become 0; returns how many there were.
@@ -87,7 +88,8 @@ std::vector<float> IndexedMesh::smooth_normals() const {
             e1[a] = double(p1[a]) - p0[a];
             e2[a] = double(p2[a]) - p0[a];
         }
-        const double c[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
+        const double c[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                             e1[0] * e2[1] - e1[1] * e2[0]};
         for (int k = 0; k < 3; ++k) {
             double* dst = &sum[3 * size_t{group[indices[t + k]]}];
             dst[0] += c[0];
@@ -252,8 +254,10 @@ void MeshIndexer::add(const TriangleChunk& chunk) {
         for (int k = 0; k < 9; ++k) finite = finite && std::isfinite(p[k]);
         if (!finite) {
             if (strict_)
-                throw Error(file_name_, "triangle " + std::to_string(input_triangles_) + " has a NaN or infinite "
-                                            "coordinate, which " + format_ + " cannot store (--strict)");
+                throw Error(file_name_, "triangle " + std::to_string(input_triangles_) +
+                                            " has a NaN or infinite "
+                                            "coordinate, which " +
+                                            format_ + " cannot store (--strict)");
             ++non_finite_;
             continue;
         }

@@ -118,10 +118,10 @@ private:
     bool strict_;
     CornerLayout layout_;
     IndexedMesh mesh_;
-    std::vector<uint64_t> ids_;    // per vertex, in id mode
-    std::vector<uint32_t> slots_;  // hash table of vertex indices; kEmpty = free
+    std::vector<uint64_t> ids_;      // per vertex, in id mode
+    std::vector<uint32_t> slots_;    // hash table of vertex indices; kEmpty = free
     std::vector<std::byte> record_;  // scratch: one corner's record
-    int id_mode_ = -1;             // -1 undecided, 0 positions, 1 vertex ids
+    int id_mode_ = -1;               // -1 undecided, 0 positions, 1 vertex ids
     uint64_t input_triangles_ = 0;
     uint64_t non_finite_ = 0, non_finite_attributes_ = 0;
 };

@@ -356,8 +356,10 @@ private:
         if (*b == '+') ++b;
         float v = 0;
         auto [p, ec] = std::from_chars(b, e, v);
-        if (ec == std::errc::result_out_of_range) v = std::strtof(std::string(tok).c_str(), nullptr);
-        else if (ec != std::errc() || p != e) fail(std::string("expected ") + what + ", found " + quote_token(tok));
+        if (ec == std::errc::result_out_of_range)
+            v = std::strtof(std::string(tok).c_str(), nullptr);
+        else if (ec != std::errc() || p != e)
+            fail(std::string("expected ") + what + ", found " + quote_token(tok));
         return v;
     }
 
@@ -1200,7 +1202,8 @@ bool guess_obj(std::span<const std::byte> head) {
     }
     std::string_view text(reinterpret_cast<const char*>(head.data()), head.size());
     if (text.starts_with("\xEF\xBB\xBF")) text.remove_prefix(3);  // UTF-8 byte order mark
-    static constexpr std::string_view kKeywords[] = {"v", "vt", "vn", "vp", "f", "o", "g", "s", "usemtl", "mtllib", "l", "p"};
+    static constexpr std::string_view kKeywords[] = {"v", "vt", "vn",     "vp",     "f", "o",
+                                                     "g", "s",  "usemtl", "mtllib", "l", "p"};
     while (!text.empty()) {
         size_t nl = text.find('\n');
         std::string_view line = text.substr(0, nl);

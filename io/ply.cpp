@@ -238,10 +238,14 @@ private:
             }
             if (key == "format") {
                 if (words.size() < 2) bad("missing encoding");
-                if (words[1] == "ascii") encoding_ = Encoding::kAscii;
-                else if (words[1] == "binary_little_endian") encoding_ = Encoding::kBinaryLittle;
-                else if (words[1] == "binary_big_endian") encoding_ = Encoding::kBinaryBig;
-                else bad("unknown format " + quote_token(words[1]));
+                if (words[1] == "ascii")
+                    encoding_ = Encoding::kAscii;
+                else if (words[1] == "binary_little_endian")
+                    encoding_ = Encoding::kBinaryLittle;
+                else if (words[1] == "binary_big_endian")
+                    encoding_ = Encoding::kBinaryBig;
+                else
+                    bad("unknown format " + quote_token(words[1]));
                 header_.variant = std::string(words[1]);
                 have_format = true;
             } else if (key == "element") {
@@ -422,8 +426,8 @@ private:
 
     [[noreturn]] void truncated() const {
         const Element& e = elements_[element_];
-        item_fail(src_.offset(), "file ends early (header promises " + std::to_string(e.count) + " " + e.name +
-                                     " items)");
+        item_fail(src_.offset(),
+                  "file ends early (header promises " + std::to_string(e.count) + " " + e.name + " items)");
     }
 
     const std::byte* need(size_t n) {
@@ -542,8 +546,10 @@ private:
         if (b != e && *b == '+') ++b;
         float v = 0;
         auto [p, ec] = std::from_chars(b, e, v);
-        if (ec == std::errc::result_out_of_range) v = std::strtof(std::string(tok).c_str(), nullptr);
-        else if (ec != std::errc() || p != e) item_fail(token_offset_, "expected a number, found " + quote_token(tok));
+        if (ec == std::errc::result_out_of_range)
+            v = std::strtof(std::string(tok).c_str(), nullptr);
+        else if (ec != std::errc() || p != e)
+            item_fail(token_offset_, "expected a number, found " + quote_token(tok));
         return v;
     }
 
@@ -555,7 +561,8 @@ private:
         auto [p, ec] = std::from_chars(b, e, v);
         if (ec == std::errc() && p == e) return v;
         double d = parse_number(tok);
-        if (d != std::floor(d) || !(std::fabs(d) < 9e18)) item_fail(token_offset_, "expected an integer, found " + quote_token(tok));
+        if (d != std::floor(d) || !(std::fabs(d) < 9e18))
+            item_fail(token_offset_, "expected an integer, found " + quote_token(tok));
         return static_cast<int64_t>(d);
     }
 
@@ -600,7 +607,8 @@ private:
     void check_size(const Element& e, size_t fixed) const {
         if (e.count > ~uint64_t{0} / fixed)
             throw Error(src_.name(), src_.offset(), 0,
-                        "element '" + e.name + "': header promises " + std::to_string(e.count) + " items, more than any file holds");
+                        "element '" + e.name + "': header promises " + std::to_string(e.count) +
+                            " items, more than any file holds");
     }
 
     void skip_element(size_t index) {
@@ -752,9 +760,8 @@ private:
             if (!record.empty()) layout.pack_values(normal, rgba, uv, scalars.data(), record.data());
             table_->append(xyz, record.data());
         }
-        header_.notes.emplace_back("vertex table", table_->storage() == VertexTable::Storage::kMemory
-                                                       ? "in memory"
-                                                       : "temporary file");
+        header_.notes.emplace_back("vertex table",
+                                   table_->storage() == VertexTable::Storage::kMemory ? "in memory" : "temporary file");
         if (doubles) {
             std::string text = "double, rounded to float: moved by up to ";
             append_number(text, static_cast<float>(worst_rounding));
@@ -911,7 +918,7 @@ private:
     ReadOptions options_;
     Encoding encoding_ = Encoding::kAscii;
     bool swap_ = false;
-    uint64_t line_ = 0;  // lines consumed (header; ascii body)
+    uint64_t line_ = 0;             // lines consumed (header; ascii body)
     bool check_item_line_ = false;  // the next token begins an ascii item
     bool line_break_seen_ = true;   // since the last ascii item ended (the header ends with one)
     uint64_t item_first_offset_ = 0, item_first_line_ = 0;  // where the current ascii item begins
@@ -920,8 +927,8 @@ private:
     int vertex_ = -1, face_ = -1, index_prop_ = -1;
     Channels stored_;                     // the channels the caller wants, of those the file has
     std::optional<CornerLayout> layout_;  // the vertex table's corner records, when it has them
-    size_t element_ = 0;  // element being read (for messages)
-    uint64_t item_ = 0;   // item number within it
+    size_t element_ = 0;                  // element being read (for messages)
+    uint64_t item_ = 0;                   // item number within it
     uint64_t token_offset_ = 0;
     std::unique_ptr<VertexTable> table_;
     std::vector<uint64_t> polygon_;
@@ -929,8 +936,8 @@ private:
     std::vector<ScalarChannel> mapped_face_scalars_;  // the chunk channels face_scalar_map_ is for
     std::vector<int> face_scalar_map_;
     PolygonScratch polygon_scratch_;
-    size_t polygon_next_ = 0;  // next triangle of polygon_ to emit
-    bool strips_ = false;      // face_ is a tristrips element
+    size_t polygon_next_ = 0;                // next triangle of polygon_ to emit
+    bool strips_ = false;                    // face_ is a tristrips element
     std::vector<uint64_t> strip_triangles_;  // index triples of the strips read, emitted from strip_next_
     size_t strip_next_ = 0;
 };
@@ -1010,8 +1017,8 @@ public:
         welder_.finish();
         const uint64_t vertices = welder_.vertex_count();
         if (vertices > 0x7fffffffULL)
-            throw Error(sink_.name(), "PLY int indices hold at most 2^31 - 1 vertices, the mesh has " +
-                                          std::to_string(vertices));
+            throw Error(sink_.name(),
+                        "PLY int indices hold at most 2^31 - 1 vertices, the mesh has " + std::to_string(vertices));
         const Channels& ch = options_.channels;
         sink_.write(header(vertices));
 

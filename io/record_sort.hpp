@@ -33,8 +33,7 @@ class RecordSorter {
 
 public:
     // `budget_bytes` bounds the run buffer; `tmpdir` (empty: $TMPDIR or /tmp) holds the runs.
-    RecordSorter(uint64_t budget_bytes, std::string tmpdir, Less less = {})
-        : tmpdir_(std::move(tmpdir)), less_(less) {
+    RecordSorter(uint64_t budget_bytes, std::string tmpdir, Less less = {}) : tmpdir_(std::move(tmpdir)), less_(less) {
         capacity_ = static_cast<size_t>(std::max<uint64_t>(budget_bytes / sizeof(T), 1024));
     }
     RecordSorter(const RecordSorter&) = delete;  // the heap points back at this object
@@ -126,8 +125,8 @@ private:
 
     // Gives runs [first, last) a block each from the merge budget and puts them on the heap.
     void start_merge(size_t first, size_t last, uint64_t merge_budget_bytes) {
-        const size_t block = static_cast<size_t>(std::max<uint64_t>(
-            merge_budget_bytes / (last - first) / sizeof(T), kMinBlockBytes / sizeof(T) + 1));
+        const size_t block = static_cast<size_t>(
+            std::max<uint64_t>(merge_budget_bytes / (last - first) / sizeof(T), kMinBlockBytes / sizeof(T) + 1));
         for (size_t r = first; r < last; ++r) {
             runs_[r].block.resize(block);
             refill(r);

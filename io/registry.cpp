@@ -24,15 +24,9 @@ constexpr const Format* kFormats[] = {
     &kDracoFormat,
 #endif
 #if MESHSTREAM_WITH_GLTF
-    &kGlbFormat,
-    &kGltfFormat,
+    &kGlbFormat,   &kGltfFormat,
 #endif
-    &kPlyFormat,
-    &kPlyAsciiFormat,
-    &kObjFormat,
-    &kTriangleStreamFormat,
-    &kStlFormat,
-    &kStlAsciiFormat,
+    &kPlyFormat,   &kPlyAsciiFormat, &kObjFormat, &kTriangleStreamFormat, &kStlFormat, &kStlAsciiFormat,
 };
 
 std::string lower(std::string_view s) {
@@ -43,7 +37,8 @@ std::string lower(std::string_view s) {
 
 // Extension of the path's last component, lower case, with a trailing ".gz" removed.
 std::string extension_of(std::string_view path) {
-    std::string p = lower(path.substr(path.find_last_of('/') == std::string_view::npos ? 0 : path.find_last_of('/') + 1));
+    std::string p =
+        lower(path.substr(path.find_last_of('/') == std::string_view::npos ? 0 : path.find_last_of('/') + 1));
     if (p.size() > 3 && p.ends_with(".gz")) p.resize(p.size() - 3);
     size_t dot = p.find_last_of('.');
     return dot == std::string::npos ? std::string() : p.substr(dot + 1);

@@ -44,9 +44,7 @@ bool is_binary_byte(std::byte b) {
     return c < 0x09 || (c > 0x0d && c < 0x20) || c == 0x7f;
 }
 
-bool has_binary_bytes(std::span<const std::byte> head) {
-    return std::any_of(head.begin(), head.end(), is_binary_byte);
-}
+bool has_binary_bytes(std::span<const std::byte> head) { return std::any_of(head.begin(), head.end(), is_binary_byte); }
 
 char lower_ascii(char c) { return c >= 'A' && c <= 'Z' ? static_cast<char>(c + ('a' - 'A')) : c; }
 
@@ -155,8 +153,8 @@ public:
         const bool plain = chunk.channels() == Channels{};
         while (!chunk.full() && read_ < count_) {
             auto window = source_.window();
-            size_t facets = std::min<uint64_t>({window.size() / kFacetBytes, chunk.capacity() - chunk.size(),
-                                                count_ - read_});
+            size_t facets =
+                std::min<uint64_t>({window.size() / kFacetBytes, chunk.capacity() - chunk.size(), count_ - read_});
             if (facets == 0) {
                 // A facet straddles the end of the buffer: peek makes it contiguous.
                 window = source_.peek(kFacetBytes);
@@ -467,8 +465,9 @@ public:
         const uint64_t limit = expected_.value_or(kMaxBinaryTriangles);
         if (written_ + chunk.size() > limit)
             throw Error(sink_.name(), sink_.offset(), 0,
-                        expected_ ? "more triangles than the " + std::to_string(*expected_) + " announced"
-                                  : "binary STL holds at most 4294967295 triangles (write ASCII STL or another format)");
+                        expected_
+                            ? "more triangles than the " + std::to_string(*expected_) + " announced"
+                            : "binary STL holds at most 4294967295 triangles (write ASCII STL or another format)");
         const float* xyz = chunk.xyz().data();
         for (size_t done = 0; done < chunk.size();) {
             size_t facets = std::min(kBatchFacets, chunk.size() - done);

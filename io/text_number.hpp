@@ -28,8 +28,10 @@ inline std::string binary_size(uint64_t bytes) {
     while (u < 3 && bytes >= scale * 1024) scale *= 1024, ++u;
     const double value = double(bytes) / scale;
     char buf[32];
-    if (value < 10 && bytes % uint64_t(scale) != 0) std::snprintf(buf, sizeof buf, "%.1f %s", value, units[u]);
-    else std::snprintf(buf, sizeof buf, "%.0f %s", value, units[u]);
+    if (value < 10 && bytes % uint64_t(scale) != 0)
+        std::snprintf(buf, sizeof buf, "%.1f %s", value, units[u]);
+    else
+        std::snprintf(buf, sizeof buf, "%.0f %s", value, units[u]);
     return buf;
 }
 

@@ -84,7 +84,7 @@ std::vector<std::byte> header_body(const WriteOptions& o) {
     append_le(body, o.triangle_count.value_or(kUnknownCount));
     append_le(body, static_cast<uint8_t>(o.sorted_axis ? *o.sorted_axis : kNoAxis));
     append_le(body, static_cast<uint8_t>((c.normal ? kNormalFlag : 0) | (c.color ? kColorFlag : 0) |
-                                      (c.vertex_id ? kVertexIdFlag : 0)));
+                                         (c.vertex_id ? kVertexIdFlag : 0)));
     append_le(body, static_cast<uint8_t>(c.color ? type_code(c.color->type) : 0));
     append_le(body, static_cast<uint8_t>(c.color && c.color->alpha ? 1 : 0));
     append_le(body, static_cast<uint8_t>(c.uv_sets));
@@ -424,10 +424,10 @@ private:
             const auto it = std::find(has.vertex_scalars.begin(), has.vertex_scalars.end(), sc);
             const double zeros[3] = {0, 0, 0};
             p = store_le_array(p,
-                            it != has.vertex_scalars.end()
-                                ? chunk.vertex_scalar_at(i, size_t(it - has.vertex_scalars.begin()))
-                                : zeros,
-                            3);
+                               it != has.vertex_scalars.end()
+                                   ? chunk.vertex_scalar_at(i, size_t(it - has.vertex_scalars.begin()))
+                                   : zeros,
+                               3);
         }
         if (c.vertex_id) {
             const uint64_t zeros[3] = {0, 0, 0};

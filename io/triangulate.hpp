@@ -11,11 +11,11 @@ namespace meshstream::io {
 
 // Working memory of triangulate_polygon, kept by the caller and reused from polygon to polygon.
 struct TriangulateScratch {
-    std::vector<double> uv;                 // corners projected to the polygon's plane
-    std::vector<uint32_t> prev, next;       // the remaining ring
+    std::vector<double> uv;            // corners projected to the polygon's plane
+    std::vector<uint32_t> prev, next;  // the remaining ring
     std::vector<uint8_t> reflex, listed, ear;
-    std::vector<uint32_t> reflex_list;      // may still hold corners that have stopped being reflex
-    std::vector<uint32_t> ears;             // candidates to clip; entries whose ear flag is unset are stale
+    std::vector<uint32_t> reflex_list;  // may still hold corners that have stopped being reflex
+    std::vector<uint32_t> ears;         // candidates to clip; entries whose ear flag is unset are stale
 };
 
 // Triangulates the polygon with corners xyz[3k .. 3k+2], k < n = xyz.size() / 3 (3 <= n < 2^32),

@@ -4,13 +4,13 @@
 
 #include "io/error.hpp"
 
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <unistd.h>
 #include <algorithm>
 #include <cerrno>
 #include <cstring>
-#include <fcntl.h>
 #include <new>
-#include <sys/mman.h>
-#include <unistd.h>
 
 namespace meshstream::io {
 namespace {
@@ -40,7 +40,8 @@ std::unique_ptr<VertexTable> VertexTable::of_input_file(const std::string& path,
     std::copy(std::begin(xyz_offsets), std::end(xyz_offsets), t->xyz_offsets_);
     if (count == 0) return t;
     t->input_fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-    if (t->input_fd_ < 0) throw Error(path, "cannot open to read the vertex block: " + std::string(std::strerror(errno)));
+    if (t->input_fd_ < 0)
+        throw Error(path, "cannot open to read the vertex block: " + std::string(std::strerror(errno)));
     t->start_cache(count * stride);
     return t;
 }
@@ -59,8 +60,7 @@ void VertexTable::append(const float* xyz, const std::byte* attributes) {
             spill();
         } else {
             size_t in_block = static_cast<size_t>(size_ & ((uint64_t{1} << kBlockRecordsLog2) - 1));
-            if (in_block == 0)
-                blocks_.push_back(std::make_unique<std::byte[]>(stride_ << kBlockRecordsLog2));
+            if (in_block == 0) blocks_.push_back(std::make_unique<std::byte[]>(stride_ << kBlockRecordsLog2));
             std::memcpy(blocks_.back().get() + in_block * stride_, rec, stride_);
             ++size_;
             return;

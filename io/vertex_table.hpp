@@ -8,10 +8,10 @@
 // Memory: records in a file are read through a direct-mapped cache of its 4 KiB pages, as
 // large as the budget and filled by pread, so resident memory is the budget (and 1/512 of it
 // for the pages' tags) plus one 1 MiB append buffer, whatever the input size; the OS page
-// cache, which RSS does not count, keeps the file's pages between misses. A shared mmap did this before: its resident pages had to be
-// counted and dropped by hand, and Linux maps far more than the page a read faults in (the
-// page's whole page-cache folio, up to 2 MiB, and 64 KiB of neighbours), which made a budget
-// either leak (counted too finely) or cost 2 MiB mappings on every miss (counted per folio).
+// cache, which RSS does not count, keeps the file's pages between misses. A shared mmap did this before: its resident
+// pages had to be counted and dropped by hand, and Linux maps far more than the page a read faults in (the page's whole
+// page-cache folio, up to 2 MiB, and 64 KiB of neighbours), which made a budget either leak (counted too finely) or
+// cost 2 MiB mappings on every miss (counted per folio).
 #pragma once
 
 #include "io/byte_stream.hpp"

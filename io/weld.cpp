@@ -10,8 +10,8 @@
 
 #include <algorithm>
 #include <array>
-#include <cassert>
 #include <bit>
+#include <cassert>
 #include <cstring>
 #include <optional>
 #include <vector>
@@ -264,7 +264,8 @@ private:
     // Doubles the table when old + new (and the final rank array) fit the budget.
     bool grow() {
         size_t cap = table_.empty() ? 4096 : 2 * table_.size();
-        uint64_t need = uint64_t{cap} * sizeof(Entry) + std::max<uint64_t>(table_.size() * sizeof(Entry), cap / 5 * 4 * 4);
+        uint64_t need =
+            uint64_t{cap} * sizeof(Entry) + std::max<uint64_t>(table_.size() * sizeof(Entry), cap / 5 * 4 * 4);
         if (need > budget_ || cap > (size_t{1} << 32)) return false;
         std::vector<Entry> old(cap);
         old.swap(table_);

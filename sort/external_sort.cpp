@@ -17,7 +17,7 @@
 namespace meshstream::sort {
 namespace {
 
-constexpr size_t kStagingBytes = size_t{1} << 20;      // >= TempFile's buffer: writes bypass it
+constexpr size_t kStagingBytes = size_t{1} << 20;       // >= TempFile's buffer: writes bypass it
 constexpr uint64_t kMinReadBytes = uint64_t{64} << 10;  // smallest per-run read buffer
 constexpr uint64_t kMaxReadBytes = uint64_t{16} << 20;  // larger reads gain nothing
 constexpr uint64_t kMinRunTriangles = 1024;
@@ -43,8 +43,7 @@ void advise_huge_pages(void* p, size_t bytes) {
 
 // Prefetches the record of the item `ahead` positions further in `sorted` (both cache lines
 // a record may straddle).
-inline void prefetch_record(const std::byte* records, size_t record_bytes, std::span<const uint64_t> sorted,
-                            size_t i) {
+inline void prefetch_record(const std::byte* records, size_t record_bytes, std::span<const uint64_t> sorted, size_t i) {
     if (i + kPrefetchDistance < sorted.size()) {
         const std::byte* r = records + (sorted[i + kPrefetchDistance] & 0xFFFFFFFFu) * record_bytes;
         __builtin_prefetch(r);
@@ -58,12 +57,12 @@ inline void prefetch_record(const std::byte* records, size_t record_bytes, std::
 struct ExternalSorter::Cursor {
     uint64_t start_offset = 0;  // first byte of the run in the file
     uint64_t next_offset = 0;   // first unread byte of the run in the file
-    uint64_t end_offset = 0;   // end of the run in the file
+    uint64_t end_offset = 0;    // end of the run in the file
     std::byte* buf = nullptr;
     size_t capacity = 0;  // bytes, a multiple of the record size
     size_t pos = 0, len = 0;
     uint64_t block_offset = 0;  // file range of the buffered block, released once consumed
-    uint32_t run = 0;  // position among the merged runs: breaks key ties (stability)
+    uint32_t run = 0;           // position among the merged runs: breaks key ties (stability)
 };
 
 class ExternalSorter::Merger {
@@ -175,8 +174,10 @@ uint64_t ExternalSorter::run_capacity_for(uint64_t memory_budget_bytes, size_t r
 }
 
 ExternalSorter::ExternalSorter(SorterOptions options)
-    : options_(std::move(options)), record_bytes_(record_bytes_for(options_.channels)),
-      corner_layout_(options_.channels), face_layout_(options_.channels) {
+    : options_(std::move(options)),
+      record_bytes_(record_bytes_for(options_.channels)),
+      corner_layout_(options_.channels),
+      face_layout_(options_.channels) {
     assert(options_.axis >= 0 && options_.axis <= 2);
     stats_.record_bytes = record_bytes_;
     stats_.run_capacity = run_capacity_for(options_.memory_budget_bytes, record_bytes_);
@@ -259,8 +260,8 @@ void ExternalSorter::release_temp_range(io::TempFile& file, uint64_t begin, uint
 #ifdef FALLOC_FL_PUNCH_HOLE
     // Consumed run data is never read again: give its blocks back so a merge pass needs about
     // one copy of the data on disk, not two. File systems without hole punching just keep it.
-    if (begin >= end || ::fallocate(file.fd(), FALLOC_FL_PUNCH_HOLE | FALLOC_FL_KEEP_SIZE,
-                                    static_cast<off_t>(begin), static_cast<off_t>(end - begin)) == 0)
+    if (begin >= end || ::fallocate(file.fd(), FALLOC_FL_PUNCH_HOLE | FALLOC_FL_KEEP_SIZE, static_cast<off_t>(begin),
+                                    static_cast<off_t>(end - begin)) == 0)
         live_temp_bytes_ -= std::min(live_temp_bytes_, consumed);
 #else
     (void)file, (void)begin, (void)end, (void)consumed;

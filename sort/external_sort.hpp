@@ -44,12 +44,12 @@ struct SorterOptions {
 
 struct SortStats {
     uint64_t triangles = 0;
-    uint64_t runs = 0;                  // runs written to disk (0: sorted in memory)
-    uint64_t run_capacity = 0;          // triangles per run
-    int merge_passes = 0;               // passes over the data after run generation, incl. the final one
-    uint64_t temp_bytes_written = 0;    // all temporary-file writes
-    uint64_t peak_temp_bytes = 0;       // largest temporary disk use at any time (after hole punching)
-    size_t record_bytes = 0;            // bytes per triangle record on disk
+    uint64_t runs = 0;                // runs written to disk (0: sorted in memory)
+    uint64_t run_capacity = 0;        // triangles per run
+    int merge_passes = 0;             // passes over the data after run generation, incl. the final one
+    uint64_t temp_bytes_written = 0;  // all temporary-file writes
+    uint64_t peak_temp_bytes = 0;     // largest temporary disk use at any time (after hole punching)
+    size_t record_bytes = 0;          // bytes per triangle record on disk
 };
 
 class ExternalSorter {

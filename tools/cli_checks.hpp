@@ -18,9 +18,10 @@ inline CLI::Validator whole_number(uint64_t min, const std::string& what) {
         [min, what](const std::string& text) -> std::string {
             uint64_t value = 0;
             const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
-            if (text.empty() || text[0] == '-' || text[0] == '+' || ec != std::errc() || end != text.data() + text.size() ||
-                value < min)
-                return "must be " + what + " from " + std::to_string(min) + " to 18446744073709551615, found '" + text + "'";
+            if (text.empty() || text[0] == '-' || text[0] == '+' || ec != std::errc() ||
+                end != text.data() + text.size() || value < min)
+                return "must be " + what + " from " + std::to_string(min) + " to 18446744073709551615, found '" + text +
+                       "'";
             return {};
         },
         "N >= " + std::to_string(min));

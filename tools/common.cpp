@@ -3,15 +3,15 @@
 
 #include "io/triangle_stream.hpp"
 
-#include <charconv>
-#include <cstdlib>
-#include <cmath>
-#include <cstdio>
-#include <fstream>
-#include <limits>
 #include <sys/ioctl.h>
 #include <sys/stat.h>
 #include <unistd.h>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <limits>
 
 namespace meshstream::tools {
 
@@ -20,16 +20,23 @@ uint64_t parse_bytes(const std::string& text) {
     const char* begin = text.data();
     const char* end = begin + text.size();
     auto [p, ec] = std::from_chars(begin, end, value);
-    if (ec != std::errc() || !(value >= 0) || !std::isfinite(value)) throw CLI::ValidationError("--memory", "expected a size like 64M or 1G, got '" + text + "'");
+    if (ec != std::errc() || !(value >= 0) || !std::isfinite(value))
+        throw CLI::ValidationError("--memory", "expected a size like 64M or 1G, got '" + text + "'");
     std::string suffix(p, end);
     for (char& c : suffix) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
     double mult = 1;
-    if (suffix.empty() || suffix == "B") mult = 1;
-    else if (suffix == "K" || suffix == "KB" || suffix == "KIB") mult = 1024.0;
-    else if (suffix == "M" || suffix == "MB" || suffix == "MIB") mult = 1024.0 * 1024;
-    else if (suffix == "G" || suffix == "GB" || suffix == "GIB") mult = 1024.0 * 1024 * 1024;
-    else if (suffix == "T" || suffix == "TB" || suffix == "TIB") mult = 1024.0 * 1024 * 1024 * 1024;
-    else throw CLI::ValidationError("--memory", "unknown size suffix in '" + text + "' (use K, M, G or T)");
+    if (suffix.empty() || suffix == "B")
+        mult = 1;
+    else if (suffix == "K" || suffix == "KB" || suffix == "KIB")
+        mult = 1024.0;
+    else if (suffix == "M" || suffix == "MB" || suffix == "MIB")
+        mult = 1024.0 * 1024;
+    else if (suffix == "G" || suffix == "GB" || suffix == "GIB")
+        mult = 1024.0 * 1024 * 1024;
+    else if (suffix == "T" || suffix == "TB" || suffix == "TIB")
+        mult = 1024.0 * 1024 * 1024 * 1024;
+    else
+        throw CLI::ValidationError("--memory", "unknown size suffix in '" + text + "' (use K, M, G or T)");
     // Past 2^64 the conversion is undefined; the largest size is then refused as more than
     // this machine's memory, like any size too large.
     const double bytes = value * mult;
@@ -64,17 +71,21 @@ std::string dropped_channels_text(const std::string& dropped, const io::Format& 
 void note_input_changes(const io::MeshHeader& header, const std::string& input_name, Warnings& warnings) {
     for (const auto& [key, text] : header.notes)
         if (key == io::kLastLineNote)
-            warnings.note("input_last_line_unterminated", input_name + ": the last line " + text + " (a truncated download or pipe?): check its last face");
+            warnings.note("input_last_line_unterminated", input_name + ": the last line " + text +
+                                                              " (a truncated download or pipe?): check its last face");
         else if (key == io::kPrecisionNote && header.coordinate_rounding.value_or(0) > 0)
-            warnings.note("input_coordinates_rounded", input_name + ": coordinates are " + text + "; meshstream works in float (32-bit)");
-    for (const io::ReaderWarning& w : header.warnings) warnings.add("reader_warning", io::describe_warning(input_name, w), w.count);
+            warnings.note("input_coordinates_rounded",
+                          input_name + ": coordinates are " + text + "; meshstream works in float (32-bit)");
+    for (const io::ReaderWarning& w : header.warnings)
+        warnings.add("reader_warning", io::describe_warning(input_name, w), w.count);
 }
 
 void note_unused_write_flags(const WriteFlags& flags, const io::Format& output, const std::string& output_path,
                              Warnings& warnings) {
     if (flags.gzip_level != WriteFlags{}.gzip_level && (output_path == "-" || !io::wants_gzip(output_path)))
-        warnings.note("unused_option", "--gzip-level applies to outputs named *.gz: ignored for " +
-                      (output_path == "-" ? std::string("<stdout> (pipe it through gzip)") : output_path));
+        warnings.note("unused_option",
+                      "--gzip-level applies to outputs named *.gz: ignored for " +
+                          (output_path == "-" ? std::string("<stdout> (pipe it through gzip)") : output_path));
     const WriteFlags defaults;
     std::string draco_given;  // the Draco settings given, which only a Draco encoding uses
     auto add_to = [](std::string& list, bool set, const char* name) {
@@ -90,14 +101,15 @@ void note_unused_write_flags(const WriteFlags& flags, const io::Format& output, 
     if (output.traits & io::Format::kAlwaysDraco) {
         if (compress_given && flags.compression() != io::WriteOptions::Compression::kDraco)
             warnings.note("unused_option", std::string(flags.no_draco ? "--no-draco" : "--compress") +
-                          " applies to glTF outputs; a .drc is always Draco");
+                                               " applies to glTF outputs; a .drc is always Draco");
         return;
     }
     if (output.traits & io::Format::kDracoUnlessOff) {
         const auto c = flags.compression();
         if (!draco_given.empty() && c != io::WriteOptions::Compression::kDraco)
-            warnings.note("unused_option", draco_given + verb(draco_given) + " to Draco compression: ignored with --compress " +
-                          (c == io::WriteOptions::Compression::kMeshopt ? "meshopt" : "none"));
+            warnings.note("unused_option", draco_given + verb(draco_given) +
+                                               " to Draco compression: ignored with --compress " +
+                                               (c == io::WriteOptions::Compression::kMeshopt ? "meshopt" : "none"));
         return;
     }
     std::string given;
@@ -122,8 +134,10 @@ const io::Format& resolve_output_format(const std::string& output, const WriteFl
     // Between two commands nothing needs a count first: the triangle stream flows at once.
     if (names_a_pipe(output)) return io::kTriangleStreamFormat;
     if (output == "-")
-        throw UsageError("<stdout>: writing to stdout needs --to unless it is a pipe (one of: " + format_names(true) + ")");
-    throw UsageError(output + ": cannot tell the output format from the name (use --to, one of: " + format_names(true) + ")");
+        throw UsageError("<stdout>: writing to stdout needs --to unless it is a pipe (one of: " + format_names(true) +
+                         ")");
+    throw UsageError(output + ": cannot tell the output format from the name (use --to, one of: " + format_names(true) +
+                     ")");
 }
 
 namespace {
@@ -137,9 +151,7 @@ std::optional<std::pair<dev_t, ino_t>> regular_file_id(const std::string& path, 
     return std::pair{st.st_dev, st.st_ino};
 }
 
-std::string shown(const std::string& path, bool output) {
-    return path != "-" ? path : output ? "<stdout>" : "<stdin>";
-}
+std::string shown(const std::string& path, bool output) { return path != "-" ? path : output ? "<stdout>" : "<stdin>"; }
 
 }  // namespace
 
@@ -173,8 +185,8 @@ void refuse_output_over_inputs(const std::string& output, const std::vector<std:
 
 void refuse_output_over_inputs(const std::string& output, const io::Format& format, const io::WriteOptions& options,
                                const std::vector<InputFiles>& inputs) {
-    refuse_output_over_inputs(output, format.side_files ? format.side_files(output, options) : std::vector<std::string>{},
-                              inputs);
+    refuse_output_over_inputs(
+        output, format.side_files ? format.side_files(output, options) : std::vector<std::string>{}, inputs);
 }
 
 InputFiles input_files(const std::string& path, const io::MeshHeader& header) { return {path, header.side_files}; }
@@ -204,10 +216,11 @@ namespace {
 
 // --drop's list into `kinds`; the error text for an unknown name, else empty.
 std::string parse_drop_list(const std::string& drop_list, io::ChannelKinds& kinds) {
-    const std::pair<std::string_view, bool io::ChannelKinds::*> names[] = {
-        {"normals", &io::ChannelKinds::normals}, {"colors", &io::ChannelKinds::colors},
-        {"uvs", &io::ChannelKinds::uvs},         {"extra", &io::ChannelKinds::extras},
-        {"materials", &io::ChannelKinds::materials}};
+    const std::pair<std::string_view, bool io::ChannelKinds::*> names[] = {{"normals", &io::ChannelKinds::normals},
+                                                                           {"colors", &io::ChannelKinds::colors},
+                                                                           {"uvs", &io::ChannelKinds::uvs},
+                                                                           {"extra", &io::ChannelKinds::extras},
+                                                                           {"materials", &io::ChannelKinds::materials}};
     size_t at = 0;
     while (at < drop_list.size()) {
         size_t end = drop_list.find(',', at);
@@ -259,15 +272,17 @@ void add_read_flags(CLI::App* cmd, ReadFlags& flags) {
 
 void strict_refuses_dropped_triangles(CLI::App* cmd) {
     cmd->get_option("--strict")
-        ->description("Triangles with a NaN/inf coordinate or two corners at the same position are skipped with a "
-                      "counted warning (decimate cannot use them); --strict makes them, and faces of fewer than 3 "
-                      "vertices and what the output format cannot hold, errors");
+        ->description(
+            "Triangles with a NaN/inf coordinate or two corners at the same position are skipped with a "
+            "counted warning (decimate cannot use them); --strict makes them, and faces of fewer than 3 "
+            "vertices and what the output format cannot hold, errors");
 }
 
 void strict_reports_bad_triangles(CLI::App* cmd) {
     cmd->get_option("--strict")
-        ->description("Make the first triangle with a NaN/inf coordinate or two corners at the same position (or a face "
-                      "of fewer than 3 vertices) an error; without it they are counted as they are");
+        ->description(
+            "Make the first triangle with a NaN/inf coordinate or two corners at the same position (or a face "
+            "of fewer than 3 vertices) an error; without it they are counted as they are");
 }
 
 io::WriteOptions WriteFlags::options(const ReadFlags& read) const {
@@ -323,8 +338,9 @@ void add_write_flags(CLI::App* cmd, WriteFlags& flags) {
                     "Draco quantization bits of float colours and generic attributes (scalars), 1-30 (default 10; "
                     "integer ones are kept exactly)")
         ->check(CLI::Range(1, 30));
-    web->add_option("--draco-cl", flags.draco_cl, "Draco compression level 0-10 (default 7; higher is slower, "
-                                                  "usually smaller)")
+    web->add_option("--draco-cl", flags.draco_cl,
+                    "Draco compression level 0-10 (default 7; higher is slower, "
+                    "usually smaller)")
         ->check(CLI::Range(0, 10));
 }
 
@@ -351,8 +367,12 @@ void draw_line(std::string_view text) {
 }  // namespace
 
 Progress::Progress(std::string label, std::optional<uint64_t> total, std::string unit)
-    : label_(std::move(label)), total_(total), unit_(std::move(unit)),
-      enabled_(!global().quiet && bar_terminal()), start_(std::chrono::steady_clock::now()), last_(start_) {}
+    : label_(std::move(label)),
+      total_(total),
+      unit_(std::move(unit)),
+      enabled_(!global().quiet && bar_terminal()),
+      start_(std::chrono::steady_clock::now()),
+      last_(start_) {}
 
 Progress::~Progress() { done(); }
 
@@ -397,8 +417,10 @@ void Progress::draw(bool force) {
     // The share done: of the file's bytes when reading one (every format, gzip too), else of
     // the count's total.
     std::optional<double> share;
-    if (file_bytes_ && *file_bytes_ > 0) share = double(bytes_read_) / double(*file_bytes_);
-    else if (total_ && *total_ > 0) share = double(done_) / double(*total_);
+    if (file_bytes_ && *file_bytes_ > 0)
+        share = double(bytes_read_) / double(*file_bytes_);
+    else if (total_ && *total_ > 0)
+        share = double(done_) / double(*total_);
     if (share) {
         const double frac = std::min(1.0, *share);
         int filled = static_cast<int>(frac * 24);
@@ -441,22 +463,32 @@ std::string human_count(double n, int significant_digits) {
     const char* unit = nullptr;
     double scaled = n;
     int decimals = 0;
-    if (n >= 1e9) unit = "G", scaled = n / 1e9, decimals = 2;
-    else if (n >= 1e6) unit = "M", scaled = n / 1e6, decimals = 2;
-    else if (n >= 1e4) unit = "k", scaled = n / 1e3, decimals = 1;
+    if (n >= 1e9)
+        unit = "G", scaled = n / 1e9, decimals = 2;
+    else if (n >= 1e6)
+        unit = "M", scaled = n / 1e6, decimals = 2;
+    else if (n >= 1e4)
+        unit = "k", scaled = n / 1e3, decimals = 1;
     char buf[32];
-    if (!unit) std::snprintf(buf, sizeof buf, "%.0f", n);
-    else if (significant_digits > 0) std::snprintf(buf, sizeof buf, "%.*g %s", significant_digits, scaled, unit);
-    else std::snprintf(buf, sizeof buf, "%.*f %s", decimals, scaled, unit);
+    if (!unit)
+        std::snprintf(buf, sizeof buf, "%.0f", n);
+    else if (significant_digits > 0)
+        std::snprintf(buf, sizeof buf, "%.*g %s", significant_digits, scaled, unit);
+    else
+        std::snprintf(buf, sizeof buf, "%.*f %s", decimals, scaled, unit);
     return buf;
 }
 
 std::string human_bytes(double bytes) {
     char buf[32];
-    if (bytes >= 1e9) std::snprintf(buf, sizeof buf, "%.2f GB", bytes / 1e9);
-    else if (bytes >= 1e6) std::snprintf(buf, sizeof buf, "%.1f MB", bytes / 1e6);
-    else if (bytes >= 1e3) std::snprintf(buf, sizeof buf, "%.1f kB", bytes / 1e3);
-    else std::snprintf(buf, sizeof buf, "%.0f B", bytes);
+    if (bytes >= 1e9)
+        std::snprintf(buf, sizeof buf, "%.2f GB", bytes / 1e9);
+    else if (bytes >= 1e6)
+        std::snprintf(buf, sizeof buf, "%.1f MB", bytes / 1e6);
+    else if (bytes >= 1e3)
+        std::snprintf(buf, sizeof buf, "%.1f kB", bytes / 1e3);
+    else
+        std::snprintf(buf, sizeof buf, "%.0f B", bytes);
     return buf;
 }
 

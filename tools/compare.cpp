@@ -1,11 +1,11 @@
 // `meshstream compare A B`: Metro-style surface error between two meshes (tools/metro.hpp),
 // as text or --json. Holds the smaller mesh in memory and streams the other one twice.
+#include "compare/metro.hpp"
 #include "io/error.hpp"
 #include "tools/cli_checks.hpp"
 #include "tools/commands.hpp"
 #include "tools/common.hpp"
 #include "tools/input_filter.hpp"
-#include "compare/metro.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -17,13 +17,13 @@
 namespace meshstream::tools {
 namespace {
 
+using compare::compare_meshes;
 using compare::CompareOptions;
 using compare::CompareResult;
 using compare::DistanceStats;
+using compare::file_source;
 using compare::MeshSource;
 using compare::MeshSummary;
-using compare::compare_meshes;
-using compare::file_source;
 
 struct CompareCliOptions {
     std::string a, b;
@@ -82,7 +82,10 @@ private:
 
 MeshSource source(const std::string& path, const ReadFlags& flags) {
     MeshSource s = file_source(path, flags.from, flags.options());
-    if (flags.strict) s.open = [open = s.open, path] { return std::make_unique<StrictReader>(open(), path == "-" ? "<stdin>" : path); };
+    if (flags.strict)
+        s.open = [open = s.open, path] {
+            return std::make_unique<StrictReader>(open(), path == "-" ? "<stdin>" : path);
+        };
     return s;
 }
 
@@ -123,10 +126,11 @@ void run_compare(const CompareCliOptions& opt) {
     Warnings warnings;
     const bool none = r.a_to_b.samples == 0 && r.b_to_a.samples == 0;
     auto unsampled = [&](const MeshSummary& from, const char* direction) {
-        warnings.note("no_samples", std::string("no samples on ") + from.name + " (" +
-                      (from.area > 0 ? "too few asked for: raise --samples" : "its triangles have no area") + "): " +
-                      direction + " is not measured" +
-                      (none ? std::string() : ", and the symmetric figures are the other direction's alone"));
+        warnings.note("no_samples",
+                      std::string("no samples on ") + from.name + " (" +
+                          (from.area > 0 ? "too few asked for: raise --samples" : "its triangles have no area") +
+                          "): " + direction + " is not measured" +
+                          (none ? std::string() : ", and the symmetric figures are the other direction's alone"));
     };
     if (r.a_to_b.samples == 0) unsampled(r.a, "A -> B");
     if (r.b_to_a.samples == 0) unsampled(r.b, "B -> A");
@@ -157,7 +161,8 @@ void run_compare(const CompareCliOptions& opt) {
                     (unsigned long long)m.edges.boundary_edges, (unsigned long long)m.edges.non_manifold_edges, m.area,
                     m.in_memory ? " (held in memory)" : " (streamed)");
         if (m.non_finite_triangles)
-            std::printf("   %llu triangles with non-finite coordinates skipped\n", (unsigned long long)m.non_finite_triangles);
+            std::printf("   %llu triangles with non-finite coordinates skipped\n",
+                        (unsigned long long)m.non_finite_triangles);
     };
     mesh_line("A:", r.a);
     mesh_line("B:", r.b);
@@ -165,8 +170,10 @@ void run_compare(const CompareCliOptions& opt) {
     auto pct = [&](double v) {
         char text[40];
         // Past a million % (a far outlier in B against a tiny A) fixed notation would run on.
-        if (diag > 0) std::snprintf(text, sizeof text, 100.0 * v / diag < 1e6 ? "%8.5f%%" : "%.4g%%", 100.0 * v / diag);
-        else std::snprintf(text, sizeof text, "%9s", "n/a");  // a point: no size to relate to
+        if (diag > 0)
+            std::snprintf(text, sizeof text, 100.0 * v / diag < 1e6 ? "%8.5f%%" : "%.4g%%", 100.0 * v / diag);
+        else
+            std::snprintf(text, sizeof text, "%9s", "n/a");  // a point: no size to relate to
         return std::string(text);
     };
     auto row = [&](const char* label, double max, double mean, double rms, std::optional<uint64_t> samples) {
@@ -181,8 +188,10 @@ void run_compare(const CompareCliOptions& opt) {
     };
     row("A -> B", r.a_to_b.max, r.a_to_b.mean, r.a_to_b.rms, r.a_to_b.samples);
     row("B -> A", r.b_to_a.max, r.b_to_a.mean, r.b_to_a.rms, r.b_to_a.samples);
-    if (none) row("symmetric", 0, 0, 0, 0);
-    else row("symmetric", r.hausdorff(), r.mean(), r.rms(), std::nullopt);
+    if (none)
+        row("symmetric", 0, 0, 0, 0);
+    else
+        row("symmetric", r.hausdorff(), r.mean(), r.rms(), std::nullopt);
 }
 
 }  // namespace
@@ -204,7 +213,8 @@ void add_compare(CLI::App& app) {
                     "Samples per direction (default: 10 × triangles of the sampled mesh, clamped to 1e6..1e7)")
         ->check(CLI::Range(uint64_t{1}, uint64_t{1} << 32));
     cmd->add_option("--seed", opt->seed, "Random seed of the sampling (same seed, same figures)")
-        ->capture_default_str()->check(whole_number(0, "a whole number"));
+        ->capture_default_str()
+        ->check(whole_number(0, "a whole number"));
     cmd->add_flag("--json", opt->json, "Print JSON instead of text");
     add_read_flags(cmd, opt->read);
     strict_reports_bad_triangles(cmd);

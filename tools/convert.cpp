@@ -82,11 +82,14 @@ void run_convert(const ConvertOptions& opt) {
 
 void add_convert(CLI::App& app) {
     auto opt = std::make_shared<ConvertOptions>();
-    CLI::App* cmd = app.add_subcommand(
-        "convert", "Convert between formats (detected by magic bytes, then extension; '-' = stdin/stdout).\n"
-                   "The output appears under its name only when complete; '.gz' outputs are gzip-compressed.");
+    CLI::App* cmd =
+        app.add_subcommand("convert",
+                           "Convert between formats (detected by magic bytes, then extension; '-' = stdin/stdout).\n"
+                           "The output appears under its name only when complete; '.gz' outputs are gzip-compressed.");
     cmd->add_option("input", opt->input, "Input mesh ('-' = stdin)")->required();
-    cmd->add_option("output", opt->output, "Output mesh ('-' = stdout: a pipe gets meshstream's triangle stream, anything else needs --to)")->required();
+    cmd->add_option("output", opt->output,
+                    "Output mesh ('-' = stdout: a pipe gets meshstream's triangle stream, anything else needs --to)")
+        ->required();
     add_clean_flag(cmd, opt->clean);
     add_json_flag(cmd, opt->json);
     add_read_flags(cmd, opt->read);

@@ -10,6 +10,7 @@
 // stream is decimated. Input in streaming order costs nothing extra (an order pass, as
 // `info --order` makes, would read the whole file first); --sort always sorts first, never as
 // read.
+#include "compare/metro.hpp"
 #include "decimate/stream_decimator.hpp"
 #include "io/error.hpp"
 #include "sort/external_sort.hpp"
@@ -19,7 +20,6 @@
 #include "tools/decimate_report.hpp"
 #include "tools/input_filter.hpp"
 #include "tools/run_report.hpp"
-#include "compare/metro.hpp"
 
 #include <chrono>
 #include <cmath>
@@ -34,9 +34,9 @@
 namespace meshstream::tools {
 namespace {
 
+using compare::compare_meshes;
 using compare::CompareOptions;
 using compare::CompareResult;
-using compare::compare_meshes;
 using compare::file_source;
 
 struct DecimateOptions {
@@ -75,8 +75,9 @@ double weld_epsilon(const DecimateOptions& opt, const std::string& input_name) {
         throw CLI::ValidationError("--weld", "must be a non-negative number, found '" + text + "'");
     if (!percent) return value;
     if (!is_regular_file(opt.input))
-        throw UsageError(input_name + ": --weld " + text + " needs the bounding box, found in a first pass over the "
-                                       "input, which a stream cannot be read twice for; give an absolute size instead");
+        throw UsageError(input_name + ": --weld " + text +
+                         " needs the bounding box, found in a first pass over the "
+                         "input, which a stream cannot be read twice for; give an absolute size instead");
     const io::Bounds box = input_bounds(opt.input, opt.read.from, opt.read.options());
     double diag2 = 0;
     for (int i = 0; i < 3; ++i) {
@@ -234,7 +235,8 @@ CountPass count_usable_triangles(const DecimateOptions& opt, const io::ReadOptio
     return pass;
 }
 
-std::unique_ptr<decimate::StreamDecimator> make_decimator(const decimate::Options& options, const io::InputCount& count) {
+std::unique_ptr<decimate::StreamDecimator> make_decimator(const decimate::Options& options,
+                                                          const io::InputCount& count) {
     try {  // on the heap only to catch a refused reservation here
         return std::make_unique<decimate::StreamDecimator>(options, count);
     } catch (const std::bad_alloc&) {
@@ -442,7 +444,10 @@ void run_decimate(const DecimateOptions& opt) {
         };
         const bool whole = decimate_pass(
             next, *decimator, emit, [&] { progress.update(in.count().read, in.source()); },
-            [&] { return may_restart && decimator->stats().forced_writes > 0 && !gate.released() && (!spool || spool->ok()); });
+            [&] {
+                return may_restart && decimator->stats().forced_writes > 0 && !gate.released() &&
+                       (!spool || spool->ok());
+            });
         if (!whole) {
             outcome.kind = SortOutcome::Kind::kSorted;
             outcome.detected_at = in.count().read;
@@ -558,29 +563,37 @@ void run_decimate(const DecimateOptions& opt) {
 void add_decimate(CLI::App& app) {
     auto opt = std::make_shared<DecimateOptions>();
     CLI::App* cmd = app.add_subcommand(
-        "decimate", "Decimate a mesh of any size in one streaming pass (Wu & Kobbelt 2003) with a fixed memory buffer.\n"
-                    "Output size is round(ratio x input), or --target: exactly, unless the mesh cannot get there\n"
-                    "(one more when an odd number is left to remove at the end and no boundary edge can be\n"
-                    "collapsed to remove a single triangle; a warning says so).");
+        "decimate",
+        "Decimate a mesh of any size in one streaming pass (Wu & Kobbelt 2003) with a fixed memory buffer.\n"
+        "Output size is round(ratio x input), or --target: exactly, unless the mesh cannot get there\n"
+        "(one more when an odd number is left to remove at the end and no boundary edge can be\n"
+        "collapsed to remove a single triangle; a warning says so).");
     cmd->add_option("input", opt->input, "Input mesh ('-' = stdin)")->required();
-    cmd->add_option("output", opt->output, "Output mesh ('-' = stdout: a pipe gets meshstream's triangle stream, anything else needs --to)")->required();
-    auto* ratio = cmd->add_option("-r,--ratio", opt->ratio, "Fraction of input triangles to keep, in (0, 1] (default 0.1)")
-                      ->check(open_unit_interval());
-    cmd->add_option("--target", opt->target, "Exact output triangle count (an input that states no count is counted in a first pass; not from a pipe)")
+    cmd->add_option("output", opt->output,
+                    "Output mesh ('-' = stdout: a pipe gets meshstream's triangle stream, anything else needs --to)")
+        ->required();
+    auto* ratio =
+        cmd->add_option("-r,--ratio", opt->ratio, "Fraction of input triangles to keep, in (0, 1] (default 0.1)")
+            ->check(open_unit_interval());
+    cmd->add_option(
+           "--target", opt->target,
+           "Exact output triangle count (an input that states no count is counted in a first pass; not from a pipe)")
         ->excludes(ratio)
         ->check(whole_number(1, "a whole number of triangles"));
     cmd->add_option("--buffer", opt->buffer, "In-core buffer capacity in triangles (memory is fixed by it)")
-        ->capture_default_str()->check(CLI::Range(size_t{16}, size_t{1} << 29));
+        ->capture_default_str()
+        ->check(CLI::Range(size_t{16}, size_t{1} << 29));
     cmd->add_option("--seed", opt->seed, "Random seed (same input, options and seed give identical output)")
-        ->capture_default_str()->check(whole_number(0, "a whole number"));
+        ->capture_default_str()
+        ->check(whole_number(0, "a whole number"));
     cmd->add_option("--weld", opt->weld, "Weld vertices on a grid of this size (absolute, or N% of the bbox diagonal)");
     cmd->add_option("--sorted-axis", opt->sorted_axis,
                     "The input is sorted along this axis: x, y or z (or 0, 1, 2); read from the file when it says so")
         ->transform(CLI::Validator(
             [](std::string& text) -> std::string {
-                static const std::map<std::string, std::string> kAxes = {
-                    {"x", "0"}, {"y", "1"}, {"z", "2"}, {"X", "0"}, {"Y", "1"}, {"Z", "2"},
-                    {"0", "0"}, {"1", "1"}, {"2", "2"}};
+                static const std::map<std::string, std::string> kAxes = {{"x", "0"}, {"y", "1"}, {"z", "2"},
+                                                                         {"X", "0"}, {"Y", "1"}, {"Z", "2"},
+                                                                         {"0", "0"}, {"1", "1"}, {"2", "2"}};
                 const auto it = kAxes.find(text);
                 if (it == kAxes.end()) return "must be x, y or z (or 0, 1, 2), found '" + text + "'";
                 text = it->second;

@@ -41,49 +41,60 @@ void note_decimate_warnings(const DecimateFacts& f, Warnings& warnings) {
                                       (f.default_buffer ? "" : " --buffer " + std::to_string(f.buffer)) + "`";
     const bool axis_conflict = f.given_axis && f.file_axis && *f.given_axis != *f.file_axis;
     if (axis_conflict)
-        warnings.note("sorted_axis_conflict", std::string("--sorted-axis ") + axis_name(*f.given_axis) + " was given, but " + f.input_name +
-                      " says it is sorted along " + axis_name(*f.file_axis) + ": the sweep used " +
-                      axis_name(*f.given_axis) + ", as given");
+        warnings.note("sorted_axis_conflict", std::string("--sorted-axis ") + axis_name(*f.given_axis) +
+                                                  " was given, but " + f.input_name + " says it is sorted along " +
+                                                  axis_name(*f.file_axis) + ": the sweep used " +
+                                                  axis_name(*f.given_axis) + ", as given");
     if (s.forced_writes > 0)
-        warnings.note("forced_writes", "buffer full of undecimatable triangles: " + std::to_string(s.forced_writes) +
-                      " triangles force-written at full resolution (" + std::to_string(s.premature_writes) +
-                      " written before reaching the target resolution; near them a few triangles may come out twice, "
-                      "back to back)" +
-                      (s.orphans_evicted > 0
-                           ? "; " + std::to_string(s.orphans_evicted) +
-                                 " of their vertices were evicted from the weld table to make room, so triangles "
-                                 "read later at those positions are not joined to them (the output has cracks there)"
-                           : std::string()) +
-                      forced_write_remedy(f, axis_conflict, order_command));
+        warnings.note(
+            "forced_writes",
+            "buffer full of undecimatable triangles: " + std::to_string(s.forced_writes) +
+                " triangles force-written at full resolution (" + std::to_string(s.premature_writes) +
+                " written before reaching the target resolution; near them a few triangles may come out twice, "
+                "back to back)" +
+                (s.orphans_evicted > 0
+                     ? "; " + std::to_string(s.orphans_evicted) +
+                           " of their vertices were evicted from the weld table to make room, so triangles "
+                           "read later at those positions are not joined to them (the output has cracks there)"
+                     : std::string()) +
+                forced_write_remedy(f, axis_conflict, order_command));
     if (s.sort_violations > 0)
-        warnings.note("not_sorted_as_stated", std::string("the input is not sorted along ") + axis_name(*f.used_axis) + " as stated: " +
-                      std::to_string(s.sort_violations) + (s.sort_violations == 1 ? " triangle" : " triangles") +
-                      " reached behind the sweep, which was switched off at the first (boundary finalized before it "
-                      "may show as cracks); " +
-                      (axis_conflict ? std::string("leave out --sorted-axis to use the file's own axis")
-                                     : std::string("run `meshstream sort` on it first")));
+        warnings.note(
+            "not_sorted_as_stated",
+            std::string("the input is not sorted along ") + axis_name(*f.used_axis) + " as stated: " +
+                std::to_string(s.sort_violations) + (s.sort_violations == 1 ? " triangle" : " triangles") +
+                " reached behind the sweep, which was switched off at the first (boundary finalized before it "
+                "may show as cracks); " +
+                (axis_conflict ? std::string("leave out --sorted-axis to use the file's own axis")
+                               : std::string("run `meshstream sort` on it first")));
     if (s.nonmanifold_edges > 0)
-        warnings.add("nonmanifold_edges_frozen", "non-manifold, duplicate or mis-oriented edges frozen and passed through", s.nonmanifold_edges);
+        warnings.add("nonmanifold_edges_frozen",
+                     "non-manifold, duplicate or mis-oriented edges frozen and passed through", s.nonmanifold_edges);
     if (s.degenerate_passed > 0)
-        warnings.add("degenerate_triangles_passed", "degenerate triangles (repeated corners) passed through", s.degenerate_passed);
-    if (s.weld_dropped > 0) warnings.add("weld_dropped_triangles", "triangles dropped because --weld merged their corners", s.weld_dropped);
+        warnings.add("degenerate_triangles_passed", "degenerate triangles (repeated corners) passed through",
+                     s.degenerate_passed);
+    if (s.weld_dropped > 0)
+        warnings.add("weld_dropped_triangles", "triangles dropped because --weld merged their corners", s.weld_dropped);
     // Welding that collapses many triangles is coarser than the mesh: it removes surface
     // detail the decimation would have kept.
     if (f.weld_eps > 0 && s.weld_dropped * 100 > s.triangles_in)
-        warnings.note("weld_too_coarse", "--weld " + f.weld_text + " welded the corners of " +
-                      std::to_string(s.weld_dropped * 100 / s.triangles_in) +
-                      " % of the triangles together: it is coarser than the mesh; weld on a smaller size");
+        warnings.note("weld_too_coarse",
+                      "--weld " + f.weld_text + " welded the corners of " +
+                          std::to_string(s.weld_dropped * 100 / s.triangles_in) +
+                          " % of the triangles together: it is coarser than the mesh; weld on a smaller size");
     // Triangles that share no corners exactly (cracks from float round-off, a soup written
     // triangle by triangle) leave every edge open: decimation then eats the surface from every
     // crack and still lands on its count. A mesh has far fewer open edges than triangles (a
     // strip one triangle wide about one per triangle); a soup has three. (A few loose triangles
     // are no surface to warn about; an input without triangles: the read loop's note says so.)
     if (s.triangles_in >= 100 && s.boundary_edges * 2 > s.triangles_in * 3)
-        warnings.note("unwelded_surface", std::to_string(s.boundary_edges) + " edges had no partner, " +
-                      std::to_string(s.boundary_edges / s.triangles_in) + "." +
-                      std::to_string(s.boundary_edges * 10 / s.triangles_in % 10) +
-                      " per triangle: the triangles share few corners exactly (an unwelded surface?), and "
-                      "decimation removes surface along every open edge; --weld EPS snaps corners to a grid of EPS");
+        warnings.note(
+            "unwelded_surface",
+            std::to_string(s.boundary_edges) + " edges had no partner, " +
+                std::to_string(s.boundary_edges / s.triangles_in) + "." +
+                std::to_string(s.boundary_edges * 10 / s.triangles_in % 10) +
+                " per triangle: the triangles share few corners exactly (an unwelded surface?), and "
+                "decimation removes surface along every open edge; --weld EPS snaps corners to a grid of EPS");
     const std::string missed = "output has " + std::to_string(s.triangles_out) + " triangles instead of the target " +
                                std::to_string(s.target_triangles);
     // Skipped triangles that come late leave --target short: the part read before them was
@@ -93,30 +104,35 @@ void note_decimate_warnings(const DecimateFacts& f, Warnings& warnings) {
                                      "them had been decimated for the larger input the header promised; `meshstream "
                                      "convert --clean` drops them into a copy that lands on the target";
     if (s.triangles_in > 0 && s.target_triangles > s.triangles_in)
-        warnings.note("target_exceeds_input", "the target " + std::to_string(s.target_triangles) + " is more than the " +
-                      std::to_string(s.triangles_in) + " usable input triangles: " +
-                      (s.collapses == 0 ? std::string("nothing was decimated") : missed + "; " + skipped_late));
+        warnings.note("target_exceeds_input",
+                      "the target " + std::to_string(s.target_triangles) + " is more than the " +
+                          std::to_string(s.triangles_in) + " usable input triangles: " +
+                          (s.collapses == 0 ? std::string("nothing was decimated") : missed + "; " + skipped_late));
     else if (f.target_given && s.triangles_in > 0 && s.triangles_out < s.target_triangles && f.skipped > 0)
         warnings.note("target_missed", missed + " (" + skipped_late + ")");
     else if (s.triangles_in > 0 && s.triangles_out == s.target_triangles + 1)
         warnings.note(
-            "target_missed", missed +
-            " (a collapse removes two triangles, and no boundary edge could be collapsed to remove the odd one)");
+            "target_missed",
+            missed +
+                " (a collapse removes two triangles, and no boundary edge could be collapsed to remove the odd one)");
     else if (s.triangles_in > 0 && s.triangles_out != s.target_triangles && s.forced_writes > 0)
-        warnings.note("target_missed", missed + " (the triangles force-written at full resolution, above, count against it)");
+        warnings.note("target_missed",
+                      missed + " (the triangles force-written at full resolution, above, count against it)");
     else if (s.triangles_in > 0 && s.triangles_out != s.target_triangles && s.no_valid_collapse_left)
-        warnings.note("target_missed", missed +
-                      " (no allowed collapse is left: each would fold a face over or change the topology, "
-                      "or move a vertex that must stay, as on a non-manifold edge)");
+        warnings.note("target_missed",
+                      missed +
+                          " (no allowed collapse is left: each would fold a face over or change the topology, "
+                          "or move a vertex that must stay, as on a non-manifold edge)");
     else if (s.triangles_in > 0 && s.triangles_out > s.target_triangles && s.nonmanifold_edges > 0)
-        warnings.note("target_missed", missed + " (the " + std::to_string(s.nonmanifold_edges) +
-                      " non-manifold, duplicate or mis-oriented edges above are frozen with their vertices: "
-                      "faces wound against their neighbours join none of them)");
+        warnings.note("target_missed",
+                      missed + " (the " + std::to_string(s.nonmanifold_edges) +
+                          " non-manifold, duplicate or mis-oriented edges above are frozen with their vertices: "
+                          "faces wound against their neighbours join none of them)");
     else if (s.triangles_in > 0 && s.triangles_out != s.target_triangles)
         warnings.note("target_missed", missed + " (too little left that could be decimated)");
     else if (s.triangles_in > 0 && s.target_triangles == 0)
         warnings.note("target_rounds_to_zero", "the target rounds to 0 triangles (" + std::to_string(s.triangles_in) +
-                      " in): the output is empty; give a larger --ratio or --target");
+                                                   " in): the output is empty; give a larger --ratio or --target");
 }
 
 std::string count_pass_notice(uint64_t triangles, double seconds) {
@@ -158,8 +174,8 @@ nlohmann::ordered_json decimate_details_json(const DecimateFacts& f) {
     j["collapses"] = s.collapses;
     j["forced_writes"] = s.forced_writes;
     j["skipped_triangles"] = f.skipped;
-    j["sorted_axis"] = f.used_axis ? nlohmann::ordered_json(std::string(1, axis_name(*f.used_axis)))
-                                   : nlohmann::ordered_json(nullptr);
+    j["sorted_axis"] =
+        f.used_axis ? nlohmann::ordered_json(std::string(1, axis_name(*f.used_axis))) : nlohmann::ordered_json(nullptr);
     if (f.weld_eps > 0) j["weld"] = {{"size", f.weld_eps}, {"vertices_merged", s.vertices_merged}};
     if (f.count_pass_seconds) j["count_pass_seconds"] = *f.count_pass_seconds;
     if (f.sort.kind == SortOutcome::Kind::kSorted)

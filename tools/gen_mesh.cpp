@@ -29,14 +29,14 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
-#include <condition_variable>
-#include <mutex>
-#include <thread>
 #include <cmath>
+#include <condition_variable>
 #include <cstdio>
 #include <cstring>
 #include <memory>
+#include <mutex>
 #include <numbers>
+#include <thread>
 #include <vector>
 
 namespace meshstream::tools {
@@ -413,10 +413,11 @@ int run(const GenOptions& opt) {
         constexpr uint64_t kBucketBytes = uint64_t{128} << 20;
         size_t buckets = size_t(std::clamp<uint64_t>(opt.triangles * 36 / kBucketBytes + 1, 1, 64));
         std::vector<std::unique_ptr<io::TempFile>> files;
-        for (size_t b = 0; b < buckets; ++b) files.push_back(std::make_unique<io::TempFile>(opt.tmpdir, "meshstream-gen"));
+        for (size_t b = 0; b < buckets; ++b)
+            files.push_back(std::make_unique<io::TempFile>(opt.tmpdir, "meshstream-gen"));
         Rng rng{opt.seed ^ 0x53485546ull};
         count = march_parallel(table, shape, n, holes, threads,
-                      [&](const float* tri) { files[rng.next() % buckets]->write(tri, 9 * sizeof(float)); });
+                               [&](const float* tri) { files[rng.next() % buckets]->write(tri, 9 * sizeof(float)); });
         // One allocation for the largest bucket: growing the vector from bucket to bucket held
         // two buckets at once while it copied (251 MB for 10 M triangles, now 134).
         uint64_t largest = 0;
@@ -458,11 +459,13 @@ int main(int argc, char** argv) {
         "flight, about 45 MB for 10 M and 150 MB for 50 M triangles with two threads (less with --threads 1);\n"
         "--shuffle adds bucket files in --tmpdir and one bucket of at most 128 MiB in memory."};
     app.add_option("output", opt.output, "Output mesh (format from the extension, or --to)")->required();
-    app.add_option("-n,--triangles", opt.triangles, "Target triangle count (met within 1 % from about 10000 up; small ones overshoot: 100 gives 160)")
+    app.add_option("-n,--triangles", opt.triangles,
+                   "Target triangle count (met within 1 % from about 10000 up; small ones overshoot: 100 gives 160)")
         ->capture_default_str()
         ->check(CLI::Range(uint64_t{100}, uint64_t{1} << 40));
     app.add_option("--seed", opt.seed, "Random seed (shape phases, holes, shuffle)")
-        ->capture_default_str()->check(meshstream::tools::whole_number(0, "a whole number"));
+        ->capture_default_str()
+        ->check(meshstream::tools::whole_number(0, "a whole number"));
     app.add_flag("--shuffle", opt.shuffle, "Write triangles in random order (out of core)");
     app.add_flag("--holes", opt.holes, "Punch 40 holes into the surface, like occlusions in a scan");
     app.add_option("--to", opt.to, "Output format (stl, stl-ascii, ...; default: by extension)");

@@ -2,13 +2,13 @@
 // channels the file carries (normals, colours, texture coordinates, named scalars, materials)
 // and what the reader skipped or repaired, in one streaming pass (memory: one chunk of
 // positions; attribute values are not read), as plain text or --json.
+#include "compare/order.hpp"
+#include "compare/topology.hpp"
 #include "io/error.hpp"
 #include "tools/cli_checks.hpp"
 #include "tools/commands.hpp"
 #include "tools/common.hpp"
 #include "tools/input_filter.hpp"
-#include "compare/topology.hpp"
-#include "compare/order.hpp"
 #include "tools/order_text.hpp"
 
 #include <nlohmann/json.hpp>
@@ -33,7 +33,7 @@ using compare::TopologyReport;
 struct InfoOptions {
     std::string input;
     bool json = false;
-    bool topology = false;  // --topology: vertex and edge counts (tools/topology.hpp)
+    bool topology = false;     // --topology: vertex and edge counts (tools/topology.hpp)
     bool order = false;        // --order: measure the stream's width (compare/order.hpp)
     uint64_t buffer = 400000;  // --buffer: decimation buffer to judge against the width
     double ratio = 0.1;        // --ratio: the decimation ratio it is judged for
@@ -71,7 +71,8 @@ void accumulate(const io::TriangleChunk& chunk, InfoStats& s) {
             e1[a] = double(p[3 + a]) - p[a];
             e2[a] = double(p[6 + a]) - p[a];
         }
-        double cx = e1[1] * e2[2] - e1[2] * e2[1], cy = e1[2] * e2[0] - e1[0] * e2[2], cz = e1[0] * e2[1] - e1[1] * e2[0];
+        double cx = e1[1] * e2[2] - e1[2] * e2[1], cy = e1[2] * e2[0] - e1[0] * e2[2],
+               cz = e1[0] * e2[1] - e1[1] * e2[0];
         if (cx == 0 && cy == 0 && cz == 0) ++s.degenerate;
     }
     s.triangles += chunk.size();
@@ -132,7 +133,8 @@ void run_info(const InfoOptions& opt) {
     positions.vertex_id = header.channels.vertex_id;
     io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, positions);
     std::unique_ptr<TopologyCounter> topology;
-    if (opt.topology) topology = std::make_unique<TopologyCounter>(opt.read.options().memory_budget_bytes, opt.read.tmpdir);
+    if (opt.topology)
+        topology = std::make_unique<TopologyCounter>(opt.read.options().memory_budget_bytes, opt.read.tmpdir);
     std::optional<OrderMeter> meter;
     if (opt.order) meter.emplace(opt.read.options().memory_budget_bytes);
     {
@@ -216,22 +218,24 @@ void run_info(const InfoOptions& opt) {
             o["buffer"] = opt.buffer;
             o["ratio"] = opt.ratio;
             o["buffer_needed"] = buffer_needed(r, opt.ratio);
-            o["buffer_suffices"] = v == BufferVerdict::kSuffices ? nlohmann::json(true)
-                                   : v == BufferVerdict::kTooSmall ? nlohmann::json(false) : nlohmann::json(nullptr);
+            o["buffer_suffices"] = v == BufferVerdict::kSuffices   ? nlohmann::json(true)
+                                   : v == BufferVerdict::kTooSmall ? nlohmann::json(false)
+                                                                   : nlohmann::json(nullptr);
             o["key_descents"] = {{"x", r.descents[0]}, {"y", r.descents[1]}, {"z", r.descents[2]}};
         }
         std::printf("%s\n", j.dump(2).c_str());
         return;
     }
     std::printf("file:        %s\n", opt.input.c_str());
-    std::printf("format:      %s%s%s%s\n", std::string(in.format().name).c_str(),
-                header.variant.empty() ? "" : " (", header.variant.c_str(), header.variant.empty() ? "" : ")");
+    std::printf("format:      %s%s%s%s\n", std::string(in.format().name).c_str(), header.variant.empty() ? "" : " (",
+                header.variant.c_str(), header.variant.empty() ? "" : ")");
     if (in.source().gzip()) std::printf("compression: gzip (%llu bytes decoded)\n", (unsigned long long)decoded_bytes);
     if (has_file_size) std::printf("file size:   %llu bytes\n", (unsigned long long)file_size);
     std::printf("triangles:   %llu\n", (unsigned long long)stats.triangles);
     if (header.vertex_count) std::printf("vertices:    %llu\n", (unsigned long long)*header.vertex_count);
     std::printf("degenerate:  %llu (zero area)\n", (unsigned long long)stats.degenerate);
-    if (stats.non_finite) std::printf("non-finite:  %llu (NaN or infinite coordinates)\n", (unsigned long long)stats.non_finite);
+    if (stats.non_finite)
+        std::printf("non-finite:  %llu (NaN or infinite coordinates)\n", (unsigned long long)stats.non_finite);
     if (has_box) {
         std::printf("bbox min:    %.9g %.9g %.9g\n", stats.min[0], stats.min[1], stats.min[2]);
         std::printf("bbox max:    %.9g %.9g %.9g\n", stats.max[0], stats.max[1], stats.max[2]);

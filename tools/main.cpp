@@ -39,7 +39,8 @@ int main(int argc, char** argv) {
             names += (names.empty() ? "" : ", ") + sub->get_name();
         }
         if (!known) {
-            std::fprintf(stderr, "meshstream: unknown command '%s' (one of: %s; see --help)\n", arg.c_str(), names.c_str());
+            std::fprintf(stderr, "meshstream: unknown command '%s' (one of: %s; see --help)\n", arg.c_str(),
+                         names.c_str());
             return 2;
         }
         break;

@@ -10,9 +10,9 @@ const char* const kAxisNames[] = {"x", "y", "z"};
 
 }  // namespace
 
-using compare::BufferVerdict;
 using compare::buffer_needed;
 using compare::buffer_verdict;
+using compare::BufferVerdict;
 using compare::OrderReport;
 
 std::string format_order_text(const OrderReport& r, uint64_t buffer_triangles, double ratio,
@@ -23,8 +23,8 @@ std::string format_order_text(const OrderReport& r, uint64_t buffer_triangles, d
     if (r.exact()) {
         out += " (exact)";
     } else {
-        std::snprintf(buf, sizeof buf, " ± %.0f (3σ; sampled 1/%.0f of the triangles to fit --memory)",
-                      r.width_error, 1 / r.sample_rate);
+        std::snprintf(buf, sizeof buf, " ± %.0f (3σ; sampled 1/%.0f of the triangles to fit --memory)", r.width_error,
+                      1 / r.sample_rate);
         out += buf;
     }
     if (r.triangles > 0) {
@@ -39,14 +39,16 @@ std::string format_order_text(const OrderReport& r, uint64_t buffer_triangles, d
     std::snprintf(buf, sizeof buf, " at --ratio %g (needs about %llu)", ratio,
                   static_cast<unsigned long long>(buffer_needed(r, ratio)));
     out += "buffer:      --buffer " + std::to_string(buffer_triangles) +
-           (v == BufferVerdict::kSuffices  ? " suffices"
+           (v == BufferVerdict::kSuffices   ? " suffices"
             : v == BufferVerdict::kTooSmall ? " is too small (decimate would force-write)"
-                                            : " may be too small") + buf;
+                                            : " may be too small") +
+           buf;
     // A surface in streaming order is a few percent wide at most (the bunny sorted: 1.1 %, a
     // 1 M mesh: 0.6 %); a shuffled one about three quarters: then sorting is the remedy.
     if (v != BufferVerdict::kSuffices && !flagged_sorted && r.width * 10 > r.triangles && r.triangles >= 10000)
-        out += ": the file is in no streaming order (its width is a tenth of it or more), so `meshstream sort` "
-               "it first";
+        out +=
+            ": the file is in no streaming order (its width is a tenth of it or more), so `meshstream sort` "
+            "it first";
     if (v == BufferVerdict::kSuffices && !flagged_sorted)
         out += flagged_axis ? ", unless the surface has holes: the file is not sorted as it says, so their rims stay "
                               "open to the end"

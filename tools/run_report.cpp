@@ -1,8 +1,8 @@
 // --json's object for convert, decimate and sort: see run_report.hpp.
 #include "tools/run_report.hpp"
 
-#include <cstdio>
 #include <sys/stat.h>
+#include <cstdio>
 
 namespace meshstream::tools {
 
@@ -19,8 +19,8 @@ nlohmann::ordered_json run_report_json(const RunReport& r, const Warnings& warni
     j["triangles_in"] = r.triangles_in;
     j["triangles_out"] = r.triangles_out;
     j["seconds"] = r.seconds;
-    j["triangles_per_second"] = r.seconds > 0 ? nlohmann::ordered_json(double(r.triangles_in) / r.seconds)
-                                              : nlohmann::ordered_json(nullptr);
+    j["triangles_per_second"] =
+        r.seconds > 0 ? nlohmann::ordered_json(double(r.triangles_in) / r.seconds) : nlohmann::ordered_json(nullptr);
     j["peak_rss_bytes"] = r.peak_rss_bytes;
     if (!r.details.empty()) j[r.command] = r.details;
     nlohmann::ordered_json list = nlohmann::ordered_json::array();

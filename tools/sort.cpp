@@ -184,8 +184,8 @@ void run_sort(const SortOptions& opt) {
     io::ReadOptions ro = opt.read.options();
     ro.memory_budget_bytes = budget / 4;
     const std::string tmpdir = !opt.read.tmpdir.empty() ? opt.read.tmpdir
-                               : !output_stream        ? io::parent_dir(opt.output)
-                                                       : std::string();
+                               : !output_stream         ? io::parent_dir(opt.output)
+                                                        : std::string();
     ro.tmpdir = tmpdir;
 
     if (opt.axis == "auto" && !is_regular_file(opt.input))
@@ -197,9 +197,10 @@ void run_sort(const SortOptions& opt) {
     const std::string input_name = in.name();  // the reader is released before the merge
     const RunFile input_file{opt.input, std::string(in.format().name), in.source().gzip()};
     refuse_output_over_inputs(opt.output, out_format, opt.write.options(opt.read), {input_files(opt.input, header)});
-    const int axis = opt.axis == "auto" ? longest_axis(input_bounds(opt.input, opt.read.from, ro))
-                                        : static_cast<int>(std::find(std::begin(kAxisNames), std::end(kAxisNames), opt.axis) -
-                                                           std::begin(kAxisNames));
+    const int axis = opt.axis == "auto"
+                         ? longest_axis(input_bounds(opt.input, opt.read.from, ro))
+                         : static_cast<int>(std::find(std::begin(kAxisNames), std::end(kAxisNames), opt.axis) -
+                                            std::begin(kAxisNames));
     sort::SorterOptions so;
     so.axis = axis;
     so.tmpdir = tmpdir;
@@ -229,8 +230,7 @@ void run_sort(const SortOptions& opt) {
     so.on_merge_progress = [&](int pass, int pass_count, uint64_t merged) {
         if (pass != shown_pass) {
             shown_pass = pass;
-            progress.phase("merge pass " + std::to_string(pass) + "/" + std::to_string(pass_count),
-                           std::nullopt);
+            progress.phase("merge pass " + std::to_string(pass) + "/" + std::to_string(pass_count), std::nullopt);
         }
         progress.update(merged);
     };
@@ -258,7 +258,8 @@ void run_sort(const SortOptions& opt) {
         while (io::TriangleChunk* chunk = pipe.get_full()) {
             sorter.add(*chunk);
             pipe.put_free(chunk);
-            progress.update(read.load(std::memory_order_relaxed), bytes_read.load(std::memory_order_relaxed), file_bytes);
+            progress.update(read.load(std::memory_order_relaxed), bytes_read.load(std::memory_order_relaxed),
+                            file_bytes);
         }
     }
     // What the reader noted by the end of the input (a last line without a line end), before
@@ -311,18 +312,19 @@ void run_sort(const SortOptions& opt) {
     if (!dropped.empty()) warnings.note("channels_dropped", dropped_channels_text(dropped, *out.format, so.channels));
     // Only STL, PLY and OBJ have a place for the axis (a header or a comment).
     if (out.format->traits & io::Format::kDracoUnlessOff)
-        warnings.note("sorted_axis_not_recorded", std::string(opt.output == "-" ? "<stdout>" : opt.output) +
-                      ": glTF has no place for the sorted axis: decimate it with --sorted-axis " + "xyz"[axis] +
-                      ", or sort to STL, PLY or OBJ, which record it");
+        warnings.note("sorted_axis_not_recorded",
+                      std::string(opt.output == "-" ? "<stdout>" : opt.output) +
+                          ": glTF has no place for the sorted axis: decimate it with --sorted-axis " + "xyz"[axis] +
+                          ", or sort to STL, PLY or OBJ, which record it");
     note_dropped_triangles(dropped_triangles(in), "removed (--clean)", warnings);
     note_input_changes(end_header, input_name, warnings);
     warnings.print();
 
     if (opt.stats)
-        std::fprintf(stderr, "%s\n",
-                     sort_stats_line(sorter.stats(), axis, seconds_since(t0), input_seconds, sort_seconds,
-                                     peak_rss_bytes())
-                         .c_str());
+        std::fprintf(
+            stderr, "%s\n",
+            sort_stats_line(sorter.stats(), axis, seconds_since(t0), input_seconds, sort_seconds, peak_rss_bytes())
+                .c_str());
     if (opt.json) {
         RunReport report;
         report.command = "sort";
@@ -346,11 +348,14 @@ void run_sort(const SortOptions& opt) {
 
 void add_sort(CLI::App& app) {
     auto opt = std::make_shared<SortOptions>();
-    CLI::App* cmd = app.add_subcommand(
-        "sort", "Sort triangles by their minimum coordinate along an axis (out of core, stable), so that\n"
-                "decimate can stream them; the output records the axis (see docs/sorting.md)");
+    CLI::App* cmd =
+        app.add_subcommand("sort",
+                           "Sort triangles by their minimum coordinate along an axis (out of core, stable), so that\n"
+                           "decimate can stream them; the output records the axis (see docs/sorting.md)");
     cmd->add_option("input", opt->input, "Input mesh ('-' = stdin, needs --axis x|y|z)")->required();
-    cmd->add_option("output", opt->output, "Output mesh ('-' = stdout: a pipe gets meshstream's triangle stream, anything else needs --to)")->required();
+    cmd->add_option("output", opt->output,
+                    "Output mesh ('-' = stdout: a pipe gets meshstream's triangle stream, anything else needs --to)")
+        ->required();
     cmd->add_option("--axis", opt->axis, "x, y, z, or auto: the longest bounding-box axis (default; needs a file)")
         ->check(CLI::IsMember({"x", "y", "z", "auto"}));
     cmd->add_flag("--stats", opt->stats, "Print runs, merge passes, temporary disk, time and peak RSS on stderr");
@@ -358,8 +363,10 @@ void add_sort(CLI::App& app) {
     add_json_flag(cmd, opt->json);
     add_read_flags(cmd, opt->read);
     add_drop_flag(cmd, opt->read);
-    cmd->get_option("--tmpdir")->description("Directory for sort runs and spills (default: the output's directory; $TMPDIR "
-                                             "or /tmp when writing to stdout, a pipe or a device)");
+    cmd->get_option("--tmpdir")
+        ->description(
+            "Directory for sort runs and spills (default: the output's directory; $TMPDIR "
+            "or /tmp when writing to stdout, a pipe or a device)");
     add_write_flags(cmd, opt->write);
     cmd->callback([opt] { run_sort(*opt); });
 }

@@ -2,9 +2,9 @@
 // itself, the Hausdorff distance of a translated sphere, the closed-form RMS of a tilted square
 // against a flat one, edge counts on tiny hand-made meshes (in memory and spilled), which mesh
 // is held in memory, and the CLI's exit codes and messages.
+#include "compare/metro.hpp"
 #include "io/error.hpp"
 #include "io/format.hpp"
-#include "compare/metro.hpp"
 
 #include "test_util.hpp"
 
@@ -273,8 +273,10 @@ TEST(Metro, HoldsTheSmallerFileAndStreamsTheLarger) {
         ply << "ply\nformat ascii 1.0\nelement vertex " << small.size() / 3
             << "\nproperty float x\nproperty float y\nproperty float z\nelement face " << small.size() / 9
             << "\nproperty list uchar int vertex_indices\nend_header\n";
-        for (size_t i = 0; i < small.size(); i += 3) ply << small[i] << ' ' << small[i + 1] << ' ' << small[i + 2] << '\n';
-        for (size_t t = 0; t < small.size() / 9; ++t) ply << "3 " << 3 * t << ' ' << 3 * t + 1 << ' ' << 3 * t + 2 << '\n';
+        for (size_t i = 0; i < small.size(); i += 3)
+            ply << small[i] << ' ' << small[i + 1] << ' ' << small[i + 2] << '\n';
+        for (size_t t = 0; t < small.size() / 9; ++t)
+            ply << "3 " << 3 * t << ' ' << 3 * t + 1 << ' ' << 3 * t + 2 << '\n';
     }
     CompareResult r3 = compare_meshes(file_source((tmp.path() / "small.ply").string()),
                                       file_source((tmp.path() / "big.stl").string()), options);
@@ -317,7 +319,8 @@ RunResult run_cli(const fs::path& dir, const std::string& args) {
 TEST(CompareCli, MissingFileExitsOneNamingTheFile) {
     TempDir tmp;
     write_mesh(tmp.path() / "s.stl", sphere(1));
-    RunResult r = run_cli(tmp.path(), "compare " + (tmp.path() / "s.stl").string() + " " + (tmp.path() / "nope.stl").string());
+    RunResult r =
+        run_cli(tmp.path(), "compare " + (tmp.path() / "s.stl").string() + " " + (tmp.path() / "nope.stl").string());
     EXPECT_EQ(r.exit_code, 1);
     EXPECT_NE(r.err.find("nope.stl"), std::string::npos) << r.err;
     EXPECT_EQ(r.err.rfind("meshstream: error: ", 0), 0u) << r.err;
@@ -327,7 +330,8 @@ TEST(CompareCli, GarbageFileExitsOneNamingTheFile) {
     TempDir tmp;
     write_mesh(tmp.path() / "s.stl", sphere(1));
     std::ofstream(tmp.path() / "bad.stl") << "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 zero\n";
-    RunResult r = run_cli(tmp.path(), "compare " + (tmp.path() / "bad.stl").string() + " " + (tmp.path() / "s.stl").string());
+    RunResult r =
+        run_cli(tmp.path(), "compare " + (tmp.path() / "bad.stl").string() + " " + (tmp.path() / "s.stl").string());
     EXPECT_EQ(r.exit_code, 1);
     EXPECT_NE(r.err.find("bad.stl"), std::string::npos) << r.err;
 }
@@ -343,9 +347,11 @@ TEST(CompareCli, BadOptionExitsTwo) {
     if (double(::sysconf(_SC_PHYS_PAGES)) * double(::sysconf(_SC_PAGESIZE)) < 2.5e11) {
         r = run_cli(tmp.path(), "compare a.stl b.stl --samples 4294967296");
         EXPECT_EQ(r.exit_code, 2);
-        EXPECT_NE(r.err.find("--samples 4294967296: the held mesh's samples alone take about 257.70 GB (60 bytes each), "
-                             "more than this machine's memory"),
-                  std::string::npos) << r.err;
+        EXPECT_NE(
+            r.err.find("--samples 4294967296: the held mesh's samples alone take about 257.70 GB (60 bytes each), "
+                       "more than this machine's memory"),
+            std::string::npos)
+            << r.err;
     }
 }
 
@@ -354,12 +360,13 @@ TEST(CompareCli, JsonReportsBothDirectionsAndCounts) {
     write_mesh(tmp.path() / "a.stl", sphere(3));
     write_mesh(tmp.path() / "b.stl", sphere(3));
     RunResult r = run_cli(tmp.path(), "compare --samples 5000 --json " + (tmp.path() / "a.stl").string() + " " +
-                                        (tmp.path() / "b.stl").string());
+                                          (tmp.path() / "b.stl").string());
     ASSERT_EQ(r.exit_code, 0) << r.err;
     for (const char* key : {"\"a_to_b\"", "\"b_to_a\"", "\"symmetric\"", "\"rms_pct\"", "\"boundary_edges\": 0",
                             "\"non_manifold_edges\": 0", "\"triangles\": 512", "\"held_in_memory\": true"})
         EXPECT_NE(r.out.find(key), std::string::npos) << key << "\n" << r.out;
-    r = run_cli(tmp.path(), "compare --samples 5000 " + (tmp.path() / "a.stl").string() + " " + (tmp.path() / "b.stl").string());
+    r = run_cli(tmp.path(),
+                "compare --samples 5000 " + (tmp.path() / "a.stl").string() + " " + (tmp.path() / "b.stl").string());
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_NE(r.out.find("symmetric"), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("boundary edges 0"), std::string::npos) << r.out;
@@ -394,9 +401,11 @@ TEST(CompareCli, ADirectionWithoutSamplesIsNotMeasuredNotZero) {
     EXPECT_NE(r.out.find("A -> B     no samples: not measured"), std::string::npos) << r.out;
     EXPECT_NE(r.err.find("warning: no samples on " + (tmp.path() / "flat.stl").string() +
                          " (its triangles have no area): A -> B is not measured"),
-              std::string::npos) << r.err;
+              std::string::npos)
+        << r.err;
     EXPECT_NE(r.err.find("A -> B is not measured, and the symmetric figures are the other direction's alone"),
-              std::string::npos) << r.err;
+              std::string::npos)
+        << r.err;
     r = run_cli(tmp.path(), "compare --json " + args);
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_NE(r.out.find("\"samples\": 0,\n    \"max\": null"), std::string::npos) << r.out;
@@ -409,13 +418,13 @@ TEST(CompareCli, ADirectionWithoutSamplesIsNotMeasuredNotZero) {
     // decimate --report used to print "Hausdorff 0 (0.0000 %)" for the same meshes, and to
     // fail (exit 1, after writing) when the output had no triangles.
     r = run_cli(tmp.path(), "decimate -r 0.5 --report " + (tmp.path() / "flat.stl").string() + " " +
-                              (tmp.path() / "flat_out.stl").string());
+                                (tmp.path() / "flat_out.stl").string());
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_NE(r.err.find("error vs input: not measured (no samples: the triangles have no area)"), std::string::npos)
         << r.err;
     write_mesh(tmp.path() / "one.stl", {0, 0, 0, 1, 0, 0, 0, 1, 0});
     r = run_cli(tmp.path(), "decimate -r 0.1 --report " + (tmp.path() / "one.stl").string() + " " +
-                              (tmp.path() / "none.stl").string());
+                                (tmp.path() / "none.stl").string());
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_NE(r.err.find("error vs input: not measured (the output has no triangles)"), std::string::npos) << r.err;
 }
@@ -426,7 +435,8 @@ TEST(CompareCli, HugePercentagesAreWrittenInFull) {
     TempDir tmp;
     write_mesh(tmp.path() / "small.stl", {0, 0, 0, 1, 0, 0, 0, 1, 0});
     write_mesh(tmp.path() / "far.stl", {0, 0, 0, 3e30f, 0, 0, 0, 3e30f, 0});
-    RunResult r = run_cli(tmp.path(), "compare " + (tmp.path() / "small.stl").string() + " " + (tmp.path() / "far.stl").string());
+    RunResult r =
+        run_cli(tmp.path(), "compare " + (tmp.path() / "small.stl").string() + " " + (tmp.path() / "far.stl").string());
     ASSERT_EQ(r.exit_code, 0) << r.err;
     const size_t b_to_a = r.out.find("B -> A     max ");
     ASSERT_NE(b_to_a, std::string::npos) << r.out;
@@ -458,8 +468,9 @@ TEST(Metro, HeldSamplesFarFromTheStreamedSurfaceAreExactToo) {
     EXPECT_GT(r.a_to_b.max, 0.99);
     EXPECT_LE(r.a_to_b.max, 1.0 + 1e-6);
     // And every held sample's distance is exactly its height (to float storage).
-    const CompareResult flat = compare_meshes(memory_source("high", {0, 0, 0.5f, 1, 0, 0.5f, 1, 1, 0.5f, 0, 0, 0.5f, 1, 1, 0.5f, 0, 1, 0.5f}),
-                                              memory_source("grid", grid), options);
+    const CompareResult flat =
+        compare_meshes(memory_source("high", {0, 0, 0.5f, 1, 0, 0.5f, 1, 1, 0.5f, 0, 0, 0.5f, 1, 1, 0.5f, 0, 1, 0.5f}),
+                       memory_source("grid", grid), options);
     EXPECT_NEAR(flat.a_to_b.max, 0.5, 1e-7);
     EXPECT_NEAR(flat.a_to_b.mean, 0.5, 1e-7);
     EXPECT_NEAR(flat.b_to_a.max, 0.5, 1e-7);

@@ -38,7 +38,8 @@ uint64_t brute_force_width(const std::vector<Tri>& tris) {
         for (int v = 0; v < 3; ++v) last[{tris[i][3 * v], tris[i][3 * v + 1], tris[i][3 * v + 2]}] = i;
     std::vector<size_t> L(tris.size());
     for (size_t i = 0; i < tris.size(); ++i)
-        for (int v = 0; v < 3; ++v) L[i] = std::max(L[i], last[{tris[i][3 * v], tris[i][3 * v + 1], tris[i][3 * v + 2]}]);
+        for (int v = 0; v < 3; ++v)
+            L[i] = std::max(L[i], last[{tris[i][3 * v], tris[i][3 * v + 1], tris[i][3 * v + 2]}]);
     uint64_t best = 0;
     for (size_t j = 0; j < tris.size(); ++j) {
         uint64_t open = 0;

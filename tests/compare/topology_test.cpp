@@ -31,7 +31,7 @@ TEST(Topology, MatchesTheCorpusManifest) {
         uint64_t vertices, boundary, non_manifold;
     };
     const Case cases[] = {
-        {"ply/cube_uv.ply", true, 24, 24, 0},            // 24 unwelded corner vertices
+        {"ply/cube_uv.ply", true, 24, 24, 0},  // 24 unwelded corner vertices
         // One concave face, a ring: ear clipping covers it once, so the outline and the hole
         // are the 64 boundary edges (the fan it had before folded: 63 and 2 non-manifold).
         {"obj/concave_polygon.obj", true, 64, 64, 0},
@@ -65,8 +65,8 @@ TEST(Topology, SpillingGivesTheSameCounts) {
 }
 
 TEST(Topology, InfoPrintsIt) {
-    std::string cmd = std::string(MESHSTREAM_BINARY) + " -q info --topology " + MESHSTREAM_FIXTURES_DIR +
-                      "/obj/WusonOBJ.obj.gz";
+    std::string cmd =
+        std::string(MESHSTREAM_BINARY) + " -q info --topology " + MESHSTREAM_FIXTURES_DIR + "/obj/WusonOBJ.obj.gz";
     FILE* p = popen(cmd.c_str(), "r");
     ASSERT_NE(p, nullptr);
     std::string out;
@@ -74,5 +74,6 @@ TEST(Topology, InfoPrintsIt) {
     while (fgets(buf, sizeof buf, p)) out += buf;
     EXPECT_EQ(pclose(p), 0);
     EXPECT_NE(out.find("topology:    2117 vertices (welded by vertex id), 5804 edges, 412 boundary, 0 non-manifold"),
-              std::string::npos) << out;
+              std::string::npos)
+        << out;
 }

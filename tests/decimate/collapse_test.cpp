@@ -132,8 +132,8 @@ TEST(Collapse, SecondFanAtEitherEndIsSeen) {
     // later triangle would get a new vertex at the same position.
     auto build = [&](HalfEdgeBuffer& buffer, const float* extra_a, const float* extra_b) {
         if (extra_a != nullptr) {
-            const float tri[9] = {extra_a[0], extra_a[1], extra_a[2], extra_b[0], extra_b[1], extra_b[2],
-                                  apex[0],    apex[1],    apex[2]};
+            const float tri[9] = {extra_a[0], extra_a[1], extra_a[2], extra_b[0], extra_b[1],
+                                  extra_b[2], apex[0],    apex[1],    apex[2]};
             ASSERT_NE(buffer.add_triangle(tri).face, kNoIndex);
         }
         add_grid(buffer);
@@ -195,14 +195,14 @@ TEST(Collapse, PlacementTargetsAreStoredFloatPositions) {
         buffer.finalize_all();
         int moved = 0, kept = 0;
         for (const uint32_t h : live_half_edges(buffer)) {
-                if (!collapse_eligible(buffer, h)) continue;
-                const CollapsePlacement placement = collapse_placement(buffer, h);
-                for (int axis = 0; axis < 3; ++axis) {
-                    const double o = buffer.origin(axis);
-                    EXPECT_EQ(placement.target[axis], double(float(placement.target[axis] + o)) - o)
-                        << "not a float position: half-edge " << h << ", axis " << axis;
-                }
-                ++(moves_target(buffer, h, placement) ? moved : kept);
+            if (!collapse_eligible(buffer, h)) continue;
+            const CollapsePlacement placement = collapse_placement(buffer, h);
+            for (int axis = 0; axis < 3; ++axis) {
+                const double o = buffer.origin(axis);
+                EXPECT_EQ(placement.target[axis], double(float(placement.target[axis] + o)) - o)
+                    << "not a float position: half-edge " << h << ", axis " << axis;
+            }
+            ++(moves_target(buffer, h, placement) ? moved : kept);
         }
         EXPECT_EQ(moved > 0, shape.some_move) << moved << " targets moved";
         EXPECT_GT(kept, 0);
@@ -273,11 +273,13 @@ TEST(Collapse, AMovedFaceMustStillRoughlyFaceItsFansWay) {
     // way over successive collapses, so it is refused (the bound is 143°). Moving it to `near`
     // leaves the steep face 135° from the fan's normal, which thin tubes need.
     HalfEdgeBuffer buffer(64, 0);
-    add_indexed(buffer, {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {-1, 0, 0}, {0, -1, 0}, {0.1f, 0.2f, 0.2f}, {-0.1f, -0.9f, -0.5f}},
+    add_indexed(buffer,
+                {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {-1, 0, 0}, {0, -1, 0}, {0.1f, 0.2f, 0.2f}, {-0.1f, -0.9f, -0.5f}},
                 {{0, 5, 6}, {0, 1, 2}, {0, 2, 3}, {0, 3, 4}, {0, 4, 1}});  // steep face first: v stays open
     const uint32_t v = vertex_at(buffer, {0, 0, 0});
     ASSERT_EQ(buffer.vertex(v).face_count, 5u);
-    const double from[3] = {0, 0, 0}, far[3] = {-0.5, -0.2, -0.1}, near[3] = {-0.3, 0.1, 0.4}, gentle[3] = {0.05, 0.05, 0};
+    const double from[3] = {0, 0, 0}, far[3] = {-0.5, -0.2, -0.1}, near[3] = {-0.3, 0.1, 0.4},
+                 gentle[3] = {0.05, 0.05, 0};
     EXPECT_FALSE(moves_keep_faces_valid(buffer, v, from, far, kNoIndex, kNoIndex));
     EXPECT_TRUE(moves_keep_faces_valid(buffer, v, from, near, kNoIndex, kNoIndex));
     EXPECT_TRUE(moves_keep_faces_valid(buffer, v, from, gentle, kNoIndex, kNoIndex));
@@ -402,14 +404,14 @@ TEST(Collapse, BestOfAllTakesTheCheapestValidCollapse) {
     uint32_t best = kNoIndex;
     CollapsePlacement best_placement{};
     for (const uint32_t h : live_half_edges(brute)) {
-            if (!collapse_eligible(brute, h)) continue;
-            const CollapsePlacement c = collapse_placement(brute, h);
-            if (c.error < cheapest && collapse_valid(brute, h, c.target)) {
-                cheapest = c.error;
-                best = h;
-                best_placement = c;
-            }
+        if (!collapse_eligible(brute, h)) continue;
+        const CollapsePlacement c = collapse_placement(brute, h);
+        if (c.error < cheapest && collapse_valid(brute, h, c.target)) {
+            cheapest = c.error;
+            best = h;
+            best_placement = c;
         }
+    }
     ASSERT_NE(best, kNoIndex);
     apply_collapse(brute, best, best_placement.target);
     ASSERT_TRUE(collapse_best_of_all(scanned));

@@ -68,7 +68,6 @@ TEST(FuzzRegression, Issue7_NonFiniteCoordinatesAreRefused) {
     EXPECT_THROW(run_decimator(soup, options), std::invalid_argument);
 }
 
-
 // pick_write() kept the candidate with the largest quadric error, starting from −1: when every
 // candidate's error was NaN (inf·0 from a 1.2e20 coordinate next to denormals), it returned
 // "no face", so finish() force-wrote (assert `allow_forced` in Debug) and the CLI warned of a
@@ -79,7 +78,7 @@ TEST(FuzzRegression, Issue7_NanQuadricErrorStillPicksAFaceToWrite) {
     options.ratio = 0.25;
     options.output_chunk_triangles = 1;
     const uint32_t p[4][3] = {{0x050c0a0b, 0x00000001, 0x0e0e0a0f},
-                              {0x0d0e090e, 0x350e0b0a, 0x60d00000},   // y 5.3e-7, z 1.2e20
+                              {0x0d0e090e, 0x350e0b0a, 0x60d00000},  // y 5.3e-7, z 1.2e20
                               {0x00120000, 0x0b0a0d0e, 0x0e7f0000},
                               {0x0a0e0f00, 0x0a0d0e0e, 0x0a0d0e0b}};
     std::vector<float> soup;

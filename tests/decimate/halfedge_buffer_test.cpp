@@ -62,8 +62,7 @@ TEST(HalfEdgeBuffer, ClosedMeshLeavesPin) {
 
 TEST(HalfEdgeBuffer, NegativeZeroWeldsWithPositiveZero) {
     HalfEdgeBuffer buffer(64, 0);
-    add_indexed(buffer, {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {-0.0f, 0, 0}, {0, -1, 0}},
-                {{0, 1, 2}, {3, 4, 1}});
+    add_indexed(buffer, {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {-0.0f, 0, 0}, {0, -1, 0}}, {{0, 1, 2}, {3, 4, 1}});
     EXPECT_EQ(buffer.free_vertex_count(), 3 * 64 + 3 - 4u);
 }
 
@@ -144,8 +143,12 @@ TEST(HalfEdgeBuffer, DegenerateTriangleIsNotInserted) {
 TEST(HalfEdgeBuffer, WeldGridMergesNearbyPositionsAndCounts) {
     HalfEdgeBuffer buffer(64, 0.01);
     // (0.1234, 0, 0) and (0.1236, 0, 0) share a 0.01 cell: the two triangles share an edge.
-    add_indexed(buffer, {{0.1234f, 0.005f, 0.005f}, {1.005f, 0.005f, 0.005f}, {0.005f, 1.005f, 0.005f},
-                         {0.1236f, 0.005f, 0.005f}, {0.5f, -1, 0.005f}},
+    add_indexed(buffer,
+                {{0.1234f, 0.005f, 0.005f},
+                 {1.005f, 0.005f, 0.005f},
+                 {0.005f, 1.005f, 0.005f},
+                 {0.1236f, 0.005f, 0.005f},
+                 {0.5f, -1, 0.005f}},
                 {{0, 1, 2}, {1, 3, 4}});
     EXPECT_EQ(buffer.vertices_merged(), 1u);
     EXPECT_EQ(buffer.free_vertex_count(), 3 * 64 + 3 - 4u);

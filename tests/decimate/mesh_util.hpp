@@ -42,8 +42,8 @@ struct Decimated {
     size_t triangle_count() const { return ids.size() / 3; }
 };
 
-inline Decimated run_decimator(const std::vector<float>& soup, const Options& options,
-                               size_t chunk_triangles = 4096, bool tell_count = true) {
+inline Decimated run_decimator(const std::vector<float>& soup, const Options& options, size_t chunk_triangles = 4096,
+                               bool tell_count = true) {
     const size_t n = soup.size() / 9;
     StreamDecimator decimator(options, tell_count ? std::optional<uint64_t>(n) : std::nullopt);
     Decimated result;
@@ -79,11 +79,11 @@ inline std::vector<uint64_t> index_by_position(const std::vector<float>& xyz) {
 }
 
 struct Topology {
-    size_t boundary_edges = 0;       // one face
-    size_t manifold_edges = 0;       // two faces, opposite directions
-    size_t misoriented_edges = 0;    // two faces, same direction
-    size_t nonmanifold_edges = 0;    // more than two faces
-    size_t degenerate_faces = 0;     // repeated vertex
+    size_t boundary_edges = 0;     // one face
+    size_t manifold_edges = 0;     // two faces, opposite directions
+    size_t misoriented_edges = 0;  // two faces, same direction
+    size_t nonmanifold_edges = 0;  // more than two faces
+    size_t degenerate_faces = 0;   // repeated vertex
 };
 
 inline Topology topology(const std::vector<uint64_t>& ids) {
@@ -105,10 +105,14 @@ inline Topology topology(const std::vector<uint64_t>& ids) {
     }
     for (const auto& [key, e] : edges) {
         const int total = e.first + e.second;
-        if (total == 1) ++t.boundary_edges;
-        else if (total > 2) ++t.nonmanifold_edges;
-        else if (e.first == 1) ++t.manifold_edges;
-        else ++t.misoriented_edges;
+        if (total == 1)
+            ++t.boundary_edges;
+        else if (total > 2)
+            ++t.nonmanifold_edges;
+        else if (e.first == 1)
+            ++t.manifold_edges;
+        else
+            ++t.misoriented_edges;
     }
     return t;
 }
@@ -137,7 +141,8 @@ inline size_t back_to_back_edges(const std::vector<float>& xyz, const std::vecto
         triangle_normal(&xyz[9 * faces[0]], m);
         triangle_normal(&xyz[9 * faces[1]], n);
         const double d = m[0] * n[0] + m[1] * n[1] + m[2] * n[2];
-        if (d < 0 && d * d > 0.81 * (m[0] * m[0] + m[1] * m[1] + m[2] * m[2]) * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]))
+        if (d < 0 &&
+            d * d > 0.81 * (m[0] * m[0] + m[1] * m[1] + m[2] * m[2]) * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]))
             ++count;
     }
     return count;
@@ -185,7 +190,10 @@ inline double flipped_area_fraction(const std::vector<float>& input, const std::
                             centroid(&input[9 * size_t{g}], d);
                             const double dist = (d[0] - c[0]) * (d[0] - c[0]) + (d[1] - c[1]) * (d[1] - c[1]) +
                                                 (d[2] - c[2]) * (d[2] - c[2]);
-                            if (dist < best) { best = dist; nearest = g; }
+                            if (dist < best) {
+                                best = dist;
+                                nearest = g;
+                            }
                         }
         }
         double m[3];
@@ -213,8 +221,8 @@ inline std::vector<uint32_t> add_indexed(HalfEdgeBuffer& buffer, const std::vect
 }
 
 inline const std::vector<std::array<float, 3>>& octahedron_points() {
-    static const std::vector<std::array<float, 3>> p = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0},
-                                                        {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+    static const std::vector<std::array<float, 3>> p = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},
+                                                        {0, -1, 0}, {0, 0, 1},  {0, 0, -1}};
     return p;
 }
 inline const std::vector<std::array<int, 3>>& octahedron_faces() {
@@ -261,8 +269,7 @@ inline bool buffer_consistent(const HalfEdgeBuffer& buffer) {
             if (buffer.corner_vertex(next_in_face(t)) != buffer.corner_vertex(h)) return false;
             bool listed = false;
             const uint32_t v = buffer.corner_vertex(h);
-            for (uint32_t c = buffer.vertex(v).first_corner; c != kNoIndex; c = buffer.next_corner(c))
-                listed |= c == h;
+            for (uint32_t c = buffer.vertex(v).first_corner; c != kNoIndex; c = buffer.next_corner(c)) listed |= c == h;
             if (!listed) return false;
         }
     return true;

@@ -28,8 +28,8 @@ TEST(Quadric, MinimumOfThreePlanesIsTheirIntersection) {
     const double x0[3] = {1, 0, 0}, x1[3] = {1, 1, 0}, x2[3] = {1, 0, 1};
     const double y0[3] = {0, 2, 0}, y1[3] = {0, 2, 1}, y2[3] = {1, 2, 0};
     const double z0[3] = {0, 0, 3}, z1[3] = {1, 0, 3}, z2[3] = {0, 1, 3};
-    const Quadric q = Quadric::from_triangle(x0, x1, x2) + Quadric::from_triangle(y0, y1, y2) +
-                      Quadric::from_triangle(z0, z1, z2);
+    const Quadric q =
+        Quadric::from_triangle(x0, x1, x2) + Quadric::from_triangle(y0, y1, y2) + Quadric::from_triangle(z0, z1, z2);
     double m[3] = {0, 0, 0};
     ASSERT_TRUE(q.minimum(m));
     EXPECT_NEAR(m[0], 1, 1e-12);

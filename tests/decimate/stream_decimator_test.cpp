@@ -3,8 +3,8 @@
 // All runs use a fixed seed; bounds are invariants, not golden counts.
 #include "decimate/stream_decimator.hpp"
 
-#include "mesh_util.hpp"
 #include "compare/metro.hpp"
+#include "mesh_util.hpp"
 
 #include <gtest/gtest.h>
 
@@ -19,7 +19,8 @@ using namespace meshstream::decimate::test;
 namespace {
 
 const std::vector<float>& bunny() {
-    static const std::vector<float> soup = load_binary_stl(std::string(MESHSTREAM_FIXTURES_DIR) + "/bunny_from_draco.bin.stl");
+    static const std::vector<float> soup =
+        load_binary_stl(std::string(MESHSTREAM_FIXTURES_DIR) + "/bunny_from_draco.bin.stl");
     return soup;
 }
 
@@ -43,7 +44,8 @@ std::vector<float> holey_grid(int nx, int ny) {
         for (int y = 0; y < ny; ++y) {
             if ((x * 7 + y * 13) % 17 == 0) continue;  // a hole
             const float a[3] = {float(x), float(y), z(x, y)}, b[3] = {float(x + 1), float(y), z(x + 1, y)};
-            const float c[3] = {float(x + 1), float(y + 1), z(x + 1, y + 1)}, d[3] = {float(x), float(y + 1), z(x, y + 1)};
+            const float c[3] = {float(x + 1), float(y + 1), z(x + 1, y + 1)},
+                        d[3] = {float(x), float(y + 1), z(x, y + 1)};
             for (const float* p : {a, b, c, a, c, d}) soup.insert(soup.end(), p, p + 3);
         }
     return soup;
@@ -99,9 +101,9 @@ TEST(StreamDecimator, BunnyAtTenPercentIsWithinAQuarterOfGarlandHeckbert) {
     meshstream::compare::CompareOptions co;
     co.samples = 200000;  // fast; the figure moves by under 1 % against 10⁶ samples
     co.seed = 1;
-    const meshstream::compare::CompareResult r = meshstream::compare::compare_meshes(
-        meshstream::compare::memory_source("bunny", bunny()), meshstream::compare::memory_source("decimated", d.xyz),
-        co);
+    const meshstream::compare::CompareResult r =
+        meshstream::compare::compare_meshes(meshstream::compare::memory_source("bunny", bunny()),
+                                            meshstream::compare::memory_source("decimated", d.xyz), co);
     const double rms_percent = 100.0 * r.rms() / r.diagonal;
     EXPECT_GT(rms_percent, 0.0);
     EXPECT_LE(rms_percent, 1.25 * kCgalRmsPercent);
@@ -167,7 +169,8 @@ TEST(StreamDecimator, FarFromTheOriginVerticesStayOnTheSurface) {
     ASSERT_EQ(out.triangle_count(), 320u);
     double worst = 0;
     for (size_t i = 0; i < out.xyz.size(); i += 3)
-        worst = std::max(worst, std::abs((double(out.xyz[i + 2]) - 100) - (double(out.xyz[i + 1]) - 4000000)) / std::sqrt(2.0));
+        worst = std::max(
+            worst, std::abs((double(out.xyz[i + 2]) - 100) - (double(out.xyz[i + 1]) - 4000000)) / std::sqrt(2.0));
     EXPECT_LT(worst, 0.005) << "metres off the slope";
 }
 
@@ -181,7 +184,8 @@ TEST(StreamDecimator, CountsTheEdgesLeftWithoutPartner) {
     EXPECT_EQ(run_decimator(soup, options).stats.boundary_edges, 300u);
     std::vector<float> octahedron;
     for (const auto& f : octahedron_faces())
-        for (int k : f) octahedron.insert(octahedron.end(), octahedron_points()[k].begin(), octahedron_points()[k].end());
+        for (int k : f)
+            octahedron.insert(octahedron.end(), octahedron_points()[k].begin(), octahedron_points()[k].end());
     EXPECT_EQ(run_decimator(octahedron, options).stats.boundary_edges, 0u);
 }
 
@@ -367,7 +371,7 @@ TEST(StreamDecimator, WeldJoinsCrackedScan) {
     options.buffer_triangles = 10000;
     const Decimated broken = run_decimator(cracked, options);
     EXPECT_GT(broken.stats.forced_writes, 0u);  // a soup of islands cannot be decimated
-    options.weld_eps = 1e-5;  // bunny diagonal is 0.25
+    options.weld_eps = 1e-5;                    // bunny diagonal is 0.25
     const Decimated welded = run_decimator(cracked, options);
     EXPECT_GT(welded.stats.vertices_merged, 10000u);
     EXPECT_EQ(welded.triangle_count(), 6945u);
@@ -443,8 +447,8 @@ TEST(StreamDecimator, BadOptionsAndCallOrderThrow) {
     refused([](Options& o) { o.buffer_triangles = 15; });
     refused([](Options& o) { o.ratio = 0; });
     refused([](Options& o) { o.sorted_axis = 3; });
-    refused([](Options& o) { o.target = 10; });  // without the input count
-    refused([](Options& o) { o.target = 50; }, 10);  // more than the input (it kept all, saying 50)
+    refused([](Options& o) { o.target = 10; });               // without the input count
+    refused([](Options& o) { o.target = 50; }, 10);           // more than the input (it kept all, saying 50)
     refused([](Options& o) { o.sorted_by_minimum = true; });  // without the axis
     Options options;
     options.ratio = 1;

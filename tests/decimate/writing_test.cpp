@@ -75,8 +75,8 @@ TEST(Writing, WritesTheFaceThatLeftPinFirst) {
     const auto faces = add_indexed(buffer, {{0, 0, 0}, {0, 1, 0}, {1, 0, 0}, {1, 1, 0}, {2, 0, 0}, {2, 1, 0}},
                                    {{0, 2, 1}, {1, 2, 3}, {2, 4, 3}, {3, 4, 5}});
     EXPECT_EQ(pick_write(buffer), kNoIndex);  // every face touches P_in
-    for (const std::array<float, 3>& p : std::vector<std::array<float, 3>>{
-             {0, 0, 0}, {0, 1, 0}, {1, 0, 0}, {1, 1, 0}, {2, 0, 0}, {2, 1, 0}})
+    for (const std::array<float, 3>& p :
+         std::vector<std::array<float, 3>>{{0, 0, 0}, {0, 1, 0}, {1, 0, 0}, {1, 1, 0}, {2, 0, 0}, {2, 1, 0}})
         buffer.finalize_vertex(vertex_at(buffer, p));
     TriangleOutput output(4);
     const Emit emit = [](const meshstream::io::TriangleChunk&) {};

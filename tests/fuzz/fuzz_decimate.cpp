@@ -16,8 +16,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <iterator>
 #include <cstring>
+#include <iterator>
 #include <limits>
 #include <vector>
 
@@ -53,8 +53,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     io::TriangleChunk chunk(in_capacity);
     for (uint64_t t = 0; t < triangles; ++t) {
         float tri[9];
-        for (int c = 0; c < 3; ++c)
-            std::memcpy(&tri[3 * c], &xyz[3 * (data[pos + 3 * t + c] % palette)], 12);
+        for (int c = 0; c < 3; ++c) std::memcpy(&tri[3 * c], &xyz[3 * (data[pos + 3 * t + c] % palette)], 12);
         if (!std::all_of(std::begin(tri), std::end(tri), [](float v) { return std::isfinite(v); })) continue;
         chunk.push(tri);
         if (chunk.full()) {

@@ -31,7 +31,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     const size_t half = bin.size() / 2;
     const unsigned index_bytes = wide ? 4 : 2;
     const std::string json =
-        std::string(R"({"asset":{"version":"2.0"},"extensionsUsed":["EXT_meshopt_compression","KHR_mesh_quantization"],)") +
+        std::string(
+            R"({"asset":{"version":"2.0"},"extensionsUsed":["EXT_meshopt_compression","KHR_mesh_quantization"],)") +
         R"("extensionsRequired":["EXT_meshopt_compression","KHR_mesh_quantization"],)" +
         R"("buffers":[{"byteLength":)" + std::to_string(bin.size()) + R"(},{"byteLength":)" +
         std::to_string(vertices * stride + 3 * triangles * index_bytes) +
@@ -45,9 +46,10 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         R"("byteOffset":)" + std::to_string(half) + R"(,"byteLength":)" + std::to_string(bin.size() - half) +
         R"(,"byteStride":)" + std::to_string(index_bytes) + R"(,"count":)" + std::to_string(3 * triangles) +
         R"(,"mode":")" + (sequence ? "INDICES" : "TRIANGLES") + R"("}}}],"accessors":[)" +
-        R"({"bufferView":0,"componentType":)" + types[s] + R"(,"normalized":)" + (s < 2 && (select & 64) ? "true" : "false") +
-        R"(,"count":)" + std::to_string(vertices) + R"(,"type":"VEC3"},)" +
-        R"({"bufferView":1,"componentType":)" + (wide ? "5125" : "5123") + R"(,"count":)" + std::to_string(3 * triangles) +
+        R"({"bufferView":0,"componentType":)" + types[s] + R"(,"normalized":)" +
+        (s < 2 && (select & 64) ? "true" : "false") + R"(,"count":)" + std::to_string(vertices) +
+        R"(,"type":"VEC3"},)" + R"({"bufferView":1,"componentType":)" + (wide ? "5125" : "5123") + R"(,"count":)" +
+        std::to_string(3 * triangles) +
         R"(,"type":"SCALAR"}],"meshes":[{"primitives":[{"attributes":{"POSITION":0},"indices":1}]}],)" +
         R"("nodes":[{"mesh":0}],"scenes":[{"nodes":[0]}],"scene":0})";
     std::string text = json;

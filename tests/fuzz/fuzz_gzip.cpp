@@ -30,7 +30,6 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
             }
             if (source.offset() != total) __builtin_trap();  // offsets must count decoded bytes
         }
-    } catch (const io::Error&) {
-    }
+    } catch (const io::Error&) {}
     return 0;
 }

@@ -53,8 +53,7 @@ inline uint64_t read_all(const io::Format& format, const uint8_t* data, size_t s
             volatile float sink = 0;
             for (float v : chunk.xyz()) sink = sink + v;
         }
-    } catch (const io::Error&) {
-    }
+    } catch (const io::Error&) {}
     return triangles;
 }
 

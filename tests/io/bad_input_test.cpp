@@ -50,7 +50,9 @@ public:
         pos_ += k;
         return k;
     }
-    std::optional<uint64_t> size() const override { return sized_ ? std::optional<uint64_t>(bytes_.size()) : std::nullopt; }
+    std::optional<uint64_t> size() const override {
+        return sized_ ? std::optional<uint64_t>(bytes_.size()) : std::nullopt;
+    }
 
 private:
     std::string bytes_;
@@ -195,8 +197,9 @@ TEST(BadInput, ZeroTrianglesIsAValidEmptyMesh) {
     stl += std::string(4, '\0');  // count 0
     write_file(dir / "zero.stl", stl);
     EXPECT_EQ(read_path(dir / "zero.stl"), 0u);
-    write_file(dir / "zero.ply", "ply\nformat ascii 1.0\nelement vertex 0\nproperty float x\nproperty float y\n"
-                                 "property float z\nelement face 0\nproperty list uchar int vertex_indices\nend_header\n");
+    write_file(dir / "zero.ply",
+               "ply\nformat ascii 1.0\nelement vertex 0\nproperty float x\nproperty float y\n"
+               "property float z\nelement face 0\nproperty list uchar int vertex_indices\nend_header\n");
     EXPECT_EQ(read_path(dir / "zero.ply"), 0u);
     write_file(dir / "zero.stl-ascii.stl", "solid empty\nendsolid empty\n");
     EXPECT_EQ(read_path(dir / "zero.stl-ascii.stl"), 0u);
@@ -331,7 +334,8 @@ TEST(BadInput, TruncatedObjReadsFewerTrianglesOrThrows) {
 // A cut inside the last index of a text file ("f 10 11 1" of "f 10 11 12") is a valid file
 // with a wrong last triangle; only the missing line end shows it, so the reader notes that.
 TEST(BadInput, TextFileCutInsideItsLastIndexIsNoted) {
-    const std::string vertices = "0 0 0\n1 0 0\n0 1 0\n5 5 5\n6 5 5\n5 6 5\n5 5 6\n6 6 6\n7 7 7\n10 10 10\n11 10 10\n10 11 10\n";
+    const std::string vertices =
+        "0 0 0\n1 0 0\n0 1 0\n5 5 5\n6 5 5\n5 6 5\n5 5 6\n6 6 6\n7 7 7\n10 10 10\n11 10 10\n10 11 10\n";
     std::string obj;
     for (size_t at = 0; at < vertices.size();) {
         const size_t end = vertices.find('\n', at);
@@ -339,9 +343,10 @@ TEST(BadInput, TextFileCutInsideItsLastIndexIsNoted) {
         at = end + 1;
     }
     obj += "f 1 2 3\nf 10 11 12\n";
-    const std::string ply = "ply\nformat ascii 1.0\nelement vertex 12\nproperty float x\nproperty float y\n"
-                            "property float z\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n" +
-                            vertices + "3 0 1 2\n3 9 10 11\n";
+    const std::string ply =
+        "ply\nformat ascii 1.0\nelement vertex 12\nproperty float x\nproperty float y\n"
+        "property float z\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n" +
+        vertices + "3 0 1 2\n3 9 10 11\n";
     auto last_line_note = [](const char* format, const std::string& bytes) {
         io::ByteSource source(std::make_unique<MemoryInput>(bytes, true), "cut");
         std::unique_ptr<io::Reader> reader = io::find_format(format)->open_reader(source, {});
@@ -411,7 +416,8 @@ TEST(BadInput, PlyCountsLyingEitherWay) {
 TEST(BadInput, IndicesOutOfRangeNameTheItem) {
     const io::Format& ply = *io::find_format("ply");
     for (const char* face : {"3 0 1 3\n", "3 0 1 -1\n", "3 0 1 2147483647\n"}) {
-        io::Error e = error_of([&] { read_with(ply, kPlyTriangleHeader + std::string("0 0 0\n1 0 0\n0 1 0\n") + face, "i.ply"); });
+        io::Error e = error_of(
+            [&] { read_with(ply, kPlyTriangleHeader + std::string("0 0 0\n1 0 0\n0 1 0\n") + face, "i.ply"); });
         EXPECT_EQ(e.line(), 13u) << e.what();
         EXPECT_NE(e.message().find("out of range"), std::string::npos) << e.what();
     }
@@ -440,8 +446,9 @@ TEST(BadInput, PlyListCountOfTwoToThe31IsAnErrorWithoutAllocatingIt) {
     io::Error e1 = error_of([&] { read_with(ply, ascii + "0 0 0\n1 0 0\n0 1 0\n2147483648 0 1 2\n", "l.ply"); });
     EXPECT_GE(e1.line(), 13u) << e1.what();  // the face line, or where its indices run out
 
-    std::string binary = "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
-                         "property float z\nelement face 1\nproperty list uint int vertex_indices\nend_header\n";
+    std::string binary =
+        "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+        "property float z\nelement face 1\nproperty list uint int vertex_indices\nend_header\n";
     const float v[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
     binary.append(reinterpret_cast<const char*>(v), sizeof v);
     const uint32_t count = 0x80000000u;

@@ -486,8 +486,9 @@ TEST(ByteSource, SizesAndOffsetsPastFourGiB) {
         io::kStlFormat.open_reader(stray, {});
         ADD_FAILURE() << "no error";
     } catch (const io::Error& e) {
-        EXPECT_STREQ(e.what(), "stray.stl: byte 84: header promises 100000000 triangles, file holds 100000000 "
-                               "and 1 stray bytes");
+        EXPECT_STREQ(e.what(),
+                     "stray.stl: byte 84: header promises 100000000 triangles, file holds 100000000 "
+                     "and 1 stray bytes");
     }
 }
 

@@ -147,8 +147,9 @@ TEST(Channels, DescribeWhatAnOutputLacks) {
     io::Channels ply;
     ply.color = io::ColorFormat{};
     ply.vertex_scalars = {{"intensity", io::ScalarType::kFloat32}};
-    EXPECT_EQ(io::describe_missing(all, ply),
-              "normals, colour alpha, texture coordinates, materials, vertex property 'confidence', face property 'label'");
+    EXPECT_EQ(
+        io::describe_missing(all, ply),
+        "normals, colour alpha, texture coordinates, materials, vertex property 'confidence', face property 'label'");
     EXPECT_EQ(io::describe_missing(all, all), "");
     const io::Channels both = io::intersect(all, ply);
     ASSERT_TRUE(both.color.has_value());

@@ -82,7 +82,9 @@ TEST(DracoReader, RefusesPointCloudsByName) {
         FAIL() << "a point cloud was read as a mesh";
     } catch (const io::Error& e) {
         EXPECT_EQ(e.file(), fixture("drc/points_pointcloud.drc"));
-        EXPECT_NE(std::string(e.what()).find("byte 7: geometry type is a Draco point cloud (no faces)"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("byte 7: geometry type is a Draco point cloud (no faces)"),
+                  std::string::npos)
+            << e.what();
     }
 }
 
@@ -201,8 +203,9 @@ TEST(DracoWriter, RefusesEmptyMeshAndLeavesOutNonFiniteTriangles) {
     bad.xyz = {0, 0, 0, 1, 0, 0, 0, NAN, 0, 0, 0, 0, 1, 0, 0, 0, 1, 0};
     const std::vector<std::string> notes = write_soup(bad, dir / "nan.drc");
     ASSERT_EQ(notes.size(), 1u);
-    EXPECT_EQ(notes[0], dir / "nan.drc" + ": 1 of the 2 triangles have a NaN or infinite coordinate, which Draco cannot "
-                                          "store: left out (--strict makes this an error)");
+    EXPECT_EQ(notes[0], dir / "nan.drc" +
+                            ": 1 of the 2 triangles have a NaN or infinite coordinate, which Draco cannot "
+                            "store: left out (--strict makes this an error)");
     EXPECT_EQ(read_soup(dir / "nan.drc").triangles(), 1u);
     io::WriteOptions strict;
     strict.strict = true;
@@ -265,9 +268,10 @@ TEST(DracoWriter, SaysWhenQuantizationFlattensTriangles) {
     for (const char* name : {"box.drc", "box.glb"}) {
         const std::vector<std::string> notes = write_soup(box, dir / name);
         ASSERT_EQ(notes.size(), 1u) << name;
-        EXPECT_NE(notes[0].find(std::string(name) + ": 12 of the 12 triangles have zero area once decoded: thinner than "
-                                "Draco's 14-bit quantization step"),
-                  std::string::npos)
+        EXPECT_NE(
+            notes[0].find(std::string(name) + ": 12 of the 12 triangles have zero area once decoded: thinner than "
+                                              "Draco's 14-bit quantization step"),
+            std::string::npos)
             << notes[0];
     }
     io::WriteOptions fine;
@@ -302,7 +306,8 @@ std::string draco_decoder_header(const std::string& drc, const std::string& ply)
 // 'confidence' (float).
 Mesh scalar_mesh() {
     Mesh m;
-    m.header.channels.vertex_scalars = {{"intensity", io::ScalarType::kUInt16}, {"confidence", io::ScalarType::kFloat32}};
+    m.header.channels.vertex_scalars = {{"intensity", io::ScalarType::kUInt16},
+                                        {"confidence", io::ScalarType::kFloat32}};
     m.scalars.resize(2);
     std::mt19937 rng(11);
     for (int t = 0; t < 40; ++t)

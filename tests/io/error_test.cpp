@@ -22,6 +22,4 @@ TEST(Error, ByteOffsetZeroIsAPosition) {
     EXPECT_STREQ(e.what(), "a.ply: byte 0: not a PLY file");
 }
 
-TEST(Error, QuotesBinaryTokens) {
-    EXPECT_EQ(meshstream::io::quote_token(std::string_view("ab\x01", 3)), "'ab\\x01'");
-}
+TEST(Error, QuotesBinaryTokens) { EXPECT_EQ(meshstream::io::quote_token(std::string_view("ab\x01", 3)), "'ab\\x01'"); }

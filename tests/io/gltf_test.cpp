@@ -18,8 +18,8 @@
 
 #include <cstdlib>
 #include <cstring>
-#include <functional>
 #include <fstream>
+#include <functional>
 #include <random>
 #include <set>
 #include <thread>
@@ -161,8 +161,9 @@ TEST(GltfReader, QuantizedAndDracoElephantsMatchTheSequentialDrc) {
 }
 
 TEST(GltfReader, StripsAndFansKeepOneWinding) {
-    for (const char* f : {"gltf/primitive_modes/Mesh_PrimitiveMode_04.gltf", "gltf/primitive_modes/Mesh_PrimitiveMode_05.gltf",
-                          "gltf/primitive_modes/Mesh_PrimitiveMode_11.gltf"}) {
+    for (const char* f :
+         {"gltf/primitive_modes/Mesh_PrimitiveMode_04.gltf", "gltf/primitive_modes/Mesh_PrimitiveMode_05.gltf",
+          "gltf/primitive_modes/Mesh_PrimitiveMode_11.gltf"}) {
         Soup s = read_soup(fixture(f));
         ASSERT_EQ(s.triangles(), 2u) << f;
         double nz[2];
@@ -198,8 +199,8 @@ uint64_t write_glb(const std::string& path, const json& doc, std::string bin) {
     while (bin.size() % 4) bin.push_back('\0');
     auto u32 = [](uint32_t v) { return std::string(reinterpret_cast<const char*>(&v), 4); };
     const uint32_t total = static_cast<uint32_t>(12 + 8 + text.size() + 8 + bin.size());
-    std::ofstream(path, std::ios::binary) << "glTF" << u32(2) << u32(total) << u32(uint32_t(text.size())) << "JSON" << text
-                                          << u32(uint32_t(bin.size())) << "BIN" << std::string(1, '\0') << bin;
+    std::ofstream(path, std::ios::binary) << "glTF" << u32(2) << u32(total) << u32(uint32_t(text.size())) << "JSON"
+                                          << text << u32(uint32_t(bin.size())) << "BIN" << std::string(1, '\0') << bin;
     return 28 + text.size();
 }
 
@@ -276,14 +277,32 @@ TEST(GltfMeshopt, ExponentialFilterAndIndexSequence) {
         {"asset", {{"version", "2.0"}}},
         {"extensionsUsed", {"EXT_meshopt_compression"}},
         {"extensionsRequired", {"EXT_meshopt_compression"}},
-        {"buffers", {{{"byteLength", bin.size()}}, {{"byteLength", 72}, {"extensions", {{"EXT_meshopt_compression", {{"fallback", true}}}}}}}},
+        {"buffers",
+         {{{"byteLength", bin.size()}},
+          {{"byteLength", 72}, {"extensions", {{"EXT_meshopt_compression", {{"fallback", true}}}}}}}},
         {"bufferViews",
-         {{{"buffer", 1}, {"byteLength", 48}, {"byteStride", 12},
-           {"extensions", {{"EXT_meshopt_compression", {{"buffer", 0}, {"byteLength", vbuf.size()}, {"byteStride", 12},
-                                                         {"count", 4}, {"mode", "ATTRIBUTES"}, {"filter", "EXPONENTIAL"}}}}}},
-          {{"buffer", 1}, {"byteOffset", 48}, {"byteLength", 24},
-           {"extensions", {{"EXT_meshopt_compression", {{"buffer", 0}, {"byteOffset", ioffset}, {"byteLength", ibuf.size()},
-                                                         {"byteStride", 4}, {"count", 6}, {"mode", "INDICES"}}}}}}}},
+         {{{"buffer", 1},
+           {"byteLength", 48},
+           {"byteStride", 12},
+           {"extensions",
+            {{"EXT_meshopt_compression",
+              {{"buffer", 0},
+               {"byteLength", vbuf.size()},
+               {"byteStride", 12},
+               {"count", 4},
+               {"mode", "ATTRIBUTES"},
+               {"filter", "EXPONENTIAL"}}}}}},
+          {{"buffer", 1},
+           {"byteOffset", 48},
+           {"byteLength", 24},
+           {"extensions",
+            {{"EXT_meshopt_compression",
+              {{"buffer", 0},
+               {"byteOffset", ioffset},
+               {"byteLength", ibuf.size()},
+               {"byteStride", 4},
+               {"count", 6},
+               {"mode", "INDICES"}}}}}}}},
         {"accessors",
          {{{"bufferView", 0}, {"componentType", 5126}, {"count", 4}, {"type", "VEC3"}},
           {{"bufferView", 1}, {"componentType", 5125}, {"count", 6}, {"type", "SCALAR"}}}},
@@ -316,7 +335,9 @@ TEST(GltfMeshopt, BadParametersAreErrorsNamingTheView) {
     };
     const std::string pos = "mesh 0 primitive 0 POSITION (accessor 0): bufferView 0 (EXT_meshopt_compression)";
     const std::string idx = "mesh 0 primitive 0 indices (accessor 1): bufferView 1 (EXT_meshopt_compression)";
-    auto ext = [](json& d, int view) -> json& { return d["bufferViews"][view]["extensions"]["EXT_meshopt_compression"]; };
+    auto ext = [](json& d, int view) -> json& {
+        return d["bufferViews"][view]["extensions"]["EXT_meshopt_compression"];
+    };
     const Case cases[] = {
         {[&](json& d) { ext(d, 1)["byteLength"] = 100; },
          idx + ": the compressed index data is corrupt or cut short (100 bytes for 16674 indices of 2 bytes; "
@@ -328,14 +349,16 @@ TEST(GltfMeshopt, BadParametersAreErrorsNamingTheView) {
          0},
         {[&](json& d) { ext(d, 0)["count"] = 2774; },
          pos + " decodes to count 2774 x byteStride 8 bytes, but its bufferView's byteLength is 22200"},
-        {[&](json& d) { ext(d, 1)["mode"] = "STRIPS"; }, idx + " has mode 'STRIPS' (one of ATTRIBUTES, TRIANGLES, INDICES)"},
+        {[&](json& d) { ext(d, 1)["mode"] = "STRIPS"; },
+         idx + " has mode 'STRIPS' (one of ATTRIBUTES, TRIANGLES, INDICES)"},
         {[&](json& d) { ext(d, 1)["byteStride"] = 8; }, idx + ": TRIANGLES with byteStride 8 (must be 2 or 4)"},
         {[&](json& d) { ext(d, 1)["count"] = 16673; }, idx + ": TRIANGLES with count 16673, not a multiple of 3"},
         {[&](json& d) { ext(d, 1)["filter"] = "OCTAHEDRAL"; },
          idx + ": filter OCTAHEDRAL with mode TRIANGLES (filters apply to ATTRIBUTES only)"},
         {[&](json& d) { ext(d, 0)["filter"] = "SHARPEN"; },
          pos + " has filter 'SHARPEN' (one of NONE, OCTAHEDRAL, QUATERNION, EXPONENTIAL)"},
-        {[&](json& d) { ext(d, 0)["byteStride"] = 6; }, pos + ": ATTRIBUTES with byteStride 6 (must be a multiple of 4, 4-256)"},
+        {[&](json& d) { ext(d, 0)["byteStride"] = 6; },
+         pos + ": ATTRIBUTES with byteStride 6 (must be a multiple of 4, 4-256)"},
         {[&](json& d) { ext(d, 0)["byteStride"] = 12, ext(d, 0)["filter"] = "OCTAHEDRAL"; },
          pos + ": filter OCTAHEDRAL with byteStride 12 (must be 4 or 8)"},
         {[&](json& d) { ext(d, 0)["byteStride"] = 4, ext(d, 0)["filter"] = "QUATERNION"; },
@@ -417,8 +440,10 @@ struct HandMade {
 TEST(GltfReader, AppliesNodeTransformsAndFlipsMirroredWinding) {
     // Node 0 translates by +10 in x and holds node 1, which mirrors x and instances the mesh;
     // node 2 instances it again untransformed.
-    HandMade doc("", "4", R"([{"translation":[10,0,0],"children":[1]},{"scale":[-1,1,1],"mesh":0},{"mesh":0,"matrix":[1,0,0,0,0,1,0,0,0,0,1,0,0,0,0,1]}])",
-                 "[0,2]");
+    HandMade doc(
+        "", "4",
+        R"([{"translation":[10,0,0],"children":[1]},{"scale":[-1,1,1],"mesh":0},{"mesh":0,"matrix":[1,0,0,0,0,1,0,0,0,0,1,0,0,0,0,1]}])",
+        "[0,2]");
     io::MeshHeader h;
     Soup s = read_soup(doc.path, 16, &h);
     ASSERT_EQ(s.triangles(), 2u);
@@ -500,7 +525,8 @@ TEST(GltfReader, AppliesMorphTargetsAtTheirDefaultWeights) {
 // and all. The message is cut and its bytes made printable.
 TEST(GltfReader, TinygltfMessagesAreCutAndPrintable) {
     TempDir dir;
-    const std::string head = R"({"asset":{"version":"2.0"},"buffers":[{"byteLength":36,"uri":"data:application/octet-stream;base64,)";
+    const std::string head =
+        R"({"asset":{"version":"2.0"},"buffers":[{"byteLength":36,"uri":"data:application/octet-stream;base64,)";
     std::ofstream(dir / "long.gltf") << head << std::string(100000, '!') << R"("}]})";
     const std::string long_error = error_of(dir / "long.gltf");
     EXPECT_NE(long_error.find("invalid glTF: Failed to decode 'uri'"), std::string::npos) << long_error.substr(0, 300);
@@ -525,7 +551,8 @@ TEST(GltfReader, BufferFilesCountAgainstTheMemoryBudget) {
     }
     EXPECT_NE(what.find("glTF documents are read whole into memory with their buffers: this one and its buffer files "
                         "take 4.4 KiB, over the memory budget of 3.9 KiB; raise --memory"),
-              std::string::npos) << what;
+              std::string::npos)
+        << what;
     options.memory_budget_bytes = 3695 + 840;
     EXPECT_EQ(io::open_input(path, {}, options).reader->triangle_count(), 12u);
 }
@@ -536,12 +563,14 @@ TEST(GltfReader, NamesABufferViewPastTheEndOfItsBuffer) {
     TempDir dir;
     const float tri[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
     std::ofstream(dir / "v.bin", std::ios::binary).write(reinterpret_cast<const char*>(tri), sizeof tri);
-    std::ofstream(dir / "v.gltf") << R"({"asset":{"version":"2.0"},"buffers":[{"uri":"v.bin","byteLength":36}],)"
-                                  << R"("bufferViews":[{"buffer":0,"byteLength":400}],)"
-                                  << R"("accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3"}],)"
-                                  << R"("meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],"nodes":[{"mesh":0}]})";
+    std::ofstream(dir / "v.gltf")
+        << R"({"asset":{"version":"2.0"},"buffers":[{"uri":"v.bin","byteLength":36}],)"
+        << R"("bufferViews":[{"buffer":0,"byteLength":400}],)"
+        << R"("accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3"}],)"
+        << R"("meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],"nodes":[{"mesh":0}]})";
     std::string what = error_of(dir / "v.gltf");
-    EXPECT_NE(what.find("bufferView 0 ends at byte 400, past the end of buffer 0 (36 bytes)"), std::string::npos) << what;
+    EXPECT_NE(what.find("bufferView 0 ends at byte 400, past the end of buffer 0 (36 bytes)"), std::string::npos)
+        << what;
 }
 
 TEST(GltfReader, RefusesAByteStrideSmallerThanTheElement) {
@@ -550,20 +579,23 @@ TEST(GltfReader, RefusesAByteStrideSmallerThanTheElement) {
     TempDir dir;
     const float padded[12] = {0, 0, 0, 9, 1, 0, 0, 9, 0, 1, 0, 9};  // x y z and a fourth float
     std::ofstream(dir / "s.bin", std::ios::binary).write(reinterpret_cast<const char*>(padded), sizeof padded);
-    auto write = [&](int stride) {
-        std::ofstream(dir / "s.gltf") << R"({"asset":{"version":"2.0"},"buffers":[{"uri":"s.bin","byteLength":48}],)"
-                                      << R"("bufferViews":[{"buffer":0,"byteLength":48,"byteStride":)" << stride << "}],"
-                                      << R"("accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3"}],)"
-                                      << R"("meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],"nodes":[{"mesh":0}]})";
-    };
+    auto write =
+        [&](int stride) {
+            std::ofstream(dir / "s.gltf")
+                << R"({"asset":{"version":"2.0"},"buffers":[{"uri":"s.bin","byteLength":48}],)"
+                << R"("bufferViews":[{"buffer":0,"byteLength":48,"byteStride":)" << stride << "}],"
+                << R"("accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3"}],)"
+                << R"("meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],"nodes":[{"mesh":0}]})";
+        };
     write(16);
     EXPECT_EQ(read_soup(dir / "s.gltf").xyz, (std::vector<float>{0, 0, 0, 1, 0, 0, 0, 1, 0}));
     for (int stride : {4, 8}) {
         write(stride);
         std::string what = error_of(dir / "s.gltf");
-        EXPECT_NE(what.find("mesh 0 primitive 0 POSITION (accessor 0): bufferView 0 has byteStride " + std::to_string(stride) +
-                            ", less than the accessor's 12-byte elements"),
-                  std::string::npos) << what;
+        EXPECT_NE(what.find("mesh 0 primitive 0 POSITION (accessor 0): bufferView 0 has byteStride " +
+                            std::to_string(stride) + ", less than the accessor's 12-byte elements"),
+                  std::string::npos)
+            << what;
     }
 }
 
@@ -581,7 +613,8 @@ TEST(GltfReader, OffsetsAndCountsNearTwoToThe64AreRefusedNotWrapped) {
         const char* expected;
     } cases[] = {
         {R"({"buffer":0,"byteOffset":18446744073709551612,"byteLength":40})", R"("bufferView":0,"count":3)",
-         "POSITION (accessor 0): bufferView 0 ends at byte 18446744073709551612 + 40, past the end of buffer 0 (36 bytes)"},
+         "POSITION (accessor 0): bufferView 0 ends at byte 18446744073709551612 + 40, past the end of buffer 0 (36 "
+         "bytes)"},
         {R"({"buffer":0,"byteLength":36})", R"("bufferView":0,"byteOffset":18446744073709551608,"count":3)",
          "POSITION (accessor 0) reaches byte 2^64 or more of a buffer view ending at 36"},
         {R"({"buffer":0,"byteLength":36,"byteStride":16})", R"("bufferView":0,"count":1152921504606846977)",
@@ -612,7 +645,8 @@ TEST(GltfReader, OffsetsAndCountsNearTwoToThe64AreRefusedNotWrapped) {
     std::ofstream(dir / "engine.gltf") << doc.dump();
     const std::string what = error_of(dir / "engine.gltf");
     EXPECT_NE(what.find("KHR_draco_mesh_compression bufferView " + std::to_string(blob) + " lies outside its buffer"),
-              std::string::npos) << what;
+              std::string::npos)
+        << what;
 }
 
 TEST(GltfReader, MissingBufferFileIsNotLookedUpInTheCurrentDirectory) {
@@ -667,13 +701,16 @@ TEST(GltfReader, RefusesJsonNestedTooDeepBeforeParsingIt) {
         std::string what = error_of(doc.path);
         EXPECT_NE(what.find(": byte " + std::to_string(first + (deep[0] == '[' ? 511 : 5 * 511)) +
                             ": JSON nested deeper than 512 arrays and objects"),
-                  std::string::npos) << what.substr(0, 300);
+                  std::string::npos)
+            << what.substr(0, 300);
         const std::string json = R"({"asset":{"version":"2.0"},"extras":)" + deep + "}";
         std::ofstream(dir / "deep.glb", std::ios::binary) << glb_of(json);
         what = error_of(dir / "deep.glb");
-        EXPECT_NE(what.find(": byte " + std::to_string(20 + json.find(deep.substr(0, 1), 10) + (deep[0] == '[' ? 511 : 5 * 511)) +
+        EXPECT_NE(what.find(": byte " +
+                            std::to_string(20 + json.find(deep.substr(0, 1), 10) + (deep[0] == '[' ? 511 : 5 * 511)) +
                             ": JSON nested deeper than 512"),
-                  std::string::npos) << what.substr(0, 300);
+                  std::string::npos)
+            << what.substr(0, 300);
     }
     // Brackets in strings, escaped quotes among them, do not count; 100 real levels are fine.
     const std::string in_strings = R"("\"[[[)" + std::string(1000, '{') + R"(\\",)";
@@ -716,7 +753,8 @@ TEST(GltfWriter, DracoGlbIsValidAndWithinQuantizationBound) {
     expect_within_quantization_bound(bunny, back, 14);
     bool noted = false;
     for (const auto& [k, v] : h.notes)
-        if (k == "draco") noted = v == "bitstream 2.2, edgebreaker connectivity, positions 14 bits (mesh 0 primitive 0)";
+        if (k == "draco")
+            noted = v == "bitstream 2.2, edgebreaker connectivity, positions 14 bits (mesh 0 primitive 0)";
     EXPECT_TRUE(noted) << "info must report the Draco settings found";
     // POSITION min/max are the decoded bounds, exactly.
     const json& pos = doc["accessors"][prim["attributes"]["POSITION"].get<int>()];
@@ -756,8 +794,10 @@ TEST(GltfWriter, GltfWithBinSideFileBothWaysIsValid) {
         EXPECT_EQ(doc["buffers"][0]["uri"], "scene%20one.bin");
         expect_valid(dir / "scene one.gltf");
         Soup back = read_soup(dir / "scene one.gltf");
-        if (draco) expect_within_quantization_bound(mesh, back, 14);
-        else EXPECT_EQ(back.xyz, mesh.xyz);
+        if (draco)
+            expect_within_quantization_bound(mesh, back, 14);
+        else
+            EXPECT_EQ(back.xyz, mesh.xyz);
     }
 }
 
@@ -968,7 +1008,8 @@ TEST(GltfWriter, MeshoptKeepsTheTriangleOrderOfASortedStream) {
         size_t same = 0;
         for (size_t t = 0; t < mesh.triangles() && t < back.triangles(); ++t) {
             TriKey a, b;
-            for (int i = 0; i < 9; ++i) a[i] = q.quantize(mesh.xyz[9 * t + i], i % 3), b[i] = q.snap(back.xyz[9 * t + i], i % 3);
+            for (int i = 0; i < 9; ++i)
+                a[i] = q.quantize(mesh.xyz[9 * t + i], i % 3), b[i] = q.snap(back.xyz[9 * t + i], i % 3);
             same += canonical(a) == canonical(b);
         }
         return same;
@@ -1009,15 +1050,18 @@ TEST(GltfWriter, KeepsDegenerateAndZeroAreaTrianglesExceptWithDraco) {
         EXPECT_EQ(report["issues"]["numWarnings"], 0) << report.dump(2);
         Soup back = read_soup(dir / "d.glb");
         ASSERT_EQ(back.triangles(), 5u);
-        if (c == io::WriteOptions::Compression::kNone) EXPECT_EQ(back.xyz, soup.xyz);
-        else EXPECT_EQ(triangle_multiset(back).size(), 5u);
+        if (c == io::WriteOptions::Compression::kNone)
+            EXPECT_EQ(back.xyz, soup.xyz);
+        else
+            EXPECT_EQ(triangle_multiset(back).size(), 5u);
     }
     // Draco: the two with a repeated vertex are left out and counted; --strict names the first.
     const std::vector<std::string> notes = write_soup(soup, dir / "d.glb");
     ASSERT_EQ(notes.size(), 1u);
-    EXPECT_EQ(notes[0], dir / "d.glb" + ": 2 of the 5 triangles have two corners at one vertex (degenerate), which "
-                                        "Draco's encoder drops: left out (write without Draco to keep them; --strict "
-                                        "makes this an error)");
+    EXPECT_EQ(notes[0], dir / "d.glb" +
+                            ": 2 of the 5 triangles have two corners at one vertex (degenerate), which "
+                            "Draco's encoder drops: left out (write without Draco to keep them; --strict "
+                            "makes this an error)");
     EXPECT_EQ(read_soup(dir / "d.glb").triangles(), 3u);
     io::WriteOptions strict;
     strict.strict = true;
@@ -1025,8 +1069,9 @@ TEST(GltfWriter, KeepsDegenerateAndZeroAreaTrianglesExceptWithDraco) {
         write_soup(soup, dir / "s.glb", strict);
         ADD_FAILURE() << "accepted";
     } catch (const io::Error& e) {
-        EXPECT_EQ(std::string(e.what()), dir / "s.glb" + ": triangle 1 has two corners at one vertex, which Draco's "
-                                                         "encoder drops (--strict)");
+        EXPECT_EQ(std::string(e.what()), dir / "s.glb" +
+                                             ": triangle 1 has two corners at one vertex, which Draco's "
+                                             "encoder drops (--strict)");
     }
     strict.compression = io::WriteOptions::Compression::kMeshopt;
     EXPECT_TRUE(write_soup(soup, dir / "s.glb", strict).empty()) << "glTF holds them: nothing to refuse";
@@ -1042,8 +1087,9 @@ TEST(GltfWriter, LeavesOutNonFiniteTrianglesOrRefusesThemUnderStrict) {
         o.compression = c;
         const std::vector<std::string> notes = write_soup(soup, dir / "n.glb", o);
         ASSERT_EQ(notes.size(), 1u);
-        EXPECT_EQ(notes[0], dir / "n.glb" + ": 2 of the 5 triangles have a NaN or infinite coordinate, which glTF "
-                                            "cannot store: left out (--strict makes this an error)");
+        EXPECT_EQ(notes[0], dir / "n.glb" +
+                                ": 2 of the 5 triangles have a NaN or infinite coordinate, which glTF "
+                                "cannot store: left out (--strict makes this an error)");
         expect_valid_allowing(dir / "n.glb", {"ACCESSOR_INDEX_TRIANGLE_DEGENERATE"});
         EXPECT_EQ(read_soup(dir / "n.glb").triangles(), 3u);
         o.strict = true;
@@ -1094,7 +1140,8 @@ TEST(GltfChannels, BoxTexturedReadsNormalsUvsAndItsTextureFromEveryEncoding) {
         const float* p = &ref.xyz[9 * t];
         double e1[3], e2[3], n[3];
         for (int a = 0; a < 3; ++a) e1[a] = p[3 + a] - p[a], e2[a] = p[6 + a] - p[a];
-        n[0] = e1[1] * e2[2] - e1[2] * e2[1], n[1] = e1[2] * e2[0] - e1[0] * e2[2], n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+        n[0] = e1[1] * e2[2] - e1[2] * e2[1], n[1] = e1[2] * e2[0] - e1[0] * e2[2],
+        n[2] = e1[0] * e2[1] - e1[1] * e2[0];
         const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
         for (int k = 0; k < 3; ++k)
             for (int a = 0; a < 3; ++a) EXPECT_NEAR(ref.normals[9 * t + 3 * k + a], n[a] / len, 1e-6) << t;
@@ -1102,7 +1149,8 @@ TEST(GltfChannels, BoxTexturedReadsNormalsUvsAndItsTextureFromEveryEncoding) {
     // Texture coordinates as the chunk holds them (v up): the file's (0.0, 1.0) corner of the
     // first face is its top left, (6, 0) in glTF's v-down convention.
     float umax = 0, vmin = 1;
-    for (size_t i = 0; i < ref.uvs.size(); i += 2) umax = std::max(umax, ref.uvs[i]), vmin = std::min(vmin, ref.uvs[i + 1]);
+    for (size_t i = 0; i < ref.uvs.size(); i += 2)
+        umax = std::max(umax, ref.uvs[i]), vmin = std::min(vmin, ref.uvs[i + 1]);
     EXPECT_FLOAT_EQ(umax, 6.0f);
     EXPECT_NEAR(vmin, 0.0f, 1e-6);
 
@@ -1184,7 +1232,8 @@ TEST(GltfChannels, BoxTexturedRoundTripsThroughEveryCompression) {
 TEST(GltfChannels, ColoursKeepTheirTypeAndValues) {
     TempDir dir;
     // CGAL's cactus: RGB as uchar (PLY and Draco), and one float RGBA triangle.
-    for (const char* file : {"ply/cactus_vcolor.binary_le.ply", "drc/cactus_vcolor_edgebreaker.drc", "ply/float-color.ply"}) {
+    for (const char* file :
+         {"ply/cactus_vcolor.binary_le.ply", "drc/cactus_vcolor_edgebreaker.drc", "ply/float-color.ply"}) {
         SCOPED_TRACE(file);
         const Mesh ref = read_mesh(fixture(file));
         ASSERT_TRUE(ref.header.channels.color);
@@ -1277,8 +1326,10 @@ TEST(GltfChannels, PlyNormalsAndTextureCoordinatesThroughGlbAndDrc) {
         } cases[] = {
             {"p.glb", io::WriteOptions::Compression::kNone, 0, 0, 0},
             {"m.glb", io::WriteOptions::Compression::kMeshopt, step, 2.0 / 127, 0},
-            {"d.glb", io::WriteOptions::Compression::kDraco, step, 4.0 / 1023, 0.5 * (uhi - ulo) / 4095 * 1.0001 + 1e-6},
-            {"d.drc", io::WriteOptions::Compression::kDraco, step, 4.0 / 1023, 0.5 * (uhi - ulo) / 4095 * 1.0001 + 1e-6},
+            {"d.glb", io::WriteOptions::Compression::kDraco, step, 4.0 / 1023,
+             0.5 * (uhi - ulo) / 4095 * 1.0001 + 1e-6},
+            {"d.drc", io::WriteOptions::Compression::kDraco, step, 4.0 / 1023,
+             0.5 * (uhi - ulo) / 4095 * 1.0001 + 1e-6},
         };
         for (const Case& c : cases) {
             SCOPED_TRACE(c.name);

@@ -28,10 +28,10 @@ inline std::string fixture(const std::string& name) { return std::string(MESHSTR
 
 // A fresh directory under the system temp dir, removed with its contents at scope exit.
 struct Soup {
-    std::vector<float> xyz;       // 9 per triangle
-    std::vector<uint8_t> rgb;     // 9 per triangle: rgba as 8 bits, without alpha
-    std::vector<float> rgba;      // 12 per triangle when the reader gives colour
-    std::vector<uint64_t> ids;    // 3 per triangle when the reader gives vertex ids
+    std::vector<float> xyz;     // 9 per triangle
+    std::vector<uint8_t> rgb;   // 9 per triangle: rgba as 8 bits, without alpha
+    std::vector<float> rgba;    // 12 per triangle when the reader gives colour
+    std::vector<uint64_t> ids;  // 3 per triangle when the reader gives vertex ids
     io::MeshHeader header;
     size_t triangles() const { return xyz.size() / 9; }
 };
@@ -47,8 +47,7 @@ inline Soup read_soup(const std::string& path, size_t capacity = io::TriangleChu
         s.xyz.insert(s.xyz.end(), chunk.xyz().begin(), chunk.xyz().end());
         s.rgba.insert(s.rgba.end(), chunk.colors().begin(), chunk.colors().end());
         for (size_t c = 0; c < chunk.colors().size(); ++c)  // RGB as 8 bits, alpha left out
-            if (c % 4 != 3)
-                s.rgb.push_back(uint8_t(std::lround(std::clamp(chunk.colors()[c], 0.0f, 1.0f) * 255.0f)));
+            if (c % 4 != 3) s.rgb.push_back(uint8_t(std::lround(std::clamp(chunk.colors()[c], 0.0f, 1.0f) * 255.0f)));
         s.ids.insert(s.ids.end(), chunk.vertex_ids().begin(), chunk.vertex_ids().end());
     }
     EXPECT_TRUE(chunk.empty());

@@ -34,7 +34,8 @@ TEST(MeshIndexer, WeldsExactPositionsTreatingMinusZeroAsZero) {
 
 TEST(MeshIndexer, UsesVertexIdsWhenPresent) {
     io::MeshIndexer ix("out.glb", "glTF", io::Channels::ids_only(), false);
-    io::TriangleChunk c = chunk_of({{0, 0, 0, 1, 0, 0, 1, 1, 0}, {0, 0, 0, 1, 1, 0, 0, 1, 0}}, io::Channels::ids_only());
+    io::TriangleChunk c =
+        chunk_of({{0, 0, 0, 1, 0, 0, 1, 1, 0}, {0, 0, 0, 1, 1, 0, 0, 1, 0}}, io::Channels::ids_only());
     const uint64_t ids[6] = {7, 8, 9, 17, 9, 18};  // corner 1 of triangle 1 shares id 9
     for (int t = 0; t < 2; ++t)
         for (int k = 0; k < 3; ++k) c.id_at(t)[k] = ids[3 * t + k];
@@ -86,8 +87,9 @@ TEST(MeshIndexer, DropsNonFiniteTrianglesOrRefusesThemUnderStrict) {
     EXPECT_EQ(ix.non_finite_count(), 1u);
     EXPECT_EQ(ix.triangle_count(), 2u);
     ASSERT_EQ(ix.notes().size(), 1u);
-    EXPECT_EQ(ix.notes()[0], "1 of the 3 triangles have a NaN or infinite coordinate, which glTF cannot store: left "
-                             "out (--strict makes this an error)");
+    EXPECT_EQ(ix.notes()[0],
+              "1 of the 3 triangles have a NaN or infinite coordinate, which glTF cannot store: left "
+              "out (--strict makes this an error)");
     io::MeshIndexer strict("out.drc", "Draco", {}, true);
     strict.add(chunk_of({{0, 0, 0, 1, 0, 0, 1, 1, 0}}));
     try {
@@ -118,7 +120,8 @@ TEST(MeshIndexer, PartsSplitTrianglesByMaterialWithTheirOwnVertices) {
     io::Channels ch;
     ch.material = true;
     io::MeshIndexer ix("out.glb", "glTF", ch, false);
-    io::TriangleChunk c = chunk_of({{0, 0, 0, 1, 0, 0, 1, 1, 0}, {0, 0, 0, 1, 1, 0, 0, 1, 0}, {5, 5, 5, 6, 5, 5, 6, 6, 5}}, ch);
+    io::TriangleChunk c =
+        chunk_of({{0, 0, 0, 1, 0, 0, 1, 1, 0}, {0, 0, 0, 1, 1, 0, 0, 1, 0}, {5, 5, 5, 6, 5, 5, 6, 6, 5}}, ch);
     *c.material_at(0) = 2;
     *c.material_at(1) = 0;
     *c.material_at(2) = 2;

@@ -31,12 +31,18 @@ using test::TempDir;
 
 TEST(ObjReader, ReadsCorpusFixturesWithManifestCounts) {
     const std::pair<const char*, size_t> cases[] = {
-        {"obj/WusonOBJ.obj", 3732},          {"obj/WusonOBJ.obj.gz", 3732},
-        {"obj/box.obj", 12},                 {"obj/box_negative_indices.obj", 12},
-        {"obj/box_without_lineending.obj", 12}, {"obj/concave_polygon.obj", 64},
-        {"obj/cube_mtllib_after_g.obj", 12}, {"obj/cube_usemtl.obj", 12},
-        {"obj/cube_with_vertexcolors.obj", 12}, {"obj/double_torus_normals.obj", 466},
-        {"obj/multiple_spaces.obj", 1},      {"obj/regr_3429812.obj", 4},
+        {"obj/WusonOBJ.obj", 3732},
+        {"obj/WusonOBJ.obj.gz", 3732},
+        {"obj/box.obj", 12},
+        {"obj/box_negative_indices.obj", 12},
+        {"obj/box_without_lineending.obj", 12},
+        {"obj/concave_polygon.obj", 64},
+        {"obj/cube_mtllib_after_g.obj", 12},
+        {"obj/cube_usemtl.obj", 12},
+        {"obj/cube_with_vertexcolors.obj", 12},
+        {"obj/double_torus_normals.obj", 466},
+        {"obj/multiple_spaces.obj", 1},
+        {"obj/regr_3429812.obj", 4},
         {"obj/testmixed.obj", 12},
     };
     for (const auto& [file, triangles] : cases) {
@@ -146,8 +152,9 @@ TEST(ObjReader, ConcavePolygonsAreCoveredOnceAndConvexOnesFanned) {
 // triangulation, but each still gives n - 2 triangles.
 TEST(ObjReader, DegeneratePolygonsStillGiveNMinus2Triangles) {
     TempDir dir;
-    test::spit(dir / "d.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 3 0 0\nv 1 1 0\nv 0 1 0\n"
-                              "f 1 2 3 4 2\nf 1 2 2 5 6\nf 1 5 2 6\n");
+    test::spit(dir / "d.obj",
+               "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 3 0 0\nv 1 1 0\nv 0 1 0\n"
+               "f 1 2 3 4 2\nf 1 2 2 5 6\nf 1 5 2 6\n");
     EXPECT_EQ(read_soup(dir / "d.obj").triangles(), 3u + 3 + 2);
 }
 
@@ -182,7 +189,8 @@ TEST(ObjReader, BadInputNamesFileLineAndOffset) {
     };
     const Case cases[] = {
         {head + "f 1 2 0\n", "vertex index 0 is invalid (OBJ indices start at 1)", 4, head.size()},
-        {head + "f 1 2 3\nf 1 2 4\nv 1 1 1\n", "vertex index 4 refers past the 3 vertices defined so far", 5, head.size() + 8},
+        {head + "f 1 2 3\nf 1 2 4\nv 1 1 1\n", "vertex index 4 refers past the 3 vertices defined so far", 5,
+         head.size() + 8},
         {head + "f -4 1 2\n", "vertex index -4 refers past the 3 vertices defined so far", 4, head.size()},
         {head + "# note\nv 1 x 2\n", "expected a coordinate, found 'x'", 5, head.size() + 7},
         {head + "v 1 2\n", "'v' needs 3 coordinates, found 2", 4, head.size()},
@@ -190,7 +198,8 @@ TEST(ObjReader, BadInputNamesFileLineAndOffset) {
         {head + "f 1 \\\n 2 \\\n 9\n", "vertex index 9 refers past", 4, head.size()},
         // Anything after x y z but w and r g b: a lost line end used to drop the second vertex
         // (and shift every later index), junk was ignored.
-        {head + "v 0 0 0 v 1 0 0\nf 1 2 3\n", "expected a number (w or colour) after 'v x y z', found 'v'", 4, head.size()},
+        {head + "v 0 0 0 v 1 0 0\nf 1 2 3\n", "expected a number (w or colour) after 'v x y z', found 'v'", 4,
+         head.size()},
         {head + "v 0 0 0 foo\n", "found 'foo'", 4, head.size()},
         {head + "v 1 2 3 4 5\n", "'v' with 5 numbers (x y z, then w and/or r g b)", 4, head.size()},
         {head + "v 1 2 3 4 5 6 7 8\n", "'v' with 8 numbers", 4, head.size()},
@@ -257,13 +266,16 @@ TEST(ObjFormat, TextIsGuessedObjWhenTheNameSaysNothingElse) {
     // that claims a format wins over the guess ("g" is OBJ's group statement and a GLB's first
     // byte).
     TempDir dir;
-    auto detected = [](const std::string& path) { return std::string(io::detect_input_format(*io::ByteSource::open(path)).name); };
+    auto detected = [](const std::string& path) {
+        return std::string(io::detect_input_format(*io::ByteSource::open(path)).name);
+    };
     for (const char* name : {"mesh", "mesh.txt", "mesh.obj"}) {
         test::spit(dir / name, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
         EXPECT_EQ(detected(dir / name), "obj") << name;
         EXPECT_EQ(read_soup(dir / name).triangles(), 1u) << name;
     }
-    const std::pair<const char*, const char*> named[] = {{"g.glb", "glb"}, {"p.ply", "ply"}, {"s.stl", "stl"}, {"g", "obj"}};
+    const std::pair<const char*, const char*> named[] = {
+        {"g.glb", "glb"}, {"p.ply", "ply"}, {"s.stl", "stl"}, {"g", "obj"}};
     for (const auto& [name, format] : named) {
         test::spit(dir / name, std::string_view(name, 1));
         EXPECT_EQ(detected(dir / name), format) << name;
@@ -283,7 +295,9 @@ TEST(ObjFormat, TextIsGuessedObjWhenTheNameSaysNothingElse) {
 }
 
 TEST(ObjFormat, GuessAcceptsObjTextAndRejectsBinaryAndStl) {
-    auto probe = [](std::string_view s) { return io::guess_obj({reinterpret_cast<const std::byte*>(s.data()), s.size()}); };
+    auto probe = [](std::string_view s) {
+        return io::guess_obj({reinterpret_cast<const std::byte*>(s.data()), s.size()});
+    };
     EXPECT_TRUE(probe("# Blender\nmtllib a.mtl\no Cube\nv 1 2 3\n"));
     EXPECT_TRUE(probe("\r\n  v 1 2 3\r\n"));
     EXPECT_TRUE(probe("# only a comment\n"));

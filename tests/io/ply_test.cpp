@@ -263,10 +263,11 @@ TEST(PlyReader, ConcavePolygonsAreCoveredOnceWithTheirColours) {
         first += p.corners();
     }
     TempDir dir;
-    test::spit(dir / "p.ply", "ply\nformat ascii 1.0\nelement vertex 22\nproperty float x\nproperty float y\n"
-                              "property float z\nproperty uchar red\nproperty uchar green\nproperty uchar blue\n"
-                              "element face 2\nproperty list uchar int vertex_indices\nend_header\n" +
-                                  vertices + faces);
+    test::spit(dir / "p.ply",
+               "ply\nformat ascii 1.0\nelement vertex 22\nproperty float x\nproperty float y\n"
+               "property float z\nproperty uchar red\nproperty uchar green\nproperty uchar blue\n"
+               "element face 2\nproperty list uchar int vertex_indices\nend_header\n" +
+                   vertices + faces);
     for (size_t capacity : {size_t{1}, size_t{7}, io::TriangleChunk::kDefaultCapacity}) {
         SCOPED_TRACE(capacity);
         test::Soup s = read_soup(dir / "p.ply", capacity);
@@ -280,8 +281,8 @@ TEST(PlyReader, ConcavePolygonsAreCoveredOnceWithTheirColours) {
 }
 
 TEST(PlyReader, ChunkCapacitiesGiveIdenticalTriangles) {
-    for (const char* file : {"ply/mpi_ngons.ascii.ply", "ply/cube_quads.binary_be.ply", "ply/cactus_vcolor.binary_le.ply",
-                             "ply/elephant_normals.binary_be.ply.gz"}) {
+    for (const char* file : {"ply/mpi_ngons.ascii.ply", "ply/cube_quads.binary_be.ply",
+                             "ply/cactus_vcolor.binary_le.ply", "ply/elephant_normals.binary_be.ply.gz"}) {
         SCOPED_TRACE(file);
         test::Soup whole = read_soup(fixture(file));
         for (size_t capacity : {size_t{1}, size_t{7}}) {
@@ -302,10 +303,11 @@ TEST(PlyReader, FillsColourFromUcharAndFloatChannels) {
     EXPECT_TRUE(any_nonzero);
 
     TempDir dir;  // float colours in [0, 1] scale to 0..255
-    test::spit(dir / "c.ply",
-               "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
-               "property float red\nproperty float green\nproperty float blue\nelement face 1\n"
-               "property list uchar int vertex_indices\nend_header\n0 0 0 1 0 0.5\n1 0 0 0 1 0\n0 1 0 0 0 1\n3 0 1 2\n");
+    test::spit(
+        dir / "c.ply",
+        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+        "property float red\nproperty float green\nproperty float blue\nelement face 1\n"
+        "property list uchar int vertex_indices\nend_header\n0 0 0 1 0 0.5\n1 0 0 0 1 0\n0 1 0 0 0 1\n3 0 1 2\n");
     test::Soup s = read_soup(dir / "c.ply");
     EXPECT_EQ(s.rgb, (std::vector<uint8_t>{255, 0, 128, 0, 255, 0, 0, 0, 255}));
 }
@@ -320,8 +322,9 @@ TEST(PlyReader, DoubleCoordinatesRoundedToFloatAreNoted) {
             if (k == io::kPrecisionNote) return v;
         return std::string("<none>");
     };
-    const std::string header = "ply\nformat ascii 1.0\nelement vertex 3\nproperty double x\nproperty double y\n"
-                               "property double z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
+    const std::string header =
+        "ply\nformat ascii 1.0\nelement vertex 3\nproperty double x\nproperty double y\n"
+        "property double z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
     test::spit(dir / "utm.ply", header + "500000 4000000.12 100\n500001 4000000 100\n500000 4000001 100.5\n3 0 1 2\n");
     test::Soup utm = read_soup(dir / "utm.ply");
     EXPECT_EQ(utm.xyz[1], 4000000.0f);
@@ -331,9 +334,10 @@ TEST(PlyReader, DoubleCoordinatesRoundedToFloatAreNoted) {
     const test::Soup exact = read_soup(dir / "exact.ply");
     EXPECT_EQ(note(exact), "double, rounded to float: moved by up to 0");
     EXPECT_EQ(exact.header.coordinate_rounding, 0.0);
-    test::spit(dir / "float.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
-                                  "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
-                                  "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+    test::spit(dir / "float.ply",
+               "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+               "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+               "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
     const test::Soup single = read_soup(dir / "float.ply");
     EXPECT_EQ(note(single), "<none>");
     EXPECT_FALSE(single.header.coordinate_rounding.has_value());
@@ -346,7 +350,8 @@ TEST(PlyReader, AnyCoordinateTypeAndElementsAroundVertexAndFace) {
     test::spit(dir / "t.ply",
                "ply\r\nformat ascii 1.0 \r\ncomment made by hand\r\nobj_info nothing\r\n"
                "element material 1\r\nproperty uchar ambient\r\nproperty list uchar float weights\r\n"
-               "element vertex 4\r\nproperty int16 x\r\nproperty short y\r\nproperty float64 z\r\nproperty uchar confidence\r\n"
+               "element vertex 4\r\nproperty int16 x\r\nproperty short y\r\nproperty float64 z\r\nproperty uchar "
+               "confidence\r\n"
                "element tag 2\r\nproperty list int int values\r\n"
                "element face 2\r\nproperty list ushort uint vertex_index\r\nproperty int flags\r\n"
                "element edge 1\r\nproperty int a\r\nproperty int b\r\n"
@@ -433,7 +438,8 @@ TEST(PlyRoundTrip, StlThroughEveryPlyEncodingAndObjBackToStlIsExact) {
             }
         }
         // Binary and ascii PLY decode to the same soup, and ids survive PLY -> PLY.
-        test::Soup le = read_soup(dir / "le.ply"), ascii = read_soup(dir / "ascii.ply.gz"), be = read_soup(dir / "be.ply");
+        test::Soup le = read_soup(dir / "le.ply"), ascii = read_soup(dir / "ascii.ply.gz"),
+                   be = read_soup(dir / "be.ply");
         EXPECT_EQ(le.xyz, ascii.xyz);
         EXPECT_EQ(le.xyz, be.xyz);
         EXPECT_EQ(le.ids, ascii.ids);
@@ -488,7 +494,9 @@ TEST(PlyWriter, WritesHeaderCommentsAndColour) {
     out.finish();
     std::string text = test::slurp(dir / "c.ply");
     EXPECT_EQ(text.rfind("ply\nformat ascii 1.0\ncomment generated by meshstream\n"
-                         "comment meshstream sorted-axis=z\ncomment first\ncomment second\n", 0), 0u);
+                         "comment meshstream sorted-axis=z\ncomment first\ncomment second\n",
+                         0),
+              0u);
     EXPECT_NE(text.find("property uchar red\nproperty uchar green\nproperty uchar blue\n"), std::string::npos);
     test::Soup original = read_soup(fixture("ply/cactus_vcolor.binary_le.ply"));
     test::Soup copy = read_soup(dir / "c.ply");
@@ -547,9 +555,11 @@ TEST(PlyReader, BadInputNamesFileElementItemAndOffset) {
         uint64_t offset, line;
     };
     const Case cases[] = {
-        {head + "3 0 1 2\n3 0 1 3\n", "element 'face' item 1: vertex index 3 out of range (3 vertices)", head.size() + 14, 14},
+        {head + "3 0 1 2\n3 0 1 3\n", "element 'face' item 1: vertex index 3 out of range (3 vertices)",
+         head.size() + 14, 14},
         {head + "3 0 -1 2\n", "element 'face' item 0: vertex index -1 out of range", head.size() + 4, 13},
-        {head + "3 0 1 2\n", "element 'face' item 1: file ends early (header promises 2 face items)", head.size() + 8, 14},
+        {head + "3 0 1 2\n", "element 'face' item 1: file ends early (header promises 2 face items)", head.size() + 8,
+         14},
         {head + "3 0 1 x\n", "element 'face' item 0: expected a number, found 'x'", head.size() + 6, 13},
     };
     for (const Case& c : cases) {
@@ -562,12 +572,14 @@ TEST(PlyReader, BadInputNamesFileElementItemAndOffset) {
         EXPECT_EQ(e.line(), c.line) << e.what();
     }
     // Binary: a header promising more vertices than the file holds, and a negative index.
-    std::string bin = "ply\nformat binary_little_endian 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
-                      "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
+    std::string bin =
+        "ply\nformat binary_little_endian 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
+        "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
     test::spit(dir / "short.ply", bin + std::string(12, '\0'));
     io::Error e = read_error(dir / "short.ply");
     EXPECT_NE(e.message().find("element 'vertex' item 1: file ends early (header promises 2 vertex items)"),
-              std::string::npos) << e.what();
+              std::string::npos)
+        << e.what();
     std::string body(24, '\0');
     body += '\3';
     const int32_t idx[3] = {0, 1, -5};

@@ -72,9 +72,9 @@ TEST(TriangulatePolygon, TriangleIsItself) {
 TEST(TriangulatePolygon, ConvexPolygonsGiveTheFanFromCorner0) {
     std::vector<Corners2> shapes = {
         {{0, 0}, {1, 0}, {1, 1}, {0, 1}},
-        {{0, 0}, {2, 0}, {2, 0.001}, {0, 1}},                                    // a near-triangle
-        {{0, 0}, {1, 0}, {2, 0}, {2, 1}, {2, 2}, {1, 2}, {0, 2}, {0, 1}},        // straight corners
-        {{0, 0}, {1, 0}, {1, 0}, {1, 1}, {0, 1}, {0, 0}},                        // repeated corners
+        {{0, 0}, {2, 0}, {2, 0.001}, {0, 1}},                              // a near-triangle
+        {{0, 0}, {1, 0}, {2, 0}, {2, 1}, {2, 2}, {1, 2}, {0, 2}, {0, 1}},  // straight corners
+        {{0, 0}, {1, 0}, {1, 0}, {1, 1}, {0, 1}, {0, 0}},                  // repeated corners
     };
     for (size_t n = 5; n <= 64; n += 3) shapes.push_back(regular(n));
     for (const Corners2& shape : shapes)

@@ -186,8 +186,7 @@ TEST(VertexTable, FileTableStaysWithinItsBudgetWhenTheFileWasReadAhead) {
         ASSERT_EQ(::fdatasync(fd), 0);
         ASSERT_EQ(::posix_fadvise(fd, 0, 0, POSIX_FADV_DONTNEED), 0);
         std::vector<char> buffer(size_t{1} << 20);
-        while (::read(fd, buffer.data(), buffer.size()) > 0) {
-        }
+        while (::read(fd, buffer.data(), buffer.size()) > 0) {}
         ::close(fd);
     }
     const uint64_t budget = uint64_t{8} << 20;

@@ -47,7 +47,8 @@ inline Soup read_soup(const std::string& path, size_t capacity = io::TriangleChu
 }
 
 // Writes `soup` to `path`; returns the writer's notes.
-inline std::vector<std::string> write_soup(const Soup& soup, const std::string& path, const io::WriteOptions& options = {}) {
+inline std::vector<std::string> write_soup(const Soup& soup, const std::string& path,
+                                           const io::WriteOptions& options = {}) {
     io::Output out = io::open_output(path, {}, options);
     io::TriangleChunk chunk(1000);
     for (size_t t = 0; t < soup.triangles(); ++t) {
@@ -147,7 +148,8 @@ inline ChannelErrors compare_meshes(const Mesh& a, const Mesh& b, double positio
     // Grid of b's triangles by centroid, cells of 4 tolerances (and at least 1e-6).
     const double cell = std::max(4 * position_tolerance, 1e-6);
     auto key = [&](const float* t, int dx, int dy, int dz) {
-        const long x = std::lround((t[0] + t[3] + t[6]) / 3 / cell) + dx, y = std::lround((t[1] + t[4] + t[7]) / 3 / cell) + dy,
+        const long x = std::lround((t[0] + t[3] + t[6]) / 3 / cell) + dx,
+                   y = std::lround((t[1] + t[4] + t[7]) / 3 / cell) + dy,
                    z = std::lround((t[2] + t[5] + t[8]) / 3 / cell) + dz;
         return std::array<long, 3>{x, y, z};
     };
@@ -184,16 +186,20 @@ inline ChannelErrors compare_meshes(const Mesh& a, const Mesh& b, double positio
         for (int k = 0; k < 3; ++k) {
             const size_t ca = 3 * t + k, cb = 3 * best + (k + best_rot) % 3;
             if (!a.normals.empty() && !b.normals.empty())
-                for (int c = 0; c < 3; ++c) e.normal = std::max(e.normal, std::abs(double(a.normals[3 * ca + c]) - b.normals[3 * cb + c]));
+                for (int c = 0; c < 3; ++c)
+                    e.normal = std::max(e.normal, std::abs(double(a.normals[3 * ca + c]) - b.normals[3 * cb + c]));
             if (!a.colors.empty() && !b.colors.empty())
-                for (int c = 0; c < 4; ++c) e.color = std::max(e.color, std::abs(double(a.colors[4 * ca + c]) - b.colors[4 * cb + c]));
+                for (int c = 0; c < 4; ++c)
+                    e.color = std::max(e.color, std::abs(double(a.colors[4 * ca + c]) - b.colors[4 * cb + c]));
             if (!a.uvs.empty() && !b.uvs.empty())
-                for (int c = 0; c < 2; ++c) e.uv = std::max(e.uv, std::abs(double(a.uvs[2 * ca + c]) - b.uvs[2 * cb + c]));
+                for (int c = 0; c < 2; ++c)
+                    e.uv = std::max(e.uv, std::abs(double(a.uvs[2 * ca + c]) - b.uvs[2 * cb + c]));
             for (size_t s = 0; s < a.scalars.size() && s < b.scalars.size(); ++s)
                 e.scalar = std::max(e.scalar, std::abs(a.scalars[s][ca] - b.scalars[s][cb]));
         }
         if (!a.materials.empty() && !b.materials.empty())
-            e.material_mismatches += a.header.materials[a.materials[t]].name != b.header.materials[b.materials[best]].name;
+            e.material_mismatches +=
+                a.header.materials[a.materials[t]].name != b.header.materials[b.materials[best]].name;
     }
     return e;
 }
@@ -239,7 +245,9 @@ struct Quantization {
         return static_cast<int32_t>(std::floor(val + 0.5f));
     }
     // Grid index of a decoded (already dequantized) coordinate.
-    int32_t snap(float v, int a) const { return static_cast<int32_t>(std::lround((double(v) - min[a]) / (double(range) / max_q()))); }
+    int32_t snap(float v, int a) const {
+        return static_cast<int32_t>(std::lround((double(v) - min[a]) / (double(range) / max_q())));
+    }
 };
 
 using TriKey = std::array<int32_t, 9>;
@@ -288,7 +296,8 @@ inline double expect_within_quantization_bound(const Soup& original, const Soup&
             double best = 1e300;
             for (int e = 0; e < 3; ++e) {
                 double m = 0;
-                for (int a = 0; a < 3; ++a) m = std::max(m, std::abs(double(original.xyz[9 * t + 3 * c + a]) - d[3 * e + a]));
+                for (int a = 0; a < 3; ++a)
+                    m = std::max(m, std::abs(double(original.xyz[9 * t + 3 * c + a]) - d[3 * e + a]));
                 best = std::min(best, m);
             }
             worst = std::max(worst, best);

@@ -3,8 +3,8 @@
 // across spilled runs.
 #include "io/weld.hpp"
 
-#include "io/record_sort.hpp"
 #include "indexed_test_util.hpp"
+#include "io/record_sort.hpp"
 
 #include <gtest/gtest.h>
 
@@ -41,7 +41,10 @@ Welded weld(const std::vector<float>& soup, uint64_t budget, io::Channels channe
                 for (int k = 0; k < 3; ++k) chunk.id_at(i)[k] = ids[3 * t + k];
             if (channels.color)  // 8-bit RGB of the corner's position, alpha 1
                 for (int k = 0; k < 12; ++k)
-                    chunk.color_at(i)[k] = k % 4 == 3 ? 1.0f : float(static_cast<uint8_t>(7 * p[3 * (k / 4)] + 3 * p[3 * (k / 4) + 1] + k % 4)) / 255.0f;
+                    chunk.color_at(i)[k] =
+                        k % 4 == 3
+                            ? 1.0f
+                            : float(static_cast<uint8_t>(7 * p[3 * (k / 4)] + 3 * p[3 * (k / 4) + 1] + k % 4)) / 255.0f;
         }
         w.add(chunk);
         w.finish();
@@ -51,7 +54,8 @@ Welded weld(const std::vector<float>& soup, uint64_t budget, io::Channels channe
         while (size_t n = w.next_vertices(xyz, records))
             for (size_t i = 0; i < n; ++i) {
                 out.xyz.insert(out.xyz.end(), &xyz[3 * i], &xyz[3 * i] + 3);
-                for (size_t b = 0; b < w.layout().bytes(); ++b) out.rgb.push_back(uint8_t(records[w.layout().bytes() * i + b]));
+                for (size_t b = 0; b < w.layout().bytes(); ++b)
+                    out.rgb.push_back(uint8_t(records[w.layout().bytes() * i + b]));
             }
         std::vector<uint32_t> idx(300);
         while (size_t n = w.next_indices(idx)) out.indices.insert(out.indices.end(), idx.begin(), idx.begin() + n);

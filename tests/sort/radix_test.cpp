@@ -13,8 +13,18 @@ using namespace meshstream::sort;
 
 TEST(OrderedKey, PreservesFloatOrder) {
     const float inf = std::numeric_limits<float>::infinity();
-    const float values[] = {-inf, -3.4e38f, -1.5f, -1e-30f, -std::numeric_limits<float>::denorm_min(), 0.0f,
-                            std::numeric_limits<float>::denorm_min(), 1e-30f, 1.0f, 1.0000001f, 3.4e38f, inf};
+    const float values[] = {-inf,
+                            -3.4e38f,
+                            -1.5f,
+                            -1e-30f,
+                            -std::numeric_limits<float>::denorm_min(),
+                            0.0f,
+                            std::numeric_limits<float>::denorm_min(),
+                            1e-30f,
+                            1.0f,
+                            1.0000001f,
+                            3.4e38f,
+                            inf};
     for (size_t i = 1; i < std::size(values); ++i)
         EXPECT_LT(ordered_key(values[i - 1]), ordered_key(values[i])) << values[i - 1] << " vs " << values[i];
     EXPECT_EQ(ordered_key(-0.0f), ordered_key(0.0f));
@@ -43,10 +53,12 @@ TEST(RadixSort, MatchesStableSortOnRandomKeys) {
                 items[i] = uint64_t{key} << 32 | i;
             }
             std::vector<uint64_t> expect = items;
-            std::stable_sort(expect.begin(), expect.end(), [](uint64_t a, uint64_t b) { return (a >> 32) < (b >> 32); });
+            std::stable_sort(expect.begin(), expect.end(),
+                             [](uint64_t a, uint64_t b) { return (a >> 32) < (b >> 32); });
             auto sorted = radix_sort_by_key(items, scratch);
             ASSERT_EQ(sorted.size(), n);
-            EXPECT_TRUE(std::equal(sorted.begin(), sorted.end(), expect.begin())) << "n=" << n << " distinct=" << distinct;
+            EXPECT_TRUE(std::equal(sorted.begin(), sorted.end(), expect.begin()))
+                << "n=" << n << " distinct=" << distinct;
         }
     }
 }

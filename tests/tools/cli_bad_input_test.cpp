@@ -92,7 +92,8 @@ TEST(CliBadInput, RandomBytesUnderEachExtensionExit1WithNoOutput) {
             CliRun r = run(std::string(cmd) + " " + in + " " + dir / "out.ply");
             EXPECT_EQ(r.code, 1) << cmd << " " << ext << ": " << r.err;
             EXPECT_EQ(r.err.rfind("meshstream: error: " + in, 0), 0u) << r.err;
-            EXPECT_EQ(listing(dir.path()), std::vector<std::string>{fs::path(in).filename().string()}) << cmd << " " << ext;
+            EXPECT_EQ(listing(dir.path()), std::vector<std::string>{fs::path(in).filename().string()})
+                << cmd << " " << ext;
         }
         fs::remove(in);
     }
@@ -140,13 +141,14 @@ TEST(CliBadInput, AnOutputThatIsAnInputIsRefusedBeforeAnythingIsWritten) {
     fs::create_symlink(dir / "in.stl", dir / "link.stl");
     fs::create_hard_link(dir / "in.stl", dir / "hard.stl");
     const std::vector<std::string> entries = listing(dir.path());
-    for (const std::string cmd : {"convert", "sort --axis x", "decimate -r 0.5", "decimate --report -r 0.5",
-                                  "convert --to stream"}) {
+    for (const std::string cmd :
+         {"convert", "sort --axis x", "decimate -r 0.5", "decimate --report -r 0.5", "convert --to stream"}) {
         for (const std::string out : {"in.stl", "link.stl", "hard.stl"}) {
             CliRun r = run(cmd + " " + dir / "in.stl" + " " + dir / out);
             EXPECT_EQ(r.code, 2) << cmd << " > " << out << ": " << r.err;
-            EXPECT_EQ(r.err.rfind("meshstream: error: " + dir / out + ": would overwrite the input " + dir / "in.stl", 0),
-                      0u) << r.err;
+            EXPECT_EQ(
+                r.err.rfind("meshstream: error: " + dir / out + ": would overwrite the input " + dir / "in.stl", 0), 0u)
+                << r.err;
             EXPECT_EQ(r.err.find("through a link") != std::string::npos, out != "in.stl") << r.err;
             EXPECT_EQ(slurp(dir / "in.stl"), before) << cmd;
             EXPECT_EQ(listing(dir.path()), entries) << cmd;
@@ -155,11 +157,12 @@ TEST(CliBadInput, AnOutputThatIsAnInputIsRefusedBeforeAnythingIsWritten) {
         // stdout appended to the input: `meshstream ... - >> in.stl`.
         CliRun piped = run(cmd + " --to stl " + dir / "in.stl" + " - >> " + dir / "in.stl");
         EXPECT_EQ(piped.code, 2) << cmd << ": " << piped.err;
-        EXPECT_NE(piped.err.find("<stdout>: would overwrite the input " + dir / "in.stl"), std::string::npos) << piped.err;
+        EXPECT_NE(piped.err.find("<stdout>: would overwrite the input " + dir / "in.stl"), std::string::npos)
+            << piped.err;
         EXPECT_EQ(slurp(dir / "in.stl"), before) << cmd;
     }
     for (const std::string& cmd : {"info " + dir / "in.stl", "compare " + dir / "in.stl" + " " + dir / "link.stl",
-                                  "convert --to stl - " + dir / "out.stl < " + dir / "in.stl"}) {
+                                   "convert --to stl - " + dir / "out.stl < " + dir / "in.stl"}) {
         if (cmd.starts_with("convert")) {
             // stdin from the input, stdout elsewhere: nothing is overwritten.
             EXPECT_EQ(run(cmd).code, 0) << cmd;
@@ -178,7 +181,8 @@ TEST(CliBadInput, AnOutputThatIsAnInputIsRefusedBeforeAnythingIsWritten) {
     EXPECT_EQ(side.code, 2) << side.err;
     EXPECT_NE(side.err.find(dir / "mesh.gltf: its side file " + dir / "mesh.bin" + " would overwrite the input " +
                             dir / "mesh.bin"),
-              std::string::npos) << side.err;
+              std::string::npos)
+        << side.err;
     EXPECT_FALSE(fs::exists(dir / "mesh.gltf"));
     ASSERT_EQ(run("convert --no-draco " + dir / "in.stl" + " " + dir / "scene.gltf").code, 0);
     const std::string buffer = slurp(dir / "scene.bin");
@@ -186,7 +190,8 @@ TEST(CliBadInput, AnOutputThatIsAnInputIsRefusedBeforeAnythingIsWritten) {
     EXPECT_EQ(over.code, 2) << over.err;
     EXPECT_NE(over.err.find(dir / "scene.bin: would overwrite " + dir / "scene.bin" + ", which the input " +
                             dir / "scene.gltf" + " reads"),
-              std::string::npos) << over.err;
+              std::string::npos)
+        << over.err;
     EXPECT_EQ(slurp(dir / "scene.bin"), buffer);
     // stdin and stdout the same file.
     CliRun both = run("convert --to stl - - < " + dir / "in.stl" + " >> " + dir / "link.stl");
@@ -203,10 +208,12 @@ TEST(CliBadInput, TextInputWithoutAFinalLineEndIsWarnedAbout) {
         CliRun r = run(command + " " + dir / "cut.obj" + " " + dir / "out.stl");
         EXPECT_EQ(r.code, 0) << command << ": " << r.err;
         // (sort used to look at the header as it was before the input was read)
-        EXPECT_NE(r.err.find("warning: " + dir / "cut.obj" +
-                             ": the last line has no line end: the file may be cut short inside it (a truncated download "
-                             "or pipe?): check its last face"),
-                  std::string::npos) << command << ": " << r.err;
+        EXPECT_NE(
+            r.err.find("warning: " + dir / "cut.obj" +
+                       ": the last line has no line end: the file may be cut short inside it (a truncated download "
+                       "or pipe?): check its last face"),
+            std::string::npos)
+            << command << ": " << r.err;
     }
 }
 
@@ -217,7 +224,8 @@ TEST(CliBadInput, GzipLevelForAnOutputThatIsNotGzipIsNoted) {
     CliRun r = run("convert --gzip-level 9 " + dir / "in.stl" + " " + dir / "out.stl");
     EXPECT_EQ(r.code, 0) << r.err;
     EXPECT_NE(r.err.find("warning: --gzip-level applies to outputs named *.gz: ignored for " + dir / "out.stl"),
-              std::string::npos) << r.err;
+              std::string::npos)
+        << r.err;
     CliRun piped = run("convert --gzip-level 1 --to stl " + dir / "in.stl" + " - > " + dir / "piped.stl");
     EXPECT_NE(piped.err.find("ignored for <stdout> (pipe it through gzip)"), std::string::npos) << piped.err;
     CliRun gz = run("convert --gzip-level 9 " + dir / "in.stl" + " " + dir / "out.stl.gz");
@@ -249,24 +257,27 @@ void expect_refusals(const TempDir& dir, const std::string& command, std::initia
 TEST(CliBadInput, DecimateOptionValuesOutOfRangeAreRefusedClearly) {
     TempDir dir;
     write_file(dir / "in.stl", binary_stl(grid(4)));  // 32 triangles
-    expect_refusals(dir, "decimate",
-                    {
-                        {"--ratio 0", 2, "--ratio: must be a number in (0, 1], found '0'"},
-                        {"--ratio 1.5", 2, "--ratio: must be a number in (0, 1], found '1.5'"},
-                        {"--target 0", 2, "--target: must be a whole number of triangles from 1 to 18446744073709551615, found '0'"},
-                        {"--target -3", 2, "--target: must be a whole number of triangles from 1 to 18446744073709551615, found '-3'"},
-                        // used to be clamped to 2^64 - 1 and named as such
-                        {"--target 18446744073709551616", 2, "found '18446744073709551616'"},
-                        // used to wrap to 2^64 - 1, and larger ones were clamped to it
-                        {"--seed -1", 2, "--seed: must be a whole number from 0 to 18446744073709551615, found '-1'"},
-                        {"--seed 18446744073709551616", 2, "--seed: must be a whole number from 0 to 18446744073709551615"},
-                        // used to weld on a grid of 1 (a decimal comma) or of 1 (a unit)
-                        {"--weld 1,5", 2, "--weld: expected a number or a percentage, found '1,5'"},
-                        {"--weld 1mm", 2, "--weld: expected a number or a percentage, found '1mm'"},
-                        {"--weld 0.5.5%", 2, "--weld: expected a number or a percentage, found '0.5.5%'"},
-                        {"--target 33", 2, "in.stl: --target 33 is more than the 32 triangles of the input"},
-                        {"--sorted-axis w", 2, "--sorted-axis: must be x, y or z (or 0, 1, 2), found 'w'"},
-                    });
+    expect_refusals(
+        dir, "decimate",
+        {
+            {"--ratio 0", 2, "--ratio: must be a number in (0, 1], found '0'"},
+            {"--ratio 1.5", 2, "--ratio: must be a number in (0, 1], found '1.5'"},
+            {"--target 0", 2,
+             "--target: must be a whole number of triangles from 1 to 18446744073709551615, found '0'"},
+            {"--target -3", 2,
+             "--target: must be a whole number of triangles from 1 to 18446744073709551615, found '-3'"},
+            // used to be clamped to 2^64 - 1 and named as such
+            {"--target 18446744073709551616", 2, "found '18446744073709551616'"},
+            // used to wrap to 2^64 - 1, and larger ones were clamped to it
+            {"--seed -1", 2, "--seed: must be a whole number from 0 to 18446744073709551615, found '-1'"},
+            {"--seed 18446744073709551616", 2, "--seed: must be a whole number from 0 to 18446744073709551615"},
+            // used to weld on a grid of 1 (a decimal comma) or of 1 (a unit)
+            {"--weld 1,5", 2, "--weld: expected a number or a percentage, found '1,5'"},
+            {"--weld 1mm", 2, "--weld: expected a number or a percentage, found '1mm'"},
+            {"--weld 0.5.5%", 2, "--weld: expected a number or a percentage, found '0.5.5%'"},
+            {"--target 33", 2, "in.stl: --target 33 is more than the 32 triangles of the input"},
+            {"--sorted-axis w", 2, "--sorted-axis: must be x, y or z (or 0, 1, 2), found 'w'"},
+        });
     // Axes by name (any case) or number; the target may equal the input count.
     for (const char* ok : {"--sorted-axis z", "--sorted-axis Y", "--sorted-axis 0 --target 32"}) {
         CliRun r = run("decimate " + dir / "in.stl" + " " + dir / "out.stl " + ok);
@@ -289,7 +300,8 @@ TEST(CliBadInput, InfoCompareAndGenOptionValuesOutOfRangeAreRefusedClearly) {
         EXPECT_EQ(r.code, 2) << args << ": " << r.err;
         EXPECT_NE(r.err.find(message), std::string::npos) << args << ": " << r.err;
     }
-    const int gen = std::system((std::string(MESHSTREAM_GEN_BINARY) + " --seed -1 " + dir / "g.stl" + " 2>/dev/null").c_str());
+    const int gen =
+        std::system((std::string(MESHSTREAM_GEN_BINARY) + " --seed -1 " + dir / "g.stl" + " 2>/dev/null").c_str());
     EXPECT_EQ(WEXITSTATUS(gen), 2);
     EXPECT_EQ(listing(dir.path()), std::vector<std::string>{"in.stl"});
 }
@@ -297,25 +309,26 @@ TEST(CliBadInput, InfoCompareAndGenOptionValuesOutOfRangeAreRefusedClearly) {
 TEST(CliBadInput, MemoryBudgetsThatAreNotSizesOrTooSmallAreRefusedClearly) {
     TempDir dir;
     write_file(dir / "in.stl", binary_stl(grid(4)));
-    expect_refusals(dir, "sort --axis x",
-                    {
-                        {"--memory nan", 2, "--memory: expected a size like 64M or 1G, got 'nan'"},
-                        {"--memory -5M", 2, "--memory: expected a size like 64M or 1G, got '-5M'"},
-                        {"--memory 12Q", 2, "--memory: unknown size suffix in '12Q'"},
-                        // used to be "out of memory" (a run buffer of the budget's size)
-                        {"--memory 100T", 2, "--memory: 100T is more than this machine's memory ("},
-                        // past 2^64 bytes: used to wrap round to "too small" (or a tiny budget)
-                        {"--memory 99999999999999999999", 2,
-                         "--memory: 99999999999999999999 is more than this machine's memory ("},
-                        {"--memory 16777216T", 2, "--memory: 16777216T is more than this machine's memory ("},
-                        // used to be "out of memory"
-                        {"--memory 1", 2, "in.stl: --memory 1 is too small to sort: give at least 97K"},
-                        {"--memory 96K", 2, "in.stl: --memory 96K is too small to sort: give at least 97K"},
-                    });
+    expect_refusals(
+        dir, "sort --axis x",
+        {
+            {"--memory nan", 2, "--memory: expected a size like 64M or 1G, got 'nan'"},
+            {"--memory -5M", 2, "--memory: expected a size like 64M or 1G, got '-5M'"},
+            {"--memory 12Q", 2, "--memory: unknown size suffix in '12Q'"},
+            // used to be "out of memory" (a run buffer of the budget's size)
+            {"--memory 100T", 2, "--memory: 100T is more than this machine's memory ("},
+            // past 2^64 bytes: used to wrap round to "too small" (or a tiny budget)
+            {"--memory 99999999999999999999", 2, "--memory: 99999999999999999999 is more than this machine's memory ("},
+            {"--memory 16777216T", 2, "--memory: 16777216T is more than this machine's memory ("},
+            // used to be "out of memory"
+            {"--memory 1", 2, "in.stl: --memory 1 is too small to sort: give at least 97K"},
+            {"--memory 96K", 2, "in.stl: --memory 96K is too small to sort: give at least 97K"},
+        });
     CliRun ok = run("sort --axis x --memory 97K " + dir / "in.stl" + " " + dir / "out.stl");  // the least, exactly
     EXPECT_EQ(ok.code, 0) << ok.err;
-    for (const std::string& cmd : {"info --topology " + dir / "in.stl", "compare " + dir / "in.stl" + " " + dir / "in.stl",
-                                  "convert " + dir / "in.stl" + " " + dir / "o.ply"}) {
+    for (const std::string& cmd :
+         {"info --topology " + dir / "in.stl", "compare " + dir / "in.stl" + " " + dir / "in.stl",
+          "convert " + dir / "in.stl" + " " + dir / "o.ply"}) {
         for (const std::string size : {"100T", "1e30"}) {
             CliRun r = run(cmd + " --memory " + size);
             EXPECT_EQ(r.code, 2) << cmd;
@@ -333,7 +346,8 @@ TEST(CliBadInput, InputWithoutTrianglesGivesAnEmptyOutputAndAWarning) {
     for (const char* cmd : {"convert", "sort --axis x", "decimate"}) {
         CliRun r = run(std::string(cmd) + " " + dir / "none.obj" + " " + dir / "out.stl");
         EXPECT_EQ(r.code, 0) << cmd << ": " << r.err;
-        EXPECT_NE(r.err.find("meshstream: warning: the input holds no triangles\n"), std::string::npos) << cmd << ": " << r.err;
+        EXPECT_NE(r.err.find("meshstream: warning: the input holds no triangles\n"), std::string::npos)
+            << cmd << ": " << r.err;
         EXPECT_EQ(fs::file_size(dir / "out.stl"), 84u) << cmd;  // a valid STL of 0 triangles
         fs::remove(dir / "out.stl");
     }
@@ -360,11 +374,14 @@ TEST(CliBadInput, ForcedWritesEndWithAWarningThatAdvisesSort) {
     // So far out of order that written vertices are evicted: the cracks are owned up to.
     EXPECT_NE(line.find(" of their vertices were evicted from the weld table to make room, so triangles read later at "
                         "those positions are not joined to them (the output has cracks there)"),
-              std::string::npos) << line;
-    EXPECT_NE(line.find("either the input is not in streaming order (without --sort never decimate sorts it first; or "
-                        "run `meshstream sort` on it) or the buffer is too small for it at this ratio (raise --buffer): "
-                        "`meshstream info --order --ratio 0.1 --buffer 64` tells which"),
-              std::string::npos) << line;
+              std::string::npos)
+        << line;
+    EXPECT_NE(
+        line.find("either the input is not in streaming order (without --sort never decimate sorts it first; or "
+                  "run `meshstream sort` on it) or the buffer is too small for it at this ratio (raise --buffer): "
+                  "`meshstream info --order --ratio 0.1 --buffer 64` tells which"),
+        std::string::npos)
+        << line;
     EXPECT_NE(line.back(), ')') << line;  // no event count appended
 
     // Sorted input (here in row order, said by --sorted-axis) in a buffer below its width:
@@ -374,7 +391,8 @@ TEST(CliBadInput, ForcedWritesEndWithAWarningThatAdvisesSort) {
     EXPECT_EQ(s.code, 0) << s.err;
     EXPECT_NE(s.err.find("; the input is sorted, so the buffer is too small for it at this ratio: raise --buffer "
                          "(`meshstream info --order --ratio 0.1 --buffer 40` estimates the buffer it needs)"),
-              std::string::npos) << s.err;
+              std::string::npos)
+        << s.err;
     EXPECT_EQ(s.err.find("run `meshstream sort`"), std::string::npos) << s.err;
 }
 
@@ -386,21 +404,25 @@ TEST(CliBadInput, ASortedAxisTheSweepCannotUseIsNamed) {
     write_file(dir / "rows.stl", binary_stl(grid(24)));  // row order: sorted along y
     CliRun z = run("decimate --buffer 40 --sorted-axis z -r 0.1 " + dir / "rows.stl" + " " + dir / "out.stl");
     EXPECT_EQ(z.code, 0) << z.err;
-    EXPECT_NE(z.err.find("; the input is said to be sorted along z, but its triangles never moved along it by more than "
-                         "three of their lengths, so the sweep that finalizes hole boundaries never started: check the "
-                         "axis (`meshstream info --order --ratio 0.1 --buffer 40` counts the key descents along each)"),
-              std::string::npos) << z.err;
+    EXPECT_NE(
+        z.err.find("; the input is said to be sorted along z, but its triangles never moved along it by more than "
+                   "three of their lengths, so the sweep that finalizes hole boundaries never started: check the "
+                   "axis (`meshstream info --order --ratio 0.1 --buffer 40` counts the key descents along each)"),
+        std::string::npos)
+        << z.err;
     EXPECT_EQ(z.err.find("raise --buffer"), std::string::npos) << z.err;
     EXPECT_NE(z.err.find("instead of the target 115 (the triangles force-written at full resolution, above, count "
                          "against it)"),
-              std::string::npos) << z.err;
+              std::string::npos)
+        << z.err;
 
     ASSERT_EQ(run("sort --axis y " + dir / "rows.stl" + " " + dir / "y.stl").code, 0);
     CliRun x = run("decimate --buffer 40 --sorted-axis x -r 0.1 " + dir / "y.stl" + " " + dir / "out.stl");
     EXPECT_EQ(x.code, 0) << x.err;
     EXPECT_NE(x.err.find("meshstream: warning: --sorted-axis x was given, but " + dir / "y.stl" +
                          " says it is sorted along y: the sweep used x, as given\n"),
-              std::string::npos) << x.err;
+              std::string::npos)
+        << x.err;
     EXPECT_NE(x.err.find("; --sorted-axis overrode the axis the file gives (see below)"), std::string::npos) << x.err;
     EXPECT_NE(x.err.find("leave out --sorted-axis to use the file's own axis"), std::string::npos) << x.err;
     EXPECT_EQ(x.err.find("meshstream sort"), std::string::npos) << x.err;
@@ -420,7 +442,8 @@ TEST(CliBadInput, WholeMeshOutputTooBigForTheBudgetIsRefusedUpFront) {
         EXPECT_EQ(r.code, 1) << out << ": " << r.err;
         EXPECT_NE(r.err.find(dir / out + ": "), std::string::npos) << r.err;
         EXPECT_NE(r.err.find("the 1152 triangles to be written need at least"), std::string::npos) << r.err;
-        EXPECT_NE(r.err.find("over the memory budget of 100 KiB; give --memory 1M or more"), std::string::npos) << r.err;
+        EXPECT_NE(r.err.find("over the memory budget of 100 KiB; give --memory 1M or more"), std::string::npos)
+            << r.err;
         EXPECT_EQ(r.err.find("decimated "), std::string::npos) << "refused after the work: " << r.err;
         EXPECT_EQ(listing(dir.path()), std::vector<std::string>{"in.stl"}) << out;
     }
@@ -439,11 +462,13 @@ TEST(CliBadInput, DracoBitCountsWhoseTablesPassTheBudgetAreRefusedUpFront) {
     write_file(dir / "in.stl", binary_stl(grid(4)));
     for (const char* out : {"out.drc", "out.glb"}) {
         for (const auto& [flags, message] : std::vector<std::pair<std::string, std::string>>{
-                 {"--draco-qp 28", "Draco's coding tables for --draco-qp 28 at --draco-cl 7 take about 1 GiB (they "
-                                   "double with each bit), over the memory budget of 256 MiB: give fewer bits (float "
-                                   "positions hold 24) or --memory 1025M or more"},
+                 {"--draco-qp 28",
+                  "Draco's coding tables for --draco-qp 28 at --draco-cl 7 take about 1 GiB (they "
+                  "double with each bit), over the memory budget of 256 MiB: give fewer bits (float "
+                  "positions hold 24) or --memory 1025M or more"},
                  {"--draco-qp 24 --draco-cl 10 --memory 150M", "take about 192 MiB"},
-                 {"--normals --draco-qn 27", "Draco's coding tables for --draco-qp 14 and --draco-qn 27 at --draco-cl 7"},
+                 {"--normals --draco-qn 27",
+                  "Draco's coding tables for --draco-qp 14 and --draco-qn 27 at --draco-cl 7"},
              }) {
             CliRun r = run("convert " + flags + " " + dir / "in.stl" + " " + dir / out);
             EXPECT_EQ(r.code, 1) << flags << " " << out << ": " << r.err;
@@ -494,7 +519,8 @@ TEST(CliBadInput, WeldPercentReadsTheBoxFirstOrRefusesAStream) {
     CliRun info = run("info " + dir / "coarse.glb" + " > " + dir / "info.txt");
     EXPECT_NE(slurp(dir / "info.txt").find("triangles:   " + std::to_string(written) + "\n"), std::string::npos)
         << slurp(dir / "info.txt");
-    EXPECT_NE(coarse.err.find("it is coarser than the mesh; weld on a smaller size\n"), std::string::npos) << coarse.err;
+    EXPECT_NE(coarse.err.find("it is coarser than the mesh; weld on a smaller size\n"), std::string::npos)
+        << coarse.err;
     CliRun p = run("decimate -r 0.5 --weld 0.5% - " + dir / "piped.stl" + " < " + dir / "in.stl");
     EXPECT_EQ(p.code, 2) << p.err;
     EXPECT_NE(p.err.find("<stdin>: --weld 0.5% needs the bounding box"), std::string::npos) << p.err;
@@ -527,7 +553,7 @@ TEST(CliBadInput, AnUnweldedSurfaceIsSaidToBeOne) {
 // warning blamed "too little left that could be decimated" instead of the frozen edges.
 TEST(CliBadInput, AMissedTargetNamesTheFrozenEdgesThatCausedIt) {
     TempDir dir;
-    std::vector<float> tris = grid(300);  // 180 000 triangles: too many at the end for a full scan
+    std::vector<float> tris = grid(300);              // 180 000 triangles: too many at the end for a full scan
     for (size_t t = 0; t < tris.size() / 9; t += 97)  // one in 97 wound the other way
         std::swap_ranges(&tris[9 * t + 3], &tris[9 * t + 6], &tris[9 * t + 6]);
     write_file(dir / "in.stl", binary_stl(tris));
@@ -592,7 +618,8 @@ TEST(CliBadInput, CompareHoldsAMeshFromAPipe) {
 TEST(CliBadInput, StdoutWriteFailuresExit1) {
     TempDir dir;
     write_file(dir / "in.stl", binary_stl(grid(4)));
-    for (const std::string& cmd : {std::string("info --json "), "compare --json --samples 1000 " + dir / "in.stl" + " "}) {
+    for (const std::string& cmd :
+         {std::string("info --json "), "compare --json --samples 1000 " + dir / "in.stl" + " "}) {
         CliRun r = run(cmd + dir / "in.stl" + " > /dev/full");
         EXPECT_EQ(r.code, 1) << cmd << r.err;
         EXPECT_NE(r.err.find("meshstream: error: <stdout>: write failed: No space left on device"), std::string::npos)
@@ -611,7 +638,8 @@ TEST(CliBadInput, ABufferTheSystemCannotReserveIsNamedWithItsSize) {
     EXPECT_EQ(r.code, 1) << r.err;
     EXPECT_NE(r.err.find("meshstream: error: --buffer 10000000 reserves 5."), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("which this system refused: give a smaller --buffer (the default 400000 reserves 233.5 MB)"),
-              std::string::npos) << r.err;
+              std::string::npos)
+        << r.err;
     EXPECT_EQ(listing(dir.path()), std::vector<std::string>{"in.stl"});
 #endif
 }
@@ -619,7 +647,8 @@ TEST(CliBadInput, ABufferTheSystemCannotReserveIsNamedWithItsSize) {
 TEST(CliBadInput, UnknownCommandIsNamedAndVersionIsPrinted) {
     CliRun r = run("decimat in.stl out.stl");
     EXPECT_EQ(r.code, 2);
-    EXPECT_EQ(r.err, "meshstream: unknown command 'decimat' (one of: info, convert, decimate, sort, compare; see --help)\n");
+    EXPECT_EQ(r.err,
+              "meshstream: unknown command 'decimat' (one of: info, convert, decimate, sort, compare; see --help)\n");
     TempDir dir;
     CliRun v = run("--version > " + dir / "version.txt");
     EXPECT_EQ(v.code, 0) << v.err;
@@ -635,7 +664,7 @@ TEST(CliBadInput, NanAndDegenerateTrianglesAreKeptOrDroppedWithCountedWarnings) 
     std::vector<float> tris = grid(3);  // 18 good triangles
     tris.insert(tris.end(), {0, 0, 0, 1, 0, 0, nan, 1, 0});
     tris.insert(tris.end(), {0, 0, 0, inf, 0, 0, 0, 1, 0});
-    tris.insert(tris.end(), {0, 0, 0, 1, 0, 0, 1, 0, 0});  // two corners at one position
+    tris.insert(tris.end(), {0, 0, 0, 1, 0, 0, 1, 0, 0});      // two corners at one position
     tris.insert(tris.end(), {-0.0f, 0, 0, 0, 0, 0, 5, 5, 5});  // -0 == +0: also degenerate
     write_file(dir / "bad.stl", binary_stl(tris));
 
@@ -654,9 +683,11 @@ TEST(CliBadInput, NanAndDegenerateTrianglesAreKeptOrDroppedWithCountedWarnings) 
     CliRun c = run("convert --clean " + dir / "bad.stl" + " " + dir / "out.stl");
     ASSERT_EQ(c.code, 0) << c.err;
     EXPECT_NE(c.err.find("warning: triangles with a NaN or infinite coordinate removed (--clean) (2)"),
-              std::string::npos) << c.err;
+              std::string::npos)
+        << c.err;
     EXPECT_NE(c.err.find("warning: degenerate triangles (two corners at the same position) removed (--clean) (2)"),
-              std::string::npos) << c.err;
+              std::string::npos)
+        << c.err;
     EXPECT_EQ(fs::file_size(dir / "out.stl"), 84u + 50u * 18u);  // header count patched to 18
     // To stdout nothing can be patched: formats with a count first spool until they know it.
     for (const char* to : {"stl", "ply"}) {
@@ -676,7 +707,8 @@ TEST(CliBadInput, NanAndDegenerateTrianglesAreKeptOrDroppedWithCountedWarnings) 
 
     CliRun d = run("decimate --ratio 0.5 " + dir / "bad.stl" + " " + dir / "dec.stl");
     ASSERT_EQ(d.code, 0) << d.err;
-    EXPECT_NE(d.err.find("warning: triangles with a NaN or infinite coordinate skipped (2)"), std::string::npos) << d.err;
+    EXPECT_NE(d.err.find("warning: triangles with a NaN or infinite coordinate skipped (2)"), std::string::npos)
+        << d.err;
     EXPECT_NE(d.err.find("triangles in 18,"), std::string::npos) << d.err;
 
     // decimate --strict: the first one is an error naming the file and the triangle; nothing
@@ -685,7 +717,8 @@ TEST(CliBadInput, NanAndDegenerateTrianglesAreKeptOrDroppedWithCountedWarnings) 
     EXPECT_EQ(r.code, 1);
     EXPECT_NE(r.err.find("meshstream: error: " + dir / "bad.stl" +
                          ": triangle 19 has a NaN or infinite coordinate (--strict)"),
-              std::string::npos) << r.err;
+              std::string::npos)
+        << r.err;
     EXPECT_FALSE(fs::exists(dir / "strict.stl"));
     for (const char* cmd : {"convert", "sort --axis x"}) {
         CliRun k = run(std::string(cmd) + " --strict " + dir / "bad.stl" + " " + dir / "strict.stl");
@@ -698,7 +731,8 @@ TEST(CliBadInput, NanAndDegenerateTrianglesAreKeptOrDroppedWithCountedWarnings) 
         CliRun e = run(cmd + " --strict");
         EXPECT_EQ(e.code, 1) << cmd;
         EXPECT_NE(e.err.find(dir / "bad.stl" + ": triangle 19 has a NaN or infinite coordinate (--strict)"),
-                  std::string::npos) << e.err;
+                  std::string::npos)
+            << e.err;
     }
 }
 
@@ -736,8 +770,9 @@ TEST(CliBadInput, HelpDescribesTheSkipPolicy) {
 // open, so the command is provably still running (blocked reading) when SIGINT arrives.
 TEST(CliBadInput, SigintDuringConvertSortDecimateLeavesNoFiles) {
     const std::string stl = binary_stl(grid(200));  // 80000 triangles, 4 MB
-    for (const char* args : {"convert --from stl - {OUT}/out.ply", "sort --from stl --axis x --memory 1M --tmpdir {OUT} - {OUT}/out.stl",
-                             "decimate --from stl --ratio 0.2 - {OUT}/out.stl"}) {
+    for (const char* args :
+         {"convert --from stl - {OUT}/out.ply", "sort --from stl --axis x --memory 1M --tmpdir {OUT} - {OUT}/out.stl",
+          "decimate --from stl --ratio 0.2 - {OUT}/out.stl"}) {
         TempDir dir;
         const std::string cmdline = expand(args, "{OUT}", dir.path().string());
         int fds[2];
@@ -786,8 +821,8 @@ TEST(CliBadInput, ClosedOutputPipeLeavesNoTemporaryFiles) {
                              "sort --axis x --memory 1M --tmpdir {T} {IN} - --to stl"}) {
         const std::string cmdline = expand(expand(args, "{IN}", dir / "in.stl"), "{T}", dir / "t");
         const std::string status = dir / "status";
-        const std::string sh = "{ TMPDIR=" + dir / "t" + " " + MESHSTREAM_BINARY + " -q " + cmdline + " 2>/dev/null; echo $? > " +
-                               status + "; } | head -c 100 > /dev/null";
+        const std::string sh = "{ TMPDIR=" + dir / "t" + " " + MESHSTREAM_BINARY + " -q " + cmdline +
+                               " 2>/dev/null; echo $? > " + status + "; } | head -c 100 > /dev/null";
         ASSERT_EQ(std::system(sh.c_str()), 0) << sh;
         EXPECT_EQ(slurp(status), "141\n") << args;  // 128 + SIGPIPE
         EXPECT_EQ(listing(dir / "t"), std::vector<std::string>{}) << args;
@@ -800,8 +835,8 @@ TEST(CliBadInput, ClosedOutputPipeLeavesNoTemporaryFiles) {
 TEST(CliBadInput, FileSizeLimitGivesAClearErrorAndNoFiles) {
     TempDir dir;
     write_file(dir / "in.stl", binary_stl(grid(100)));  // 20000 triangles, 1 MB
-    for (const char* args : {"convert {IN} {OUT}/out.ply", "convert {IN} {OUT}/out.stl", "sort --axis x {IN} {OUT}/out.stl",
-                             "decimate --ratio 0.9 {IN} {OUT}/out.stl"}) {
+    for (const char* args : {"convert {IN} {OUT}/out.ply", "convert {IN} {OUT}/out.stl",
+                             "sort --axis x {IN} {OUT}/out.stl", "decimate --ratio 0.9 {IN} {OUT}/out.stl"}) {
         fs::create_directory(dir / "o");
         const std::string cmdline = expand(expand(args, "{OUT}", dir / "o"), "{IN}", dir / "in.stl");
         CliRun r = run(cmdline, "ulimit -f 256;");  // 128 KiB (dash counts 512-byte blocks)

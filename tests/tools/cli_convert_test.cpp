@@ -179,29 +179,35 @@ TEST(CliConvert, DracoOptionsForOtherOutputsAreSaidToDoNothing) {
     cli_test::CliRun ply = run("convert --normals --draco-qp 10 " + cube + " " + dir / "c.ply");
     EXPECT_EQ(ply.code, 0) << ply.err;
     EXPECT_NE(ply.err.find("warning: --normals, --draco-qp apply to Draco and glTF outputs only: ignored for ply"),
-              std::string::npos) << ply.err;
+              std::string::npos)
+        << ply.err;
     cli_test::CliRun one = run("convert --draco-qp 10 " + cube + " " + dir / "d.ply");
     EXPECT_NE(one.err.find("warning: --draco-qp applies to Draco and glTF outputs only: ignored for ply"),
-              std::string::npos) << one.err;
+              std::string::npos)
+        << one.err;
     cli_test::CliRun glb = run("convert --normals --draco-qp 10 " + cube + " " + dir / "c.glb");
     EXPECT_EQ(glb.code, 0) << glb.err;
     EXPECT_EQ(glb.err.find("warning"), std::string::npos) << glb.err;
     cli_test::CliRun plain = run("convert --no-draco --draco-cl 9 " + cube + " " + dir / "p.glb");
     EXPECT_EQ(plain.code, 0) << plain.err;
     EXPECT_NE(plain.err.find("warning: --draco-cl applies to Draco compression: ignored with --compress none"),
-              std::string::npos) << plain.err;
-    cli_test::CliRun packed = run("convert --compress meshopt --draco-qp 12 --draco-qt 9 " + cube + " " + dir / "m.glb");
+              std::string::npos)
+        << plain.err;
+    cli_test::CliRun packed =
+        run("convert --compress meshopt --draco-qp 12 --draco-qt 9 " + cube + " " + dir / "m.glb");
     EXPECT_EQ(packed.code, 0) << packed.err;
     EXPECT_NE(packed.err.find("warning: --draco-qp, --draco-qt apply to Draco compression: ignored with --compress "
                               "meshopt"),
-              std::string::npos) << packed.err;
+              std::string::npos)
+        << packed.err;
     cli_test::CliRun drc = run("convert --compress meshopt " + cube + " " + dir / "c.drc");
     EXPECT_EQ(drc.code, 0) << drc.err;
     EXPECT_NE(drc.err.find("warning: --compress applies to glTF outputs; a .drc is always Draco"), std::string::npos)
         << drc.err;
     cli_test::CliRun stl = run("convert --compress none " + cube + " " + dir / "c.stl");
     EXPECT_NE(stl.err.find("warning: --compress applies to Draco and glTF outputs only: ignored for stl"),
-              std::string::npos) << stl.err;
+              std::string::npos)
+        << stl.err;
     // A compression that does not exist, or two ways of saying one, are command-line errors.
     EXPECT_EQ(run("convert --compress zip " + cube + " " + dir / "z.glb").code, 2);
     EXPECT_EQ(run("convert --no-draco --compress meshopt " + cube + " " + dir / "z.glb").code, 2);
@@ -223,8 +229,9 @@ TEST(CliConvert, FormatsAreNamedByTheirExtensionToo) {
 // Double coordinates rounded to float are said when they moved, and only then.
 TEST(CliConvert, RoundedDoubleCoordinatesAreAWarning) {
     TempDir dir;
-    const std::string header = "ply\nformat ascii 1.0\nelement vertex 3\nproperty double x\nproperty double y\n"
-                               "property double z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
+    const std::string header =
+        "ply\nformat ascii 1.0\nelement vertex 3\nproperty double x\nproperty double y\n"
+        "property double z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
     write_file(dir / "utm.ply", header + "500000 4000000.12 100\n500001 4000000 100\n500000 4000001 100.5\n3 0 1 2\n");
     write_file(dir / "exact.ply", header + "0 0 0\n1 0 0\n0 1 0.5\n3 0 1 2\n");
     auto r = run("convert " + dir / "utm.ply" + " " + dir / "utm.stl");
@@ -246,8 +253,8 @@ TEST(CliPipe, SortIntoDecimateStreamsWithoutASpool) {
     TempDir dir;
     const std::string glb = dir / "out.glb";
     cli_test::CliRun r = run("sort --memory 64M " + kBunny + " - | TMPDIR=/nonexistent/tmp " + MESHSTREAM_BINARY +
-                       " decimate - " + glb + " -r 0.01",
-                   "TMPDIR=/nonexistent/tmp");
+                                 " decimate - " + glb + " -r 0.01",
+                             "TMPDIR=/nonexistent/tmp");
     ASSERT_EQ(r.code, 0) << r.err;
     EXPECT_NE(r.err.find("sorted along x (ascending)"), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("triangles in 69451, out 695"), std::string::npos) << r.err;
@@ -330,8 +337,9 @@ TEST(CliConvert, GltfAndDracoKeepTheirChannelsAndSayWhatTheyDrop) {
         EXPECT_EQ(glb.err.find("dropped"), std::string::npos) << compress << ": " << glb.err;
     }
     cli_test::CliRun stl = run("convert " + box + " " + dir / "b.stl");
-    EXPECT_NE(stl.err.find("warning: normals, texture coordinates, materials dropped: stl output carries positions only"),
-              std::string::npos)
+    EXPECT_NE(
+        stl.err.find("warning: normals, texture coordinates, materials dropped: stl output carries positions only"),
+        std::string::npos)
         << stl.err;
     // Draco keeps the normals and texture coordinates, not the material.
     cli_test::CliRun drc = run("convert " + box + " " + dir / "b.drc");
@@ -360,7 +368,8 @@ TEST(CliProgress, PercentFromTheFilesBytesAndClearedAtTheEnd) {
     const std::string gz = std::string(MESHSTREAM_FIXTURES_DIR) + "/gearwheel.ascii.stl.gz";
     const auto on_terminal = [&](const std::string& args) {
         const std::string out = dir / "tty.txt";
-        const std::string cmd = "TERM=xterm script -qec \"" + std::string(MESHSTREAM_BINARY) + " " + args + "\" /dev/null > " + out;
+        const std::string cmd =
+            "TERM=xterm script -qec \"" + std::string(MESHSTREAM_BINARY) + " " + args + "\" /dev/null > " + out;
         EXPECT_EQ(std::system(cmd.c_str()), 0) << cmd;
         return slurp(out);
     };

@@ -1,9 +1,9 @@
 // `meshstream decimate` on generated meshes through the binaries (MESHSTREAM_BINARY,
 // MESHSTREAM_GEN_BINARY): properties that need a mesh larger and more twisted than the
 // fixtures, such as the topology kept through small buffers.
+#include "compare/metro.hpp"
 #include "io/format.hpp"
 #include "tools/cli_util.hpp"
-#include "compare/metro.hpp"
 
 #include <gtest/gtest.h>
 
@@ -98,7 +98,8 @@ TEST(CliDecimate, ATargetOfZeroTrianglesIsSaid) {
     EXPECT_EQ(r.code, 0) << r.err;
     EXPECT_NE(r.err.find("warning: the target rounds to 0 triangles (1 in): the output is empty; give a larger --ratio "
                          "or --target"),
-              std::string::npos) << r.err;
+              std::string::npos)
+        << r.err;
 }
 
 TEST(CliDecimate, ACadAssemblyReachesTheTarget) {
@@ -187,7 +188,8 @@ TEST(CliDecimate, AnOddTargetMissedByOneSaysWhy) {
     EXPECT_EQ(io::open_input(dir / "out.stl").reader->triangle_count(), 71u);
     EXPECT_NE(r.err.find("output has 71 triangles instead of the target 70 (a collapse removes two triangles, and no "
                          "boundary edge could be collapsed to remove the odd one)"),
-              std::string::npos) << r.err;
+              std::string::npos)
+        << r.err;
     EXPECT_GT(edges_of(dir / "out.stl").boundary_edges, 0u);
 }
 
@@ -210,7 +212,8 @@ TEST(CliDecimate, ATargetMissedBecauseNoCollapseIsAllowedSaysSo) {
     EXPECT_NE(r.err.find("output has 4 triangles instead of the target 1 (no allowed collapse is left: each would fold "
                          "a face over or change the topology, or move a vertex that must stay, as on a non-manifold "
                          "edge)"),
-              std::string::npos) << r.err;
+              std::string::npos)
+        << r.err;
 }
 
 TEST(CliDecimate, AClosedElephantLandsOnItsTargetAtOnePercent) {
@@ -314,5 +317,6 @@ TEST(CliDecimate, TargetCountsAFileThatStatesNoCount) {
     // More than the input holds: said with the counted figure.
     const CliRun over = run("decimate --target 3000 " + ascii + " " + dir / "c.stl");
     EXPECT_EQ(over.code, 2);
-    EXPECT_NE(over.err.find("--target 3000 is more than the 2444 triangles of the input"), std::string::npos) << over.err;
+    EXPECT_NE(over.err.find("--target 3000 is more than the 2444 triangles of the input"), std::string::npos)
+        << over.err;
 }

@@ -3,8 +3,8 @@
 // centroid more than one grid cell below an earlier one), a watertight manifold surface after
 // exact welding (the derived case table is consistent across cells), holes that open it,
 // a shuffle that keeps the same triangles in another order, same seed same bytes, and exit codes.
-#include "io/format.hpp"
 #include "compare/metro.hpp"
+#include "io/format.hpp"
 
 #include "test_util.hpp"
 
@@ -118,7 +118,8 @@ TEST(GenMesh, HolesOpenTheSurface) {
 TEST(GenMesh, ShuffleKeepsTheTrianglesInRandomOrder) {
     TempDir dir;
     ASSERT_EQ(gen(dir, "-q -n 20000 --seed 3 " + (dir.path() / "s.stl").string()).exit_code, 0);
-    ASSERT_EQ(gen(dir, "-q -n 20000 --seed 3 --shuffle --tmpdir " + dir.path().string() + " " + (dir.path() / "r.stl").string())
+    ASSERT_EQ(gen(dir, "-q -n 20000 --seed 3 --shuffle --tmpdir " + dir.path().string() + " " +
+                           (dir.path() / "r.stl").string())
                   .exit_code,
               0);
     auto sorted = read_all(dir.path() / "s.stl"), shuffled = read_all(dir.path() / "r.stl");
@@ -129,7 +130,8 @@ TEST(GenMesh, ShuffleKeepsTheTrianglesInRandomOrder) {
     EXPECT_EQ(sorted, shuffled);
     // The bucket files are gone.
     size_t left = 0;
-    for (const auto& entry : fs::directory_iterator(dir.path())) left += entry.path().filename().string().starts_with("meshstream-gen");
+    for (const auto& entry : fs::directory_iterator(dir.path()))
+        left += entry.path().filename().string().starts_with("meshstream-gen");
     EXPECT_EQ(left, 0u);
 }
 
@@ -144,8 +146,8 @@ TEST(GenMesh, SameSeedSameBytesAcrossThreadCounts) {
 
 TEST(GenMesh, ExitCodes) {
     TempDir dir;
-    EXPECT_EQ(gen(dir, "-n 1000").exit_code, 2);                                      // no output
-    EXPECT_EQ(gen(dir, "-n 5 " + (dir.path() / "x.stl").string()).exit_code, 2);         // below 100
+    EXPECT_EQ(gen(dir, "-n 1000").exit_code, 2);                                  // no output
+    EXPECT_EQ(gen(dir, "-n 5 " + (dir.path() / "x.stl").string()).exit_code, 2);  // below 100
     GenRun r = gen(dir, "-n 1000 " + (dir.path() / "x.unknown").string());
     EXPECT_EQ(r.exit_code, 1);
     EXPECT_NE(r.err.find("x.unknown"), std::string::npos) << r.err;

@@ -74,9 +74,10 @@ TEST(CliInfo, ShowsLenientReadsWithPositionAndCount) {
     {
         std::FILE* f = std::fopen((dir / "quad.stl").c_str(), "wb");
         ASSERT_NE(f, nullptr);
-        std::fputs("solid q\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 1 1 0\nvertex 0 1 0\n"
-                   "endloop\nendfacet\n",
-                   f);
+        std::fputs(
+            "solid q\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 1 1 0\nvertex 0 1 0\n"
+            "endloop\nendfacet\n",
+            f);
         std::fclose(f);
     }
     const std::string text = info(dir, dir / "quad.stl");
@@ -84,8 +85,9 @@ TEST(CliInfo, ShowsLenientReadsWithPositionAndCount) {
     EXPECT_NE(text.find("warning:     facets with more than 3 vertices split into triangles (at line 2) (1)\n"),
               std::string::npos)
         << text;
-    EXPECT_NE(text.find("warning:     no 'endsolid' at the end of the file (cut short between facets?) (at line 10) (1)\n"),
-              std::string::npos)
+    EXPECT_NE(
+        text.find("warning:     no 'endsolid' at the end of the file (cut short between facets?) (at line 10) (1)\n"),
+        std::string::npos)
         << text;
     nlohmann::json j = nlohmann::json::parse(info(dir, "--json " + dir / "quad.stl"));
     ASSERT_EQ(j["warnings"].size(), 2u);
@@ -103,10 +105,11 @@ TEST(CliReaderWarnings, ConvertRepeatsThemWithPositionAndCount) {
     {
         std::FILE* f = std::fopen((dir / "tri.stl").c_str(), "wb");
         ASSERT_NE(f, nullptr);
-        std::fputs("solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nendloop\nendfacet\n"
-                   "facet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\n"
-                   "facet normal 0 0 1\nouter loop\nendloop\nendfacet\nendsolid t\n",
-                   f);
+        std::fputs(
+            "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nendloop\nendfacet\n"
+            "facet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\n"
+            "facet normal 0 0 1\nouter loop\nendloop\nendfacet\nendsolid t\n",
+            f);
         std::fclose(f);
     }
     auto r = run("convert " + dir / "tri.stl" + " " + dir / "out.stl");

@@ -1,7 +1,7 @@
 // --json's object for convert, decimate and sort (tools/run_report), built directly from
 // statistics, and through the binary: one object on stdout and nothing else.
-#include "tools/cli_util.hpp"
 #include "tools/run_report.hpp"
+#include "tools/cli_util.hpp"
 
 #include <gtest/gtest.h>
 

@@ -42,7 +42,8 @@ struct CliRun {
 
 // Runs `meshstream ARGS` through the shell; `args` may contain pipes and redirections of stdin.
 CliRun run(const std::string& args, const TempDir& dir) {
-    std::string cmd = std::string(MESHSTREAM_BINARY) + " " + args + " > " + dir / "stdout.txt" + " 2> " + dir / "stderr.txt";
+    std::string cmd =
+        std::string(MESHSTREAM_BINARY) + " " + args + " > " + dir / "stdout.txt" + " 2> " + dir / "stderr.txt";
     int status = std::system(cmd.c_str());
     CliRun r{WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(dir / "stdout.txt"), slurp(dir / "stderr.txt")};
     fs::remove(dir / "stdout.txt");
@@ -128,7 +129,9 @@ TEST(SortCommand, SortsShuffledFixtureAndRecordsAxis) {
     std::shuffle(tris.begin(), tris.end(), std::mt19937_64(3));
     write_stl(dir / "shuffled.stl", tris);
     fs::create_directory(dir / "tmp");
-    CliRun r = run("sort --axis z --memory 1M --tmpdir " + dir / "tmp" + " " + dir / "shuffled.stl" + " " + dir / "sorted.stl", dir);
+    CliRun r =
+        run("sort --axis z --memory 1M --tmpdir " + dir / "tmp" + " " + dir / "shuffled.stl" + " " + dir / "sorted.stl",
+            dir);
     ASSERT_EQ(r.code, 0) << r.err;
     Mesh m = read_mesh(dir / "sorted.stl");
     expect_sorted_permutation(m.tris, tris, 2);
@@ -219,10 +222,11 @@ TEST(SortCommand, DeviceOutputsAreWrittenInPlaceWithRunsInTheTemporaryDirectory)
     fs::create_directory(dir / "tmp");
     ASSERT_EQ(run("sort --axis z --memory 1M " + dir / "in.stl" + " " + dir / "ref.stl", dir).code, 0);
     const std::string ref = slurp(dir / "ref.stl");
-    const std::string sort = "TMPDIR=" + dir / "tmp" + " " + MESHSTREAM_BINARY + " -q sort --axis z --memory 1M --to stl " +
-                             dir / "in.stl";
+    const std::string sort =
+        "TMPDIR=" + dir / "tmp" + " " + MESHSTREAM_BINARY + " -q sort --axis z --memory 1M --to stl " + dir / "in.stl";
     for (const char* name : {"/dev/stdout", "/dev/fd/1"}) {
-        EXPECT_EQ(std::system((sort + " " + name + " 2> " + dir / "err.txt" + " | cat > " + dir / "piped.stl").c_str()), 0);
+        EXPECT_EQ(std::system((sort + " " + name + " 2> " + dir / "err.txt" + " | cat > " + dir / "piped.stl").c_str()),
+                  0);
         EXPECT_EQ(slurp(dir / "err.txt"), "") << name;
         EXPECT_TRUE(slurp(dir / "piped.stl") == ref) << name;
         std::ofstream(dir / "log.stl") << "kept";
@@ -231,8 +235,10 @@ TEST(SortCommand, DeviceOutputsAreWrittenInPlaceWithRunsInTheTemporaryDirectory)
     }
     EXPECT_EQ(file_count(dir / "tmp"), 0u);
     // Runs in $TMPDIR, not in /dev: a $TMPDIR that does not exist is named in the error.
-    const int status = std::system(("TMPDIR=" + dir / "none" + " " + MESHSTREAM_BINARY + " -q sort --axis z --memory 1M --to stl " +
-                                    dir / "in.stl" + " /dev/null 2> " + dir / "err.txt").c_str());
+    const int status =
+        std::system(("TMPDIR=" + dir / "none" + " " + MESHSTREAM_BINARY + " -q sort --axis z --memory 1M --to stl " +
+                     dir / "in.stl" + " /dev/null 2> " + dir / "err.txt")
+                        .c_str());
     EXPECT_EQ(WEXITSTATUS(status), 1);
     EXPECT_NE(slurp(dir / "err.txt").find(dir / "none"), std::string::npos) << slurp(dir / "err.txt");
 }
@@ -242,7 +248,8 @@ TEST(SortCommand, TruncatedInputLeavesNoOutputAndNoTemporaryFiles) {
     write_stl(dir / "in.stl", random_triangles(100000, 5));
     fs::resize_file(dir / "in.stl", 84 + 50 * 60000 + 17);  // runs are already on disk when it fails
     fs::create_directory(dir / "tmp");
-    CliRun r = run("sort --axis z --memory 1M --tmpdir " + dir / "tmp" + " " + dir / "in.stl" + " " + dir / "out.stl", dir);
+    CliRun r =
+        run("sort --axis z --memory 1M --tmpdir " + dir / "tmp" + " " + dir / "in.stl" + " " + dir / "out.stl", dir);
     EXPECT_EQ(r.code, 1);
     EXPECT_NE(r.err.find("in.stl"), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(dir / "out.stl"));
@@ -288,7 +295,8 @@ TEST(SortCommand, SigintRemovesTemporaryFiles) {
         ::kill(pid, SIGINT);
         ::waitpid(pid, &status, 0);
     }
-    if (WIFEXITED(status) && WEXITSTATUS(status) == 0) GTEST_SKIP() << "the sort finished before it could be interrupted";
+    if (WIFEXITED(status) && WEXITSTATUS(status) == 0)
+        GTEST_SKIP() << "the sort finished before it could be interrupted";
     EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGINT) << status;
     EXPECT_EQ(file_count(tmp), 0u);
     EXPECT_EQ(file_count(dir / "out"), 0u);
@@ -311,7 +319,8 @@ TEST(InfoOrder, DistinguishesShuffledFromSorted) {
     // A larger buffer is not the remedy for a shuffled file: sorting is.
     EXPECT_NE(shuffled.out.find(": the file is in no streaming order (its width is a tenth of it or more), so "
                                 "`meshstream sort` it first\n"),
-              std::string::npos) << shuffled.out;
+              std::string::npos)
+        << shuffled.out;
     {
         // The shuffled triangles under the sorted file's header, which says "sorted along y".
         std::string bytes = slurp(dir / "shuffled.stl");
@@ -320,15 +329,18 @@ TEST(InfoOrder, DistinguishesShuffledFromSorted) {
         CliRun f = run("info --order " + dir / "false_flag.stl", dir);
         ASSERT_EQ(f.code, 0) << f.err;
         EXPECT_NE(f.out.find("(the file says it is sorted along y, but it is not: `meshstream sort` it again)"),
-                  std::string::npos) << f.out;
-        EXPECT_NE(f.out.find(", unless the surface has holes: the file is not sorted as it says"), std::string::npos) << f.out;
+                  std::string::npos)
+            << f.out;
+        EXPECT_NE(f.out.find(", unless the surface has holes: the file is not sorted as it says"), std::string::npos)
+            << f.out;
     }
     EXPECT_NE(sorted.out.find("--buffer 20000 suffices at --ratio 0.1 (needs about "), std::string::npos) << sorted.out;
     EXPECT_EQ(sorted.out.find("unless the surface has holes"), std::string::npos) << sorted.out;  // flagged sorted
     // Not flagged as sorted: holes would stay open to the end, which the width cannot tell.
     CliRun big = run("info --order --buffer 200000 " + dir / "shuffled.stl", dir);
     EXPECT_NE(big.out.find("--buffer 200000 suffices at --ratio 0.1 (needs about "), std::string::npos) << big.out;
-    EXPECT_NE(big.out.find(", unless the surface has holes: the file is not flagged as sorted"), std::string::npos) << big.out;
+    EXPECT_NE(big.out.find(", unless the surface has holes: the file is not flagged as sorted"), std::string::npos)
+        << big.out;
     EXPECT_NE(sorted.out.find("(sorted along y by minimum coordinate)"), std::string::npos) << sorted.out;
     EXPECT_NE(sorted.out.find("(exact)"), std::string::npos) << sorted.out;
     // --json carries the same numbers.
@@ -347,11 +359,12 @@ TEST(InfoOrder, DistinguishesShuffledFromSorted) {
         ASSERT_NE(at, std::string::npos) << info.out;
         const uint64_t needed = std::stoull(info.out.substr(at + 17));
         EXPECT_GT(needed, w_sorted) << ratio;
-        CliRun d = run("decimate -r " + std::string(ratio) + " --buffer " + std::to_string(needed) + " " + dir / "sorted.stl" +
-                           " " + dir / "dec.stl",
+        CliRun d = run("decimate -r " + std::string(ratio) + " --buffer " + std::to_string(needed) + " " +
+                           dir / "sorted.stl" + " " + dir / "dec.stl",
                        dir);
         ASSERT_EQ(d.code, 0) << d.err;
-        EXPECT_EQ(d.err.find("force-written"), std::string::npos) << "ratio " << ratio << ", buffer " << needed << ": " << d.err;
+        EXPECT_EQ(d.err.find("force-written"), std::string::npos)
+            << "ratio " << ratio << ", buffer " << needed << ": " << d.err;
     }
 }
 
@@ -382,14 +395,18 @@ TEST(SortCommand, FullDiskIsAClearErrorAndLeavesNothing) {
     // early; 7000k holds all but the last few KiB of the runs, which used to wait in the temp
     // file's buffer and fail only when the merge read them, without the --tmpdir advice.
     for (const char* size : {"1M", "7000k"}) {
-        if (std::system(("mount -t tmpfs -o size=" + std::string(size) + " tmpfs " + dir / "small" + " 2>/dev/null").c_str()) != 0)
+        if (std::system(
+                ("mount -t tmpfs -o size=" + std::string(size) + " tmpfs " + dir / "small" + " 2>/dev/null").c_str()) !=
+            0)
             GTEST_SKIP() << "cannot mount a small tmpfs here";
-        CliRun r = run("sort --axis z --memory 1M --tmpdir " + dir / "small" + " " + dir / "in.stl" + " " + dir / "out.stl", dir);
+        CliRun r = run(
+            "sort --axis z --memory 1M --tmpdir " + dir / "small" + " " + dir / "in.stl" + " " + dir / "out.stl", dir);
         size_t left = file_count(dir / "small");
         std::system(("umount " + dir / "small").c_str());
         EXPECT_EQ(r.code, 1) << size;
         EXPECT_NE(r.err.find("No space left on device"), std::string::npos) << size << ": " << r.err;
-        EXPECT_NE(r.err.find("(temporary file of meshstream sort; --tmpdir picks another directory)"), std::string::npos)
+        EXPECT_NE(r.err.find("(temporary file of meshstream sort; --tmpdir picks another directory)"),
+                  std::string::npos)
             << size << ": " << r.err;
         EXPECT_EQ(left, 0u) << size;
         EXPECT_FALSE(fs::exists(dir / "out.stl")) << size;
@@ -406,9 +423,9 @@ TEST(SortCommand, TheLeastBudgetMergesInAboutOneCopyOnDisk) {
     fs::create_directory(dir / "small");
     if (std::system(("mount -t tmpfs -o size=4500k tmpfs " + dir / "small" + " 2>/dev/null").c_str()) != 0)
         GTEST_SKIP() << "cannot mount a small tmpfs here";
-    CliRun r = run("sort --stats --axis z --memory 97K --tmpdir " + dir / "small" + " " + dir / "in.stl" + " " +
-                       dir / "out.stl",
-                   dir);
+    CliRun r = run(
+        "sort --stats --axis z --memory 97K --tmpdir " + dir / "small" + " " + dir / "in.stl" + " " + dir / "out.stl",
+        dir);
     std::system(("umount " + dir / "small").c_str());
     ASSERT_EQ(r.code, 0) << r.err;
     EXPECT_NE(r.err.find(" merge passes"), std::string::npos) << r.err;
