@@ -1,6 +1,8 @@
 // Shared CLI helpers: option groups, sizes, progress bar, warnings.
 #include "tools/common.hpp"
 
+#include "tools/help.hpp"
+
 #include "io/triangle_stream.hpp"
 
 #include <sys/ioctl.h>
@@ -248,8 +250,9 @@ io::ChannelKinds kept_channel_kinds(const std::string& drop_list) {
 
 void add_drop_flag(CLI::App* cmd, ReadFlags& flags) {
     cmd->add_option("--drop", flags.drop,
-                    "Channels not to read or write, comma separated: normals, colors, uvs, extra (named vertex and "
-                    "face properties), materials; dropped without a warning")
+                    "channels not to read or write: normals,colors,uvs,extra,materials\n"
+                    "Any of them, comma separated (extra: the named vertex and face properties); they are not read "
+                    "and their loss is not warned about")
         ->type_name("LIST")
         ->check(CLI::Validator(
             [](const std::string& text) -> std::string {
@@ -260,19 +263,31 @@ void add_drop_flag(CLI::App* cmd, ReadFlags& flags) {
 }
 
 void add_read_flags(CLI::App* cmd, ReadFlags& flags) {
-    cmd->add_option("--from", flags.from, "Input format, overriding detection (e.g. stl, stl-ascii)")
-        ->check(format_name(false));
     cmd->add_option("--memory", flags.memory,
-                    "Memory budget for tables, spills and sort runs, e.g. 64M, 1G (default 256M)");
-    cmd->add_option("--tmpdir", flags.tmpdir, "Directory for temporary files (default: $TMPDIR or /tmp)");
+                    "memory budget, e.g. 512M or 2G (default 256M)\n"
+                    "Bounds the tables of indexed formats (PLY, OBJ), sort runs and spills, and the whole-mesh "
+                    "writers (Draco, glTF); K, M, G, T are binary multiples. A budget above this machine's memory is "
+                    "refused")
+        ->type_name("SIZE");
+    cmd->add_option("--tmpdir", flags.tmpdir, "where temporary files go (default: $TMPDIR or /tmp)")
+        ->type_name("DIR")
+        ->group(kMoreOptions);
+    cmd->add_option("--from", flags.from,
+                    "input format, instead of detection (e.g. stl-ascii)\nOne of: " + format_names(false))
+        ->type_name("FMT")
+        ->group(kMoreOptions)
+        ->check(format_name(false));
     cmd->add_flag("--strict", flags.strict,
-                  "Make a counted recovery an error: input a reader repairs (faces of fewer than 3 vertices), and what "
-                  "the output format cannot hold (e.g. triangles Draco drops)");
+                  "make a counted recovery an error\n"
+                  "Input a reader repairs (faces of fewer than 3 vertices), and what the output format cannot "
+                  "hold (e.g. triangles Draco drops)")
+        ->group(kMoreOptions);
 }
 
 void strict_refuses_dropped_triangles(CLI::App* cmd) {
     cmd->get_option("--strict")
         ->description(
+            "make skipped triangles errors\n"
             "Triangles with a NaN/inf coordinate or two corners at the same position are skipped with a "
             "counted warning (decimate cannot use them); --strict makes them, and faces of fewer than 3 "
             "vertices and what the output format cannot hold, errors");
@@ -281,8 +296,9 @@ void strict_refuses_dropped_triangles(CLI::App* cmd) {
 void strict_reports_bad_triangles(CLI::App* cmd) {
     cmd->get_option("--strict")
         ->description(
-            "Make the first triangle with a NaN/inf coordinate or two corners at the same position (or a face "
-            "of fewer than 3 vertices) an error; without it they are counted as they are");
+            "make bad triangles errors\n"
+            "Makes the first triangle with a NaN/inf coordinate or two corners at the same position (or a "
+            "face of fewer than 3 vertices) an error; without it they are counted as they are");
 }
 
 io::WriteOptions WriteFlags::options(const ReadFlags& read) const {
@@ -308,39 +324,53 @@ io::WriteOptions::Compression WriteFlags::compression() const {
 
 void add_write_flags(CLI::App* cmd, WriteFlags& flags) {
     cmd->add_option("--to", flags.to,
-                    "Output format, overriding the extension (e.g. stl, stl-ascii). Without it, '-' on a pipe gets "
-                    "meshstream's triangle stream, which the next command reads as it comes; --to stl or ply to a "
-                    "pipe spools the body to --tmpdir first (their count goes before it)")
+                    "output format, instead of the extension's (e.g. ply, glb)\nOne of: " + format_names(true) +
+                        ". Without it, '-' on a pipe gets meshstream's triangle stream, which the next command reads "
+                        "as it comes; --to stl or ply to a pipe spools the body to --tmpdir first (their count goes "
+                        "before it)")
+        ->type_name("FMT")
         ->check(format_name(true));
-    cmd->add_option("--gzip-level", flags.gzip_level, "zlib level 0-9 for outputs ending in .gz (default 6)")
+    cmd->add_option("--gzip-level", flags.gzip_level, "zlib level 0-9 for outputs named *.gz (default 6)")
+        ->type_name("N")
+        ->group(kMoreOptions)
         ->check(CLI::Range(0, 9));
     // Draco (.drc) and glTF (.glb/.gltf) hold the whole mesh in memory (docs/formats.md).
-    auto* web = cmd->add_option_group("Draco / glTF output",
-                                      ".drc, .glb and .gltf are written from the whole mesh in memory; past --memory "
-                                      "they stop with an error asking for a larger --memory");
-    auto* compress =
-        web->add_option("--compress", flags.compress,
-                        "glTF compression: draco (KHR_draco_mesh_compression, the default), meshopt "
-                        "(EXT_meshopt_compression with 14-bit quantized positions, like gltfpack -cc; needs a viewer "
-                        "with a meshopt decoder, e.g. three.js with MeshoptDecoder) or none (plain float accessors)")
-            ->check(CLI::IsMember({"draco", "meshopt", "none"}));
-    web->add_flag("--no-draco", flags.no_draco, "The same as --compress none (its older spelling)")->excludes(compress);
-    web->add_flag("--normals", flags.normals,
-                  "Draco/glTF: write area-weighted smooth vertex normals (when the input has no normals of its own)");
-    web->add_option("--draco-qp", flags.draco_qp, "Draco position quantization bits, 1-30 (default 14)")
+    auto* compress = cmd->add_option("--compress", flags.compress,
+                                     "glTF compression: draco (default), meshopt or none\n"
+                                     "draco: KHR_draco_mesh_compression with the --draco-* settings; meshopt: "
+                                     "EXT_meshopt_compression with 14-bit quantized positions, like gltfpack -cc "
+                                     "(viewers need a meshopt decoder, e.g. three.js's MeshoptDecoder); none: plain "
+                                     "float accessors")
+                         ->type_name("KIND")
+                         ->group(kWebOptions)
+                         ->check(CLI::IsMember({"draco", "meshopt", "none"}));
+    cmd->add_flag("--no-draco", flags.no_draco, "the same as --compress none")->group(kWebOptions)->excludes(compress);
+    cmd->add_flag("--normals", flags.normals, "add smooth vertex normals to a mesh without normals of its own")
+        ->group(kWebOptions);
+    cmd->add_option("--draco-qp", flags.draco_qp, "Draco position quantization bits, 1-30 (default 14)")
+        ->type_name("N")
+        ->group(kWebOptions)
         ->check(CLI::Range(1, 30));
     // Draco's octahedral normal coder needs 2 bits or more (1 fails inside its encoder).
-    web->add_option("--draco-qn", flags.draco_qn, "Draco normal quantization bits, 2-30 (default 10)")
+    cmd->add_option("--draco-qn", flags.draco_qn, "Draco normal quantization bits, 2-30 (default 10)")
+        ->type_name("N")
+        ->group(kWebOptions)
         ->check(CLI::Range(2, 30));
-    web->add_option("--draco-qt", flags.draco_qt, "Draco texture coordinate quantization bits, 1-30 (default 12)")
+    cmd->add_option("--draco-qt", flags.draco_qt, "Draco texture coordinate quantization bits, 1-30 (default 12)")
+        ->type_name("N")
+        ->group(kWebOptions)
         ->check(CLI::Range(1, 30));
-    web->add_option("--draco-qc", flags.draco_qc,
-                    "Draco quantization bits of float colours and generic attributes (scalars), 1-30 (default 10; "
-                    "integer ones are kept exactly)")
+    cmd->add_option("--draco-qc", flags.draco_qc,
+                    "Draco bits of float colours and named scalars, 1-30 (default 10)\n"
+                    "Integer colours and scalars are kept exactly")
+        ->type_name("N")
+        ->group(kWebOptions)
         ->check(CLI::Range(1, 30));
-    web->add_option("--draco-cl", flags.draco_cl,
-                    "Draco compression level 0-10 (default 7; higher is slower, "
-                    "usually smaller)")
+    cmd->add_option("--draco-cl", flags.draco_cl,
+                    "Draco compression level 0-10 (default 7)\n"
+                    "Higher is slower, and usually smaller")
+        ->type_name("N")
+        ->group(kWebOptions)
         ->check(CLI::Range(0, 10));
 }
 

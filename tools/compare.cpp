@@ -5,6 +5,7 @@
 #include "tools/cli_checks.hpp"
 #include "tools/commands.hpp"
 #include "tools/common.hpp"
+#include "tools/help.hpp"
 #include "tools/input_filter.hpp"
 
 #include <nlohmann/json.hpp>
@@ -200,24 +201,28 @@ void add_compare(CLI::App& app) {
     auto opt = std::make_shared<CompareCliOptions>();
     CLI::App* cmd = app.add_subcommand(
         "compare",
-        "Metro-style surface error between meshes A and B: area-weighted random samples on each surface, their\n"
-        "distance to the other surface; Hausdorff max, mean and RMS both ways, absolute and as % of A's bounding-box\n"
-        "diagonal, plus triangle, boundary-edge and non-manifold-edge counts (after exact welding).\n"
-        "Memory: only the smaller mesh (by header triangle count, or a PLY's face count, when both files state\n"
-        "it, else B) is held in memory, with its samples and two BVHs (about 60 bytes per triangle + 60 per\n"
-        "sample); the other mesh is streamed twice, so it may be far larger than memory (not from stdin).\n"
-        "Edge counting of the streamed mesh spills to temporary files beyond --memory.");
-    cmd->add_option("a", opt->a, "Mesh A (the reference, e.g. the original; '-' = stdin)")->required();
-    cmd->add_option("b", opt->b, "Mesh B (e.g. the decimated mesh)")->required();
+        "Hausdorff, mean and RMS surface error between two meshes (Metro)\n"
+        "A, B: mesh files ('-' for stdin, one of them at most), e.g. the original and its decimation.\n"
+        "Area-weighted samples on each surface, their distance to the other one, both ways; and each mesh's\n"
+        "boundary and non-manifold edges. The smaller mesh is held in memory, about 60 bytes a triangle and\n"
+        "60 a sample; the other one is streamed twice, so it may be far larger than memory (docs/cli.md).");
+    cmd->add_option("A", opt->a, "mesh A (the reference, e.g. the original; '-' = stdin)")->required();
+    cmd->add_option("B", opt->b, "mesh B (e.g. the decimated mesh)")->required();
     cmd->add_option("--samples", opt->samples,
-                    "Samples per direction (default: 10 × triangles of the sampled mesh, clamped to 1e6..1e7)")
+                    "samples per direction (default: 10 x the sampled mesh's triangles, within 1e6..1e7)")
+        ->type_name("N")
         ->check(CLI::Range(uint64_t{1}, uint64_t{1} << 32));
-    cmd->add_option("--seed", opt->seed, "Random seed of the sampling (same seed, same figures)")
-        ->capture_default_str()
+    cmd->add_option("--seed", opt->seed, "random seed of the sampling (default 1): same seed, same figures")
+        ->type_name("N")
         ->check(whole_number(0, "a whole number"));
-    cmd->add_flag("--json", opt->json, "Print JSON instead of text");
+    cmd->add_flag("--json", opt->json, "print JSON instead of text");
     add_read_flags(cmd, opt->read);
+    cmd->get_option("--memory")
+        ->description(
+            "budget for counting the streamed mesh's edges (default 256M)\n"
+            "Spills to --tmpdir past it; K, M, G, T are binary multiples");
     strict_reports_bad_triangles(cmd);
+    cmd->footer("  meshstream compare scan.ply scan_1.glb");
     cmd->callback([opt] { run_compare(*opt); });
 }
 

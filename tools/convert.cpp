@@ -3,6 +3,7 @@
 #include "io/error.hpp"
 #include "tools/commands.hpp"
 #include "tools/common.hpp"
+#include "tools/help.hpp"
 #include "tools/input_filter.hpp"
 #include "tools/run_report.hpp"
 
@@ -82,19 +83,19 @@ void run_convert(const ConvertOptions& opt) {
 
 void add_convert(CLI::App& app) {
     auto opt = std::make_shared<ConvertOptions>();
-    CLI::App* cmd =
-        app.add_subcommand("convert",
-                           "Convert between formats (detected by magic bytes, then extension; '-' = stdin/stdout).\n"
-                           "The output appears under its name only when complete; '.gz' outputs are gzip-compressed.");
-    cmd->add_option("input", opt->input, "Input mesh ('-' = stdin)")->required();
-    cmd->add_option("output", opt->output,
-                    "Output mesh ('-' = stdout: a pipe gets meshstream's triangle stream, anything else needs --to)")
-        ->required();
+    CLI::App* cmd = app.add_subcommand(
+        "convert", "any format to any other, every triangle and channel the output can hold kept\n" + kInOutText);
+    cmd->add_option("IN", opt->input, "input mesh ('-' = stdin)")->required();
+    cmd->add_option("OUT", opt->output, "output mesh ('-' = stdout)")->required();
+    add_write_flags(cmd, opt->write);
+    cmd->get_option("--compress")->group("Options");
     add_clean_flag(cmd, opt->clean);
+    add_drop_flag(cmd, opt->read);
     add_json_flag(cmd, opt->json);
     add_read_flags(cmd, opt->read);
-    add_drop_flag(cmd, opt->read);
-    add_write_flags(cmd, opt->write);
+    cmd->footer(
+        "  meshstream convert scan.ply scan.glb --compress meshopt\n"
+        "  meshstream convert scan.stl - --to ply | gzip > scan.ply.gz");
     cmd->callback([opt] { run_convert(*opt); });
 }
 

@@ -18,6 +18,7 @@
 #include "tools/commands.hpp"
 #include "tools/common.hpp"
 #include "tools/decimate_report.hpp"
+#include "tools/help.hpp"
 #include "tools/input_filter.hpp"
 #include "tools/run_report.hpp"
 
@@ -563,32 +564,53 @@ void run_decimate(const DecimateOptions& opt) {
 void add_decimate(CLI::App& app) {
     auto opt = std::make_shared<DecimateOptions>();
     CLI::App* cmd = app.add_subcommand(
-        "decimate",
-        "Decimate a mesh of any size in one streaming pass (Wu & Kobbelt 2003) with a fixed memory buffer.\n"
-        "Output size is round(ratio x input), or --target: exactly, unless the mesh cannot get there\n"
-        "(one more when an odd number is left to remove at the end and no boundary edge can be\n"
-        "collapsed to remove a single triangle; a warning says so).");
-    cmd->add_option("input", opt->input, "Input mesh ('-' = stdin)")->required();
-    cmd->add_option("output", opt->output,
-                    "Output mesh ('-' = stdout: a pipe gets meshstream's triangle stream, anything else needs --to)")
-        ->required();
+        "decimate", "decimate a mesh of any size in one streaming pass, in fixed memory\n" + kInOutText);
+    cmd->add_option("IN", opt->input, "input mesh ('-' = stdin)")->required();
+    cmd->add_option("OUT", opt->output, "output mesh ('-' = stdout)")->required();
     auto* ratio =
-        cmd->add_option("-r,--ratio", opt->ratio, "Fraction of input triangles to keep, in (0, 1] (default 0.1)")
+        cmd->add_option("-r,--ratio", opt->ratio,
+                        "fraction of the triangles to keep, in (0, 1] (default 0.1)\n"
+                        "The output has round(ratio x input) triangles: exactly, unless the mesh cannot get "
+                        "there (one more when an odd number is left to remove at the end and no boundary edge "
+                        "can be collapsed to remove a single triangle; a warning says so)")
+            ->type_name("P")
             ->check(open_unit_interval());
-    cmd->add_option(
-           "--target", opt->target,
-           "Exact output triangle count (an input that states no count is counted in a first pass; not from a pipe)")
+    cmd->add_option("--target", opt->target,
+                    "exact output triangle count, instead of --ratio\n"
+                    "An input that states no count is counted in a first pass (not from a pipe)")
+        ->type_name("N")
         ->excludes(ratio)
         ->check(whole_number(1, "a whole number of triangles"));
-    cmd->add_option("--buffer", opt->buffer, "In-core buffer capacity in triangles (memory is fixed by it)")
-        ->capture_default_str()
+    cmd->add_option("--buffer", opt->buffer,
+                    "in-core buffer in triangles, which fixes the memory (default 400000)\n"
+                    "About 580 bytes a triangle; a larger buffer holds input in a poorer order")
+        ->type_name("N")
         ->check(CLI::Range(size_t{16}, size_t{1} << 29));
-    cmd->add_option("--seed", opt->seed, "Random seed (same input, options and seed give identical output)")
-        ->capture_default_str()
+    cmd->add_option("--weld", opt->weld, "weld corners on a grid of EPS, or of P% of the bounding-box diagonal")
+        ->type_name("EPS");
+    cmd->add_option("--sort", opt->sort,
+                    "auto (default), always or never: sort the input first\n"
+                    "auto: input not known to be sorted whose order the buffer cannot hold (forced writes) is sorted "
+                    "out of core first, within half of --memory, in --tmpdir (stdin is spooled there); always: sort "
+                    "first; never: decimate as read")
+        ->type_name("WHEN")
+        ->check(CLI::IsMember({"auto", "always", "never"}));
+    cmd->add_flag("--report", opt->report,
+                  "measure the output's error against the input at the end\n"
+                  "Hausdorff, mean and RMS distance, as compare does");
+    add_json_flag(cmd, opt->json);
+    add_write_flags(cmd, opt->write);
+    add_read_flags(cmd, opt->read);
+    cmd->get_option("--tmpdir")->group("Options");
+    strict_refuses_dropped_triangles(cmd);
+    cmd->add_option("--seed", opt->seed, "random seed (default 1): same input, options and seed, same output")
+        ->type_name("N")
+        ->group(kMoreOptions)
         ->check(whole_number(0, "a whole number"));
-    cmd->add_option("--weld", opt->weld, "Weld vertices on a grid of this size (absolute, or N% of the bbox diagonal)");
     cmd->add_option("--sorted-axis", opt->sorted_axis,
-                    "The input is sorted along this axis: x, y or z (or 0, 1, 2); read from the file when it says so")
+                    "the input is sorted along x, y or z (read from the file when it says so)")
+        ->type_name("AXIS")
+        ->group(kMoreOptions)
         ->transform(CLI::Validator(
             [](std::string& text) -> std::string {
                 static const std::map<std::string, std::string> kAxes = {{"x", "0"}, {"y", "1"}, {"z", "2"},
@@ -599,17 +621,10 @@ void add_decimate(CLI::App& app) {
                 text = it->second;
                 return {};
             },
-            "x|y|z"));
-    cmd->add_option("--sort", opt->sort,
-                    "auto (default): input not known to be sorted whose order the buffer cannot hold (forced writes) "
-                    "is sorted out of core first, within half of --memory, in --tmpdir (stdin is spooled there); "
-                    "always: sort first; never: decimate as read")
-        ->check(CLI::IsMember({"auto", "always", "never"}));
-    cmd->add_flag("--report", opt->report, "Compare the output against the input (Hausdorff, mean, RMS) at the end");
-    add_json_flag(cmd, opt->json);
-    add_read_flags(cmd, opt->read);
-    strict_refuses_dropped_triangles(cmd);
-    add_write_flags(cmd, opt->write);
+            ""));
+    cmd->footer(
+        "  meshstream decimate scan.ply scan.glb -r 0.01\n"
+        "  meshstream sort big.stl - | meshstream decimate - out.glb -r 0.01");
     cmd->callback([opt] { run_decimate(*opt); });
 }
 

@@ -23,6 +23,7 @@
 #include "io/format.hpp"
 #include "io/random.hpp"
 #include "tools/cli_checks.hpp"
+#include "tools/help.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -35,6 +36,7 @@
 #include <cstring>
 #include <memory>
 #include <mutex>
+#include <new>
 #include <numbers>
 #include <thread>
 #include <vector>
@@ -454,31 +456,68 @@ int main(int argc, char** argv) {
     using namespace meshstream;
     tools::GenOptions opt;
     CLI::App app{
-        "meshstream-gen: write a synthetic marching-cubes mesh (gyroid network with bumps, clipped to a ball) as a\n"
-        "triangle soup approximately sorted along z, like a scanner pipeline. Memory: the bands of triangles in\n"
-        "flight, about 45 MB for 10 M and 150 MB for 50 M triangles with two threads (less with --threads 1);\n"
-        "--shuffle adds bucket files in --tmpdir and one bucket of at most 128 MiB in memory."};
-    app.add_option("output", opt.output, "Output mesh (format from the extension, or --to)")->required();
+        "write a synthetic marching-cubes mesh, a triangle soup approximately sorted along z\n"
+        "OUTPUT: a mesh file, its format from the extension (or --to), '-' for stdout with --to.\n"
+        "A gyroid network with bumps, clipped to a ball, like a scanner pipeline's output. Memory: the bands\n"
+        "of triangles in flight, about 45 MB for 10 M and 150 MB for 50 M triangles with two threads;\n"
+        "--shuffle adds bucket files in --tmpdir and one bucket of at most 128 MiB in memory.",
+        "meshstream-gen"};
+    tools::use_help_formatter(app);
+    app.add_option("OUTPUT", opt.output, "output mesh")->required();
     app.add_option("-n,--triangles", opt.triangles,
-                   "Target triangle count (met within 1 % from about 10000 up; small ones overshoot: 100 gives 160)")
-        ->capture_default_str()
+                   "about this many triangles (default 1000000)\n"
+                   "Met within 1 % from about 10000 up; small counts overshoot: 100 gives 160")
+        ->type_name("N")
         ->check(CLI::Range(uint64_t{100}, uint64_t{1} << 40));
-    app.add_option("--seed", opt.seed, "Random seed (shape phases, holes, shuffle)")
-        ->capture_default_str()
-        ->check(meshstream::tools::whole_number(0, "a whole number"));
-    app.add_flag("--shuffle", opt.shuffle, "Write triangles in random order (out of core)");
-    app.add_flag("--holes", opt.holes, "Punch 40 holes into the surface, like occlusions in a scan");
-    app.add_option("--to", opt.to, "Output format (stl, stl-ascii, ...; default: by extension)");
-    app.add_option("--tmpdir", opt.tmpdir, "Directory for --shuffle's bucket files (default: $TMPDIR or /tmp)");
-    app.add_option("--threads", opt.threads, "Marching threads (default: one per core; output is the same)");
-    app.add_flag("-q,--quiet", opt.quiet, "No summary line");
+    app.add_option("--seed", opt.seed, "random seed of the shape, holes and shuffle (default 1)")
+        ->type_name("N")
+        ->check(tools::whole_number(0, "a whole number"));
+    app.add_flag("--shuffle", opt.shuffle, "write the triangles in random order (out of core)");
+    app.add_flag("--holes", opt.holes, "punch 40 holes into the surface, like occlusions in a scan");
+    app.add_option("--to", opt.to,
+                   "output format, instead of the extension's (e.g. ply)\nOne of: " + io::format_names(true))
+        ->type_name("FMT")
+        ->check(CLI::Validator(
+            [](const std::string& name) -> std::string {
+                const io::Format* f = io::find_format(name);
+                if (f != nullptr && f->open_writer != nullptr) return {};
+                return "unknown output format '" + name + "' (one of: " + io::format_names(true) + ")";
+            },
+            ""));
+    app.add_option("--tmpdir", opt.tmpdir, "where --shuffle's bucket files go (default: $TMPDIR or /tmp)")
+        ->type_name("DIR");
+    app.add_option("--threads", opt.threads, "marching threads (default: one per core; the output is the same)")
+        ->type_name("N");
+    app.add_flag("-q,--quiet", opt.quiet, "no summary line");
+    app.set_version_flag("--version", std::string("meshstream-gen ") + MESHSTREAM_VERSION, "print the version");
+    app.footer(
+        "  meshstream-gen --triangles 10000000 big.stl\n"
+        "  meshstream-gen -n 1000000 --shuffle --holes shuffled.ply");
     io::install_cleanup_handlers();
+    if (const std::string unknown = tools::first_unknown_option(app, "", argc, argv); !unknown.empty()) {
+        std::fprintf(stderr, "%s\n",
+                     tools::usage_error_line("meshstream-gen", "", "unknown option " + unknown).c_str());
+        return 2;
+    }
     try {
         app.parse(argc, argv);
-        return tools::run(opt);
     } catch (const CLI::ParseError& e) {
-        int code = app.exit(e);
-        return code == 0 ? 0 : 2;
+        if (e.get_exit_code() == 0) return app.exit(e);  // --help, --help-all, --version
+        std::fprintf(stderr, "%s\n", tools::parse_error_line(app, e, "meshstream-gen", "").c_str());
+        return 2;
+    }
+    // An output whose format cannot be told is a bad command line, as in meshstream.
+    if (opt.to.empty() && io::format_for_extension(opt.output, true) == nullptr) {
+        const std::string name = opt.output == "-" ? "<stdout>" : opt.output;
+        std::fprintf(stderr, "meshstream-gen: %s: cannot tell the output format from the name (use --to, one of: %s)\n",
+                     name.c_str(), io::format_names(true).c_str());
+        return 2;
+    }
+    try {
+        return tools::run(opt);
+    } catch (const std::bad_alloc&) {
+        std::fprintf(stderr, "meshstream-gen: error: out of memory\n");
+        return 1;
     } catch (const std::exception& e) {
         std::fprintf(stderr, "meshstream-gen: error: %s\n", e.what());
         return 1;

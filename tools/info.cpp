@@ -8,6 +8,7 @@
 #include "tools/cli_checks.hpp"
 #include "tools/commands.hpp"
 #include "tools/common.hpp"
+#include "tools/help.hpp"
 #include "tools/input_filter.hpp"
 #include "tools/order_text.hpp"
 
@@ -293,24 +294,30 @@ void run_info(const InfoOptions& opt) {
 void add_info(CLI::App& app) {
     auto opt = std::make_shared<InfoOptions>();
     CLI::App* cmd = app.add_subcommand("info",
-                                       "Print format, triangle count, bounding box, file size, degenerate triangles, "
-                                       "the channels the file carries and what its reader skipped");
-    cmd->add_option("file", opt->input, "Mesh file ('-' = stdin; gzip is detected)")->required();
-    cmd->add_flag("--json", opt->json, "Print JSON instead of text");
+                                       "format, counts, bounding box, degenerate triangles, channels, order\n"
+                                       "FILE: a mesh file, '-' for stdin; gzip is detected");
+    cmd->add_option("FILE", opt->input, "mesh file ('-' = stdin)")->required();
+    cmd->add_flag("--json", opt->json, "print JSON instead of text");
     cmd->add_flag("--topology", opt->topology,
-                  "Count vertices, boundary and non-manifold edges (welded by vertex id for PLY/OBJ, else by "
-                  "position; sorts 144 bytes a triangle within --memory, spilling beyond)");
+                  "count vertices, boundary and non-manifold edges\n"
+                  "Welded by vertex id for PLY/OBJ, else by position; sorts 144 bytes a triangle within --memory, "
+                  "spilling beyond");
     cmd->add_flag("--order", opt->order,
-                  "Measure the stream's width: triangles held at once until all their vertices' uses were read "
-                  "(exact within --memory, else sampled; see docs/cli.md)");
+                  "measure how far the file is from the order decimate needs\n"
+                  "The stream's width: triangles held at once until all their vertices' uses were read (exact "
+                  "within --memory, else sampled; see docs/cli.md)");
     // The same ranges as decimate's: settings it cannot run are not judged.
-    cmd->add_option("--buffer", opt->buffer, "With --order: decimation buffer (triangles) to judge (default 400000)")
+    cmd->add_option("--buffer", opt->buffer, "with --order: the decimate --buffer to judge (default 400000)")
+        ->type_name("N")
         ->check(CLI::Range(size_t{16}, size_t{1} << 29));
     cmd->add_option("--ratio", opt->ratio,
-                    "With --order: the decimation ratio to judge it for (default 0.1; the buffer needed grows with it)")
+                    "with --order: the decimation ratio to judge it for (default 0.1)\n"
+                    "The buffer needed grows with it")
+        ->type_name("P")
         ->check(open_unit_interval());
     add_read_flags(cmd, opt->read);
     strict_reports_bad_triangles(cmd);
+    cmd->footer("  meshstream info scan.ply --order");
     cmd->callback([opt] { run_info(*opt); });
 }
 

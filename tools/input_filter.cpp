@@ -41,8 +41,9 @@ void note_dropped_triangles(const DroppedTriangles& dropped, const std::string& 
 
 void add_clean_flag(CLI::App* cmd, bool& clean) {
     cmd->add_flag("--clean", clean,
-                  "Drop triangles with a NaN or infinite coordinate and degenerate ones (two corners at the same "
-                  "position), counting them; without it every input triangle is kept");
+                  "drop NaN/inf and degenerate triangles (default: every triangle is kept)\n"
+                  "Drops triangles with a NaN or infinite coordinate and degenerate ones (two corners at the same "
+                  "position), and counts them in a warning");
 }
 
 }  // namespace meshstream::tools

@@ -35,8 +35,9 @@ nlohmann::ordered_json run_report_json(const RunReport& r, const Warnings& warni
 
 void add_json_flag(CLI::App* cmd, bool& json) {
     cmd->add_flag("--json", json,
-                  "Print one JSON object on stdout at the end (files, formats, counts, time, peak RSS, warnings "
-                  "with codes); stdout then holds nothing else, so the output cannot be '-'");
+                  "print one JSON object on stdout at the end\n"
+                  "Files, formats, counts, time, peak RSS, warnings with codes (docs/cli.md); stdout then holds "
+                  "nothing else, so the output cannot be '-'");
 }
 
 void refuse_json_with_stdout_output(const std::string& output) {

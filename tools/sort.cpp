@@ -8,6 +8,7 @@
 #include "sort/external_sort.hpp"
 #include "tools/commands.hpp"
 #include "tools/common.hpp"
+#include "tools/help.hpp"
 #include "tools/input_filter.hpp"
 #include "tools/run_report.hpp"
 
@@ -348,26 +349,34 @@ void run_sort(const SortOptions& opt) {
 
 void add_sort(CLI::App& app) {
     auto opt = std::make_shared<SortOptions>();
-    CLI::App* cmd =
-        app.add_subcommand("sort",
-                           "Sort triangles by their minimum coordinate along an axis (out of core, stable), so that\n"
-                           "decimate can stream them; the output records the axis (see docs/sorting.md)");
-    cmd->add_option("input", opt->input, "Input mesh ('-' = stdin, needs --axis x|y|z)")->required();
-    cmd->add_option("output", opt->output,
-                    "Output mesh ('-' = stdout: a pipe gets meshstream's triangle stream, anything else needs --to)")
-        ->required();
-    cmd->add_option("--axis", opt->axis, "x, y, z, or auto: the longest bounding-box axis (default; needs a file)")
+    CLI::App* cmd = app.add_subcommand(
+        "sort", "sort triangles along an axis, out of core, so that decimate can stream them\n" + kInOutText +
+                    "\nA stable sort by each triangle's minimum coordinate; the output "
+                    "records the axis (docs/sorting.md)");
+    cmd->add_option("IN", opt->input, "input mesh ('-' = stdin, needs --axis x, y or z)")->required();
+    cmd->add_option("OUT", opt->output, "output mesh ('-' = stdout)")->required();
+    cmd->add_option("--axis", opt->axis, "x, y, z or auto: the longest bounding-box axis (default; needs a file)")
+        ->type_name("AXIS")
         ->check(CLI::IsMember({"x", "y", "z", "auto"}));
-    cmd->add_flag("--stats", opt->stats, "Print runs, merge passes, temporary disk, time and peak RSS on stderr");
+    add_read_flags(cmd, opt->read);
+    cmd->get_option("--memory")
+        ->description(
+            "memory for runs and merge buffers, e.g. 64M, 1G (default 256M)\n"
+            "A quarter goes to the reader's and writer's own tables; K, M, G, T are binary multiples");
+    cmd->get_option("--tmpdir")
+        ->group("Options")
+        ->description(
+            "where sorted runs go (default: the output's directory)\n"
+            "When writing to stdout, a pipe or a device: $TMPDIR or /tmp");
+    add_write_flags(cmd, opt->write);
     add_clean_flag(cmd, opt->clean);
     add_json_flag(cmd, opt->json);
-    add_read_flags(cmd, opt->read);
+    cmd->add_flag("--stats", opt->stats, "print runs, merge passes, temporary disk, time and peak RSS on stderr");
     add_drop_flag(cmd, opt->read);
-    cmd->get_option("--tmpdir")
-        ->description(
-            "Directory for sort runs and spills (default: the output's directory; $TMPDIR "
-            "or /tmp when writing to stdout, a pipe or a device)");
-    add_write_flags(cmd, opt->write);
+    cmd->get_option("--drop")->group(kMoreOptions);
+    cmd->footer(
+        "  meshstream sort scan.stl sorted.stl\n"
+        "  cat scan.stl | meshstream sort --axis z --to stl - - > sorted.stl");
     cmd->callback([opt] { run_sort(*opt); });
 }
 

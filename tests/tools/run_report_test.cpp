@@ -92,7 +92,8 @@ TEST(RunReportJson, RefusesAnOutputOnStdout) {
     for (const char* cmd : {"convert", "sort", "decimate"}) {
         const cli_test::CliRun r = run(std::string(cmd) + " --json --to stl " + kFixtures + "/cube.bin.stl -");
         EXPECT_EQ(r.code, 2) << cmd;
-        EXPECT_NE(r.err.find("meshstream: error: <stdout>: --json prints its report on stdout"), std::string::npos)
+        EXPECT_NE(r.err.find("meshstream: " + std::string(cmd) + ": <stdout>: --json prints its report on stdout"),
+                  std::string::npos)
             << r.err;
         // The same file by another name: stdout redirected into the output.
         const cli_test::CliRun same =
