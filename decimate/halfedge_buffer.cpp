@@ -408,6 +408,7 @@ HalfEdgeBuffer::Added HalfEdgeBuffer::add_triangle(const float tri[9], const uin
     // Every corner was found through (or entered into) the hash table, so all three are on
     // P_in; vertices whose fan just closed leave it.
     added_face.pin_count = 3;
+    ++pinned_face_count_;
     for (int k = 0; k < 3; ++k)
         if (slots_[v[k]].vertex.open_edges == 0) finalize_vertex(v[k]);
     added.face = f;
@@ -444,7 +445,10 @@ void HalfEdgeBuffer::finalize_vertex(uint32_t v) {
         return;
     }
     for (uint32_t c = x.first_corner; c != kNoIndex; c = next_corner(c))
-        if (--faces_[face_of(c)].pin_count == 0) enter_interior(face_of(c));
+        if (--faces_[face_of(c)].pin_count == 0) {
+            --pinned_face_count_;
+            enter_interior(face_of(c));
+        }
     // A vertex where two fans touch must not move (it is not a manifold vertex); finding out
     // now, once, spares every collapse the walk.
     if (!one_fan(v)) x.flags |= kManyFans;
@@ -485,6 +489,7 @@ void HalfEdgeBuffer::detach_face(uint32_t f) {
     for (uint32_t k = 0; k < 3; ++k) unlink_corner(faces_[f].vertex[k], half_edge(f, k));
     faces_[f].alive = 0;
     --face_count_;
+    if (faces_[f].pin_count > 0) --pinned_face_count_;
     free_faces_[free_face_count_++] = f;
 }
 

@@ -131,6 +131,10 @@ public:
     size_t face_capacity() const { return face_capacity_; }
     size_t face_count() const { return face_count_; }
     bool full() const { return face_count_ == face_capacity_; }
+    // Faces added so far (the creation serial of the last: Face::born, which wraps at 2^32).
+    uint32_t faces_added() const { return born_counter_; }
+    // Faces with a corner on P_in (the rest are interior: oldest_interior_face()).
+    size_t pinned_face_count() const { return pinned_face_count_; }
     // Free vertex slots; add_triangle needs 3.
     size_t free_vertex_count() const { return vertex_capacity_ - vertex_used_; }
     // Face slots [0, face_slots()) have been used; face_alive() tells which hold a face.
@@ -355,7 +359,7 @@ private:
 
     RawArray<Face> faces_;
     RawArray<uint32_t> free_faces_;
-    size_t free_face_count_ = 0, face_count_ = 0;
+    size_t free_face_count_ = 0, face_count_ = 0, pinned_face_count_ = 0;
     uint32_t face_high_ = 0, born_counter_ = 0;
 
     // Faces in the order they left P_in: a ring of (face, born) compacted when full (entries

@@ -32,6 +32,15 @@ inline double resolution_level(double ratio, size_t current, uint64_t triangles_
     return represented > 0 ? double(current) / represented : INFINITY;
 }
 
+// The budget of a decimator that is one part of a mesh cut into ranges (parallel decimation):
+// faces with a corner on P_in cannot be decimated yet and stand for themselves, at full
+// resolution, so the other in-core faces are held at p: N_current − pinned ≤
+// p·(represented − N_out/p − pinned). `represented` counts the input triangles read, each
+// weighted by how many input triangles it stands for (1 for the input itself).
+inline double part_budget(double ratio, double represented, uint64_t triangles_out, size_t pinned) {
+    return ratio * represented - double(triangles_out) + (1 - ratio) * double(pinned);
+}
+
 struct RoomPlan {
     size_t decimate_to;  // collapse until the buffer holds at most this many triangles
     size_t write_to;     // then write until it holds at most this many
@@ -39,12 +48,15 @@ struct RoomPlan {
 
 // What to do when the buffer of `capacity` triangles is full (hysteresis: refill to 100 %,
 // work down to 50 %).
-inline RoomPlan plan_full_buffer(size_t capacity, double ratio, uint64_t triangles_in, uint64_t triangles_out) {
+inline RoomPlan plan_full_buffer(size_t capacity, double budget) {
     const size_t half = capacity / 2;
-    const double budget = resolution_budget(ratio, triangles_in, triangles_out);
     const size_t decimate_to =
         budget <= double(half) ? half : std::min(capacity, static_cast<size_t>(std::ceil(budget)));
     return {decimate_to, half};
+}
+
+inline RoomPlan plan_full_buffer(size_t capacity, double ratio, uint64_t triangles_in, uint64_t triangles_out) {
+    return plan_full_buffer(capacity, resolution_budget(ratio, triangles_in, triangles_out));
 }
 
 // The exact output size: round(p·N_in), or the explicit target.

@@ -34,6 +34,9 @@ const Options& checked(const Options& options, std::optional<uint64_t> input_cou
     if (options.sorted_axis && (*options.sorted_axis < 0 || *options.sorted_axis > 2))
         refuse("sorted_axis must be 0, 1 or 2");
     if (options.output_chunk_triangles == 0) refuse("output_chunk_triangles must be at least 1");
+    if (options.part != Part::kWhole && options.target) refuse("a range or the seam pass takes a ratio, not a target");
+    if (options.earlier_span && (options.part != Part::kRange || !options.sorted_axis))
+        refuse("earlier_span needs a range on a sorted axis");
     return options;
 }
 
@@ -76,8 +79,12 @@ size_t StreamDecimator::reserved_bytes(size_t buffer_triangles) {
     return HalfEdgeBuffer::reserved_bytes(buffer_triangles) + CollapseQueue::reserved_bytes(buffer_triangles);
 }
 
-void StreamDecimator::push(const io::TriangleChunk& in, const Emit& out) {
+void StreamDecimator::push(const io::TriangleChunk& in, const Emit& out) { push(in, 1.0, out); }
+
+void StreamDecimator::push(const io::TriangleChunk& in, double weight, const Emit& out) {
     if (finished_) throw std::logic_error("StreamDecimator::push after finish()");
+    assert(weight == 1.0 || options_.part == Part::kSeams);
+    weight_ = weight;
     const std::span<const float> xyz = in.xyz();
     // NaN/inf corners can be neither welded nor finalized (the commands drop them first).
     if (!std::all_of(xyz.begin(), xyz.end(), [](float v) { return std::isfinite(v); }))
@@ -111,6 +118,7 @@ void StreamDecimator::read_triangle(const float tri[9], const uint64_t hashes[3]
         return buffer_.add_triangle(tri, hashes);
     }();
     ++stats_.triangles_in;
+    represented_ += weight_;
     if (added.face == kNoIndex) {
         // A triangle the weld grid collapsed is gone, as the weld asked (passed through it took
         // output budget, and whole-mesh writers dropped it after the count was printed); one
@@ -202,7 +210,11 @@ void StreamDecimator::sweep() {
             continue;
         }
         const Vertex& x = buffer_.vertex(e.vertex);
-        if ((x.flags & (kAlive | kInHash)) == (kAlive | kInHash) && x.generation == e.generation) {
+        // A range's vertex that an earlier range's triangle may reach stays open: it may be on a
+        // seam (the seam pass joins it); being behind the front, it never comes up again.
+        const bool shared = options_.earlier_span && double(e.coordinate) >= (*options_.earlier_span)[0] &&
+                            double(e.coordinate) <= (*options_.earlier_span)[1];
+        if (!shared && (x.flags & (kAlive | kInHash)) == (kAlive | kInHash) && x.generation == e.generation) {
             buffer_.finalize_vertex(e.vertex);
             ++stats_.vertices_finalized_by_sweep;
             swept_to_ = threshold;
@@ -255,17 +267,28 @@ void StreamDecimator::follow_dropped() {
     ratio_ = usable > 0 ? std::min(1.0, double(*options_.target) / double(usable)) : 1.0;
 }
 
+double StreamDecimator::budget() const {
+    if (options_.part == Part::kWhole) return resolution_budget(ratio_, stats_.triangles_in, output_.triangle_count());
+    return part_budget(ratio_, represented_, output_.triangle_count(), buffer_.pinned_face_count());
+}
+
 void StreamDecimator::make_room(const Emit& out) {
     follow_dropped();
     if (options_.sorted_axis) sweep();
-    const RoomPlan plan =
-        plan_full_buffer(buffer_.face_capacity(), ratio_, stats_.triangles_in, output_.triangle_count());
+    const RoomPlan plan = plan_full_buffer(buffer_.face_capacity(), budget());
     rate_pending(buffer_, queue_);
-    while (buffer_.face_count() > plan.decimate_to && collapse_cheapest(buffer_, queue_)) ++stats_.collapses;
+    if (options_.part == Part::kWhole) {
+        while (buffer_.face_count() > plan.decimate_to && collapse_cheapest(buffer_, queue_)) ++stats_.collapses;
+    } else {
+        // A collapse may remove faces on P_in, which stood for themselves: the budget falls
+        // with them, and is followed as it falls.
+        while (buffer_.face_count() > plan_full_buffer(buffer_.face_capacity(), budget()).decimate_to &&
+               collapse_cheapest(buffer_, queue_))
+            ++stats_.collapses;
+    }
     while (buffer_.face_count() > plan.write_to) {
-        const double budget = resolution_budget(ratio_, stats_.triangles_in, output_.triangle_count());
         // Early when above the level planned, the budget rounded up (each write lowers both).
-        if (double(buffer_.face_count()) > std::ceil(budget)) ++stats_.premature_writes;
+        if (double(buffer_.face_count()) > std::ceil(budget())) ++stats_.premature_writes;
         write_one(out, true);
     }
     if (buffer_.free_vertex_count() < 3) stats_.orphans_evicted += buffer_.evict_orphans();
@@ -274,15 +297,56 @@ void StreamDecimator::make_room(const Emit& out) {
 
 void StreamDecimator::finish(const Emit& out) {
     if (finished_) throw std::logic_error("StreamDecimator::finish called twice");
+    finish_at(options_.target ? *options_.target : final_triangle_count(ratio_, stats_.triangles_in), out);
+}
+
+void StreamDecimator::finish_at(uint64_t target, const Emit& out) {
+    if (finished_) throw std::logic_error("StreamDecimator::finish called twice");
+    if (options_.part == Part::kRange) throw std::logic_error("StreamDecimator: a range ends with finish_range()");
     finished_ = true;
     // No more input: whatever is still open is true boundary.
     buffer_.finalize_all();
-    const uint64_t target = options_.target ? *options_.target : final_triangle_count(ratio_, stats_.triangles_in);
     stats_.target_triangles = target;
     const size_t budget = final_budget(target, output_.triangle_count());
+    decimate_final(budget);
+    // Collapses remove two faces; an odd remainder needs one boundary collapse.
+    if (buffer_.face_count() == budget + 1 && collapse_one_boundary_edge(buffer_)) ++stats_.collapses;
+    while (buffer_.face_count() > 0) write_one(out, false);
+    output_.flush(out);
+    collect_stats();
+}
+
+void StreamDecimator::finish_range(const Emit& interior, const Emit& first_seam, const Emit& last_seam) {
+    if (finished_) throw std::logic_error("StreamDecimator::finish_range called twice");
+    if (options_.part != Part::kRange) throw std::logic_error("StreamDecimator::finish_range needs Part::kRange");
+    finished_ = true;
+    // Nothing is finalized: a vertex still open may be shared with another range. The faces on
+    // P_in stand for themselves (budget()), the rest come down to the ratio.
+    decimate_final(0);
+    stats_.target_triangles = output_.triangle_count() + buffer_.face_count();
+    for (uint32_t f = pick_write(buffer_); f != kNoIndex; f = pick_write(buffer_))
+        stats_.vertices_moved += write_face(buffer_, f, next_id_, output_, interior);
+    output_.flush(interior);
+    // The faces on P_in, in slot order; their P_in corners are frozen where they were read.
+    const uint32_t half = buffer_.faces_added() / 2;
+    for (const bool first : {true, false}) {
+        const Emit& seam = first ? first_seam : last_seam;
+        for (uint32_t f = 0; f < buffer_.face_slots(); ++f)
+            if (buffer_.face_alive(f) && (buffer_.face(f).born <= half) == first)
+                stats_.vertices_moved += write_face(buffer_, f, next_id_, output_, seam);
+        output_.flush(seam);
+    }
+    collect_stats();
+}
+
+void StreamDecimator::decimate_final(size_t keep) {
+    // A range's budget falls as collapses remove faces on P_in (they stood for themselves): it is
+    // followed as it falls.
+    const bool range = options_.part == Part::kRange;
+    auto in_core = [&] { return range ? size_t(std::max(0.0, std::round(budget()))) : keep; };
     rate_pending(buffer_, queue_);
     bool rated_all = false;
-    while (buffer_.face_count() >= budget + 2) {
+    while (buffer_.face_count() >= in_core() + 2) {
         if (collapse_cheapest(buffer_, queue_)) {
             ++stats_.collapses;
         } else if (!rated_all) {
@@ -300,10 +364,9 @@ void StreamDecimator::finish(const Emit& out) {
             break;
         }
     }
-    // Collapses remove two faces; an odd remainder needs one boundary collapse.
-    if (buffer_.face_count() == budget + 1 && collapse_one_boundary_edge(buffer_)) ++stats_.collapses;
-    while (buffer_.face_count() > 0) write_one(out, false);
-    output_.flush(out);
+}
+
+void StreamDecimator::collect_stats() {
     stats_.triangles_out = output_.triangle_count();
     stats_.peak_vertices = buffer_.peak_vertices();
     stats_.vertices_merged = buffer_.vertices_merged();

@@ -17,6 +17,7 @@
 #include "io/chunk.hpp"
 #include "io/input_count.hpp"
 
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -24,6 +25,22 @@
 #include <optional>
 
 namespace meshstream::decimate {
+
+// What a decimator's stream is (parallel decimation cuts a mesh into contiguous ranges of
+// triangles, decimates each in its own decimator and joins them in a seam pass).
+enum class Part : uint8_t {
+    kWhole,  // the whole mesh (finish())
+    // One range of the mesh (finish_range()): the vertices still on P_in at its end may be shared
+    // with another range, so they are never finalized: they and their faces come out as read
+    // (positions, at full resolution). Faces with a corner on P_in stand for themselves in the
+    // schedule (schedule.hpp, part_budget), the rest are held at the ratio.
+    kRange,
+    // The seam pass over the ranges' outputs in range order (push() with weights, finish_at()):
+    // each triangle stands for the input triangles its range said, so where the ranges' outputs
+    // are already at the ratio nothing is decimated, and the full-resolution strips along the
+    // seams are decimated down to it once both sides have been read.
+    kSeams,
+};
 
 struct Options {
     double ratio = 0.1;                // p in (0, 1]: output = round(p · input)
@@ -37,6 +54,11 @@ struct Options {
     // needs no margin, and one triangle whose minimum descends shows the order is not that.
     bool sorted_by_minimum = false;
     size_t output_chunk_triangles = io::TriangleChunk::kDefaultCapacity;  // ≥ 1
+    Part part = Part::kWhole;
+    // kRange on sorted input: the interval along sorted_axis covered by every triangle before
+    // this range. A vertex inside it may be shared with an earlier range: the sweep leaves it
+    // open (it finalizes only vertices no other range can reach).
+    std::optional<std::array<double, 2>> earlier_span;
 };
 
 struct Stats {
@@ -85,6 +107,19 @@ public:
     // the rest, flushes `out`.
     // Call once; push() or finish() after it throw std::logic_error.
     void finish(const Emit& out);
+    // Part::kSeams: pushes `in` with each triangle standing for `weight` input triangles in the
+    // schedule (push() above weighs 1).
+    void push(const io::TriangleChunk& in, double weight, const Emit& out);
+    // Part::kSeams: the end of input, landing on `target` triangles in total (the ratio over
+    // the ranges' input counts, or --target); otherwise as finish().
+    void finish_at(uint64_t target, const Emit& out);
+    // Part::kRange: the end of the range. Decimates what can be decimated to the ratio and writes
+    // it to `interior` (faces with no corner left on P_in; push() writes there too), then the
+    // faces with a corner on P_in, as they are (their P_in corners keep their input positions):
+    // those read in the first half of the range to `first_seam` (on streaming input they border
+    // the range before), the others to `last_seam`. Each output is flushed; a triangle written to
+    // `interior` stands for 1/ratio input triangles, one written to a seam for one.
+    void finish_range(const Emit& interior, const Emit& first_seam, const Emit& last_seam);
 
     const Stats& stats() const { return stats_; }
     // round(ratio · input_triangle_count): the output size finish() lands on.
@@ -103,6 +138,9 @@ private:
     void sweep();
     void track_sweep(const float tri[9]);
     void follow_dropped();
+    double budget() const;
+    void decimate_final(size_t keep);  // down to `keep` faces in core (kRange: follows budget())
+    void collect_stats();
 
     Options options_;
     io::InputCount own_count_;     // the count given to the first constructor
@@ -113,6 +151,8 @@ private:
     Rng rng_;
     TriangleOutput output_;
     uint64_t next_id_ = 0;
+    double weight_ = 1;       // input triangles each triangle being read stands for (kSeams)
+    double represented_ = 0;  // input triangles the triangles read stand for (kRange, kSeams)
     Stats stats_;
     bool finished_ = false;
 

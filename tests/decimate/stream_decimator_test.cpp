@@ -12,6 +12,7 @@
 #include <array>
 #include <map>
 #include <numeric>
+#include <set>
 
 using namespace meshstream::decimate;
 using namespace meshstream::decimate::test;
@@ -494,4 +495,100 @@ TEST(StreamDecimator, TargetFollowsTheTrianglesTheReadLoopDropped) {
     decimator.finish(emit);
     EXPECT_NEAR(double(out), 6945.0, 1.0);
     EXPECT_NEAR(decimator.ratio(), 6945.0 / double(n), 1e-12);
+}
+
+// Parallel decimation's parts (tools/decimate_threads.hpp runs them on threads): the bunny cut
+// into two ranges, each decimated by a Part::kRange decimator, and their outputs joined in
+// range order by a Part::kSeams decimator with the weights the ranges give.
+TEST(StreamDecimator, RangesKeepTheirSeamsAndTheSeamPassJoinsThem) {
+    const std::vector<float> bunny =
+        load_binary_stl(std::string(MESHSTREAM_FIXTURES_DIR) + "/bunny_from_draco.bin.stl");
+    const size_t n = bunny.size() / 9, cut = n / 2;
+    Options options;
+    options.ratio = 0.1;
+    options.buffer_triangles = 8000;
+    const Decimated whole = run_decimator(bunny, options);
+
+    // Positions used on both sides of the cut.
+    std::set<std::array<float, 3>> first_half, shared;
+    for (size_t c = 0; c < 3 * cut; ++c) first_half.insert({bunny[3 * c], bunny[3 * c + 1], bunny[3 * c + 2]});
+    for (size_t c = 3 * cut; c < 3 * n; ++c)
+        if (first_half.count({bunny[3 * c], bunny[3 * c + 1], bunny[3 * c + 2]}))
+            shared.insert({bunny[3 * c], bunny[3 * c + 1], bunny[3 * c + 2]});
+    ASSERT_GT(shared.size(), 50u);
+
+    struct Piece {
+        std::vector<float> xyz;
+        std::vector<double> weights;  // one per chunk
+        std::vector<size_t> sizes;
+    };
+    Piece pieces[2][3];  // per range: interior, first seam, last seam
+    Options range_options = options;
+    range_options.part = Part::kRange;
+    for (int r = 0; r < 2; ++r) {
+        StreamDecimator decimator(range_options, std::nullopt);
+        auto collect = [&](int piece, double weight) -> Emit {
+            return [&, piece, weight](const meshstream::io::TriangleChunk& chunk) {
+                Piece& p = pieces[r][piece];
+                p.xyz.insert(p.xyz.end(), chunk.xyz().begin(), chunk.xyz().end());
+                p.weights.push_back(weight);
+                p.sizes.push_back(chunk.size());
+            };
+        };
+        const Emit interior = collect(0, 1 / options.ratio), first = collect(1, 1), last = collect(2, 1);
+        meshstream::io::TriangleChunk chunk(1000);
+        for (size_t t = r == 0 ? 0 : cut; t < (r == 0 ? cut : n); ++t) {
+            float tri[9];
+            std::memcpy(tri, &bunny[9 * t], sizeof tri);
+            chunk.push(tri);
+            if (chunk.full()) {
+                decimator.push(chunk, interior);
+                chunk.clear();
+            }
+        }
+        decimator.push(chunk, interior);
+        decimator.finish_range(interior, first, last);
+        EXPECT_EQ(decimator.stats().forced_writes, 0u);
+        // Every shared position is still in the range's output, where it was read.
+        std::set<std::array<float, 3>> out;
+        for (const Piece& p : pieces[r])
+            for (size_t c = 0; c < p.xyz.size() / 3; ++c)
+                out.insert({p.xyz[3 * c], p.xyz[3 * c + 1], p.xyz[3 * c + 2]});
+        for (const auto& s : shared) EXPECT_TRUE(out.count(s)) << "range " << r;
+    }
+
+    Options seam_options = options;
+    seam_options.part = Part::kSeams;
+    seam_options.buffer_triangles = 2000;
+    StreamDecimator seams(seam_options, std::nullopt);
+    Decimated joined;
+    const Emit emit = [&](const meshstream::io::TriangleChunk& chunk) {
+        joined.xyz.insert(joined.xyz.end(), chunk.xyz().begin(), chunk.xyz().end());
+    };
+    auto feed = [&](const Piece& p) {
+        size_t at = 0;
+        for (size_t i = 0; i < p.sizes.size(); ++i) {
+            meshstream::io::TriangleChunk chunk(p.sizes[i] > 0 ? p.sizes[i] : 1);
+            for (size_t t = 0; t < p.sizes[i]; ++t, ++at) {
+                float tri[9];
+                std::memcpy(tri, &p.xyz[9 * at], sizeof tri);
+                chunk.push(tri);
+            }
+            seams.push(chunk, p.weights[i], emit);
+        }
+    };
+    for (const int piece : {0, 1, 2}) feed(pieces[0][piece]);
+    for (const int piece : {1, 0, 2}) feed(pieces[1][piece]);
+    const uint64_t target = StreamDecimator::expected_output(options.ratio, n);
+    seams.finish_at(target, emit);
+    EXPECT_EQ(seams.stats().forced_writes, 0u);
+    EXPECT_LE(joined.xyz.size() / 9, target + 1);
+    EXPECT_GE(joined.xyz.size() / 9, target);
+
+    // As one decimator's output: no non-manifold or mis-oriented edge, and about as much
+    // boundary (the bunny's holes).
+    const Topology one = topology(index_by_position(whole.xyz)), two = topology(index_by_position(joined.xyz));
+    EXPECT_EQ(two.nonmanifold_edges, one.nonmanifold_edges);
+    EXPECT_EQ(two.misoriented_edges, 0u);
+    EXPECT_LE(two.boundary_edges, one.boundary_edges + one.boundary_edges / 5);
 }
