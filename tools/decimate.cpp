@@ -12,12 +12,14 @@
 // read.
 #include "compare/metro.hpp"
 #include "decimate/stream_decimator.hpp"
+#include "io/byte_stream.hpp"
 #include "io/error.hpp"
 #include "sort/external_sort.hpp"
 #include "tools/cli_checks.hpp"
 #include "tools/commands.hpp"
 #include "tools/common.hpp"
 #include "tools/decimate_report.hpp"
+#include "tools/decimate_threads.hpp"
 #include "tools/help.hpp"
 #include "tools/input_filter.hpp"
 #include "tools/run_report.hpp"
@@ -31,6 +33,7 @@
 #include <memory>
 #include <new>
 #include <stdexcept>
+#include <thread>
 
 namespace meshstream::tools {
 namespace {
@@ -39,6 +42,8 @@ using compare::compare_meshes;
 using compare::CompareOptions;
 using compare::CompareResult;
 using compare::file_source;
+
+unsigned every_core() { return std::max(1u, std::thread::hardware_concurrency()); }
 
 struct DecimateOptions {
     std::string input, output;
@@ -49,6 +54,7 @@ struct DecimateOptions {
     std::string weld;  // "" / "0.001" / "0.01%"
     std::optional<int> sorted_axis;
     std::string sort = "auto";  // --sort auto|always|never
+    unsigned threads = every_core();
     bool report = false;
     bool json = false;
     ReadFlags read;
@@ -222,6 +228,7 @@ decimate::Options decimation_options(const DecimateOptions& opt, const io::MeshH
 struct CountPass {
     io::InputCount count;
     double seconds = 0;
+    bool for_threads = false;  // made to cut the input into ranges (else for --target)
 };
 
 CountPass count_usable_triangles(const DecimateOptions& opt, const io::ReadOptions& read) {
@@ -400,6 +407,35 @@ void run_decimate(const DecimateOptions& opt) {
     const std::optional<uint64_t> input_count = counted ? counted->count.promised : header.triangle_count;
     const decimate::Options options = decimation_options(opt, header, input_name, in.format().name, input_count);
 
+    // --threads: a file cut into ranges of triangles (decimate_threads.hpp) by the count its
+    // header states or estimates, else by one counted in a first pass (not for a file too small
+    // to be cut, judged by its size: any format takes 8 bytes a triangle or more, uncompressed).
+    const bool sort_first = opt.sort == "always";
+    std::optional<uint64_t> cut_count = input_count ? input_count : header.triangle_estimate;
+    unsigned ranges = 1;
+    if (opt.threads > 1 && !sort_first && is_regular_file(opt.input)) {
+        const uint64_t bytes = in.source().stored_size().value_or(0);
+        const uint64_t most = in.source().gzip() ? std::numeric_limits<uint64_t>::max() : bytes / 8;
+        if (!cut_count && most >= 2 * uint64_t(opt.buffer)) {
+            in.close();
+            counted = count_usable_triangles(opt, read);
+            counted->for_threads = true;
+            in = open_triangle_input(opt.input, opt.read, read, Command::kDecimate);
+            cut_count = counted->count.promised;
+        }
+        if (cut_count) ranges = range_count(opt.threads, *cut_count, opt.buffer);
+    }
+    // The ranges' outputs wait in --tmpdir: where nothing can be written, one thread decimates.
+    std::string one_thread_why;
+    if (ranges > 1) {
+        try {
+            io::TempFile probe(opt.read.tmpdir, "meshstream-range");
+        } catch (const io::Error& e) {
+            ranges = 1;
+            one_thread_why = e.what();
+        }
+    }
+
     io::WriteOptions wo = opt.write.options(opt.read);
     // The output count, for whole-mesh writers to refuse a --memory too small before the work.
     if (input_count)
@@ -413,7 +449,6 @@ void run_decimate(const DecimateOptions& opt) {
 
     // --sort: what may happen. Input known to be sorted (its flag, --sorted-axis) is decimated
     // as it comes in auto: sorting again cannot help it, a larger buffer can.
-    const bool sort_first = opt.sort == "always";
     const bool may_restart = opt.sort == "auto" && !options.sorted_axis;
     const bool read_once = !is_regular_file(opt.input);
     const uint64_t budget = opt.read.options().memory_budget_bytes;
@@ -435,7 +470,33 @@ void run_decimate(const DecimateOptions& opt) {
     std::unique_ptr<decimate::StreamDecimator> decimator;
     decimate::Options used = options;
     std::optional<SortedInput> sorted;
-    if (!sort_first) {
+    std::optional<RangesResult> threaded;
+    if (!sort_first && ranges > 1) {
+        in.close();  // each range opens the input itself
+        const auto attempt = std::chrono::steady_clock::now();
+        RangesJob job;
+        job.open = [&] { return open_triangle_input(opt.input, opt.read, read, Command::kDecimate); };
+        job.make_decimator = [](const decimate::Options& o) {
+            static const io::InputCount kNoCount;  // a range and the seam pass take a ratio
+            return make_decimator(o, kNoCount);
+        };
+        job.tmpdir = opt.read.tmpdir;
+        job.options = options;
+        job.options.target.reset();
+        if (options.target) job.options.ratio = std::min(1.0, double(*options.target) / double(*cut_count));
+        job.target = options.target;
+        job.cut_triangles = *cut_count;
+        job.ranges = ranges;
+        job.stop_at_forced_write = may_restart;
+        // Output that cannot be taken back is held until no range can call for a sort any more.
+        job.seams_after_ranges = may_restart && gate.holding();
+        threaded = decimate_in_ranges(job, emit, [&](uint64_t done) { progress.update(done); });
+        if (threaded->stopped_at_forced_write) {
+            outcome.kind = SortOutcome::Kind::kSorted;
+            outcome.detected_at = threaded->forced_write_at;
+            outcome.attempt_seconds = seconds_since(attempt);
+        }
+    } else if (!sort_first) {
         decimator = make_decimator(options, decimator_count(in.count()));
         const auto attempt = std::chrono::steady_clock::now();
         const ChunkSource next = [&](io::TriangleChunk& chunk) {
@@ -463,7 +524,8 @@ void run_decimate(const DecimateOptions& opt) {
         }
     }
     if (sort_first || outcome.kind == SortOutcome::Kind::kSorted) {
-        if (decimator) {
+        threaded.reset();  // the sorted stream is decimated by one thread
+        if (decimator || outcome.kind == SortOutcome::Kind::kSorted) {
             // The attempt is dropped: its decimator, and its output (held back, or a
             // temporary file that a new one replaces).
             decimator.reset();
@@ -513,15 +575,20 @@ void run_decimate(const DecimateOptions& opt) {
         }
     }
     progress.phase("finishing", std::nullopt);
-    decimator->finish(emit);
+    if (decimator) decimator->finish(emit);
     gate.release();
     progress.done();
     out->finish();
     const double seconds = seconds_since(start);
 
     DecimateFacts facts;
-    facts.stats = decimator->stats();
-    facts.ratio = decimator->ratio();
+    facts.stats = threaded ? threaded->stats : decimator->stats();
+    facts.ratio = threaded ? threaded->ratio : decimator->ratio();
+    facts.threads = threaded ? ranges : 1;
+    if (threaded) {
+        facts.seam_buffer = seam_buffer(opt.buffer);
+        facts.seam_forced_writes = threaded->seams.forced_writes;
+    }
     facts.target_given = options.target.has_value();
     facts.buffer = opt.buffer;
     facts.default_buffer = opt.buffer == DecimateOptions{}.buffer;
@@ -530,10 +597,13 @@ void run_decimate(const DecimateOptions& opt) {
     facts.used_axis = used.sorted_axis;
     facts.weld_eps = options.weld_eps;
     facts.weld_text = opt.weld;
-    facts.skipped = sorted ? sorted->count.dropped : in.count().dropped;
+    facts.skipped = sorted ? sorted->count.dropped : threaded ? threaded->count.dropped : in.count().dropped;
     facts.input_name = input_name;
     facts.sort = outcome;
-    if (counted) facts.count_pass_seconds = counted->seconds;
+    if (counted) {
+        facts.count_pass_seconds = counted->seconds;
+        facts.count_pass_for_threads = counted->for_threads;
+    }
     if (!opt.json && !global().quiet) print_decimate_summary(facts, opt.output, seconds);
 
     Warnings warnings;
@@ -541,16 +611,25 @@ void run_decimate(const DecimateOptions& opt) {
         warnings.note("channels_dropped", dropped + " dropped: decimate keeps positions only");
     note_unused_write_flags(opt.write, *out->format, opt.output, warnings);
     for (const std::string& note : out->writer->notes()) warnings.note("output_note", note);
-    note_dropped_triangles(sorted ? sorted->dropped : dropped_triangles(in), "skipped", warnings);
-    note_input_changes(sorted ? sorted->end_header : in.header(), input_name, warnings);
+    note_dropped_triangles(sorted     ? sorted->dropped
+                           : threaded ? threaded->dropped
+                                      : dropped_triangles(in),
+                           "skipped", warnings);
+    note_input_changes(sorted     ? sorted->end_header
+                       : threaded ? threaded->end_header
+                                  : in.header(),
+                       input_name, warnings);
     note_decimate_warnings(facts, warnings);
+    if (!one_thread_why.empty())
+        warnings.note("threads_unavailable",
+                      "decimated by one thread: the ranges' outputs cannot be spooled (" + one_thread_why + ")");
     warnings.print();
 
     RunReport report;
     report.command = "decimate";
     report.inputs = {input_file};
     report.outputs = {{opt.output, std::string(out->format->name), opt.output != "-" && io::wants_gzip(opt.output)}};
-    report.triangles_in = sorted ? sorted->count.read : in.count().read;
+    report.triangles_in = sorted ? sorted->count.read : threaded ? threaded->count.read : in.count().read;
     report.triangles_out = facts.stats.triangles_out;
     report.seconds = seconds;
     report.peak_rss_bytes = peak_rss_bytes();
@@ -598,6 +677,14 @@ void add_decimate(CLI::App& app) {
     cmd->add_flag("--report", opt->report,
                   "measure the output's error against the input at the end\n"
                   "Hausdorff, mean and RMS distance, as compare does");
+    cmd->add_option("--threads", opt->threads,
+                    "decimate a file in N ranges at once (default: every core, " + std::to_string(every_core()) +
+                        " here)\n"
+                        "Each range of at least --buffer triangles is decimated with its own --buffer, and the seams "
+                        "between them are joined by one more pass; the output depends on N, not on timing. 1: one "
+                        "stream decimator")
+        ->type_name("N")
+        ->check(CLI::Range(1u, 1024u));
     add_json_flag(cmd, opt->json);
     add_write_flags(cmd, opt->write);
     add_read_flags(cmd, opt->read);

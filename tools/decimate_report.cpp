@@ -58,6 +58,12 @@ void note_decimate_warnings(const DecimateFacts& f, Warnings& warnings) {
                            "read later at those positions are not joined to them (the output has cracks there)"
                      : std::string()) +
                 forced_write_remedy(f, axis_conflict, order_command));
+    if (f.seam_forced_writes > 0)
+        warnings.note("seam_forced_writes",
+                      "the seam pass's buffer (" + std::to_string(f.seam_buffer) +
+                          " triangles) filled with triangles along seams it could not join yet: " +
+                          std::to_string(f.seam_forced_writes) +
+                          " triangles force-written at full resolution there; raise --buffer or lower --threads");
     if (s.sort_violations > 0)
         warnings.note(
             "not_sorted_as_stated",
@@ -135,11 +141,11 @@ void note_decimate_warnings(const DecimateFacts& f, Warnings& warnings) {
                                                    " in): the output is empty; give a larger --ratio or --target");
 }
 
-std::string count_pass_notice(uint64_t triangles, double seconds) {
-    char line[160];
-    std::snprintf(line, sizeof line,
-                  "counted %llu input triangles in a first pass for --target (the input states no count): %.2f s",
-                  (unsigned long long)triangles, seconds);
+std::string count_pass_notice(uint64_t triangles, double seconds, bool for_threads) {
+    char line[192];
+    std::snprintf(
+        line, sizeof line, "counted %llu input triangles in a first pass %s (the input states no count): %.2f s",
+        (unsigned long long)triangles, for_threads ? "to cut it into ranges for --threads" : "for --target", seconds);
     return line;
 }
 
@@ -178,6 +184,7 @@ nlohmann::ordered_json decimate_details_json(const DecimateFacts& f) {
         f.used_axis ? nlohmann::ordered_json(std::string(1, axis_name(*f.used_axis))) : nlohmann::ordered_json(nullptr);
     if (f.weld_eps > 0) j["weld"] = {{"size", f.weld_eps}, {"vertices_merged", s.vertices_merged}};
     if (f.count_pass_seconds) j["count_pass_seconds"] = *f.count_pass_seconds;
+    j["threads"] = f.threads;
     if (f.sort.kind == SortOutcome::Kind::kSorted)
         j["sorted_first"] = {{"axis", std::string(1, axis_name(f.sort.axis))},
                              {"requested", f.sort.requested},
@@ -191,7 +198,8 @@ void print_decimate_summary(const DecimateFacts& f, const std::string& output, d
     std::fprintf(stderr, "decimated %s -> %s\n", f.input_name.c_str(), output.c_str());
     if (const std::string notice = sort_notice(f.sort); !notice.empty()) std::fprintf(stderr, "  %s\n", notice.c_str());
     if (f.count_pass_seconds)
-        std::fprintf(stderr, "  %s\n", count_pass_notice(f.stats.triangles_in, *f.count_pass_seconds).c_str());
+        std::fprintf(stderr, "  %s\n",
+                     count_pass_notice(f.stats.triangles_in, *f.count_pass_seconds, f.count_pass_for_threads).c_str());
     std::fprintf(stderr, "  triangles in %llu, out %llu (target %llu, ratio %.6g)\n",
                  (unsigned long long)s.triangles_in, (unsigned long long)s.triangles_out,
                  (unsigned long long)s.target_triangles, f.ratio);
@@ -202,6 +210,10 @@ void print_decimate_summary(const DecimateFacts& f, const std::string& output, d
                  s.buffer_capacity, s.peak_buffer_triangles,
                  100.0 * double(s.peak_buffer_triangles) / double(s.buffer_capacity), (unsigned long long)s.collapses,
                  (unsigned long long)s.forced_writes);
+    if (f.threads > 1)
+        std::fprintf(stderr,
+                     "  threads %u: %u ranges decimated at once, seams joined by a pass through %zu triangles\n",
+                     f.threads, f.threads, f.seam_buffer);
     if (f.weld_eps > 0)
         std::fprintf(stderr, "  weld %.6g: %llu vertices merged\n", f.weld_eps, (unsigned long long)s.vertices_merged);
     if (f.used_axis)

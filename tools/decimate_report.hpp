@@ -45,8 +45,14 @@ struct DecimateFacts {
     uint64_t skipped = 0;           // input triangles the read loop dropped
     std::string input_name;
     SortOutcome sort;
-    // --target with an input that states no count: the first pass that counted it.
+    // --target or --threads with an input that states no count: the first pass that counted it.
     std::optional<double> count_pass_seconds;
+    bool count_pass_for_threads = false;  // made to cut the input into ranges (else for --target)
+    // --threads: the ranges decimated at once (1: one stream decimator), the seam pass's buffer
+    // and the triangles it force-wrote (kept apart from stats.forced_writes, the ranges').
+    unsigned threads = 1;
+    size_t seam_buffer = 0;
+    uint64_t seam_forced_writes = 0;
 };
 
 // The warnings about the decimation itself (not the read loop's or the writer's, which the
@@ -57,11 +63,12 @@ void note_decimate_warnings(const DecimateFacts& facts, Warnings& warnings);
 std::string sort_notice(const SortOutcome& sort);
 
 // The decimation's own figures for --json (run_report.hpp): target, ratio, buffer and its peak
-// fill, collapses, forced writes, the sweep axis, the weld and a sort done first.
+// fill, collapses, forced writes, the sweep axis, the weld, a sort done first and the threads.
 nlohmann::ordered_json decimate_details_json(const DecimateFacts& facts);
 
-// "counted N input triangles in a first pass for --target (...): 0.12 s".
-std::string count_pass_notice(uint64_t triangles, double seconds);
+// "counted N input triangles in a first pass for --target (...): 0.12 s" (or "to cut it into
+// ranges for --threads").
+std::string count_pass_notice(uint64_t triangles, double seconds, bool for_threads = false);
 
 // The summary lines on stderr after a run (triangles, time, buffer, weld, sweep, sort).
 void print_decimate_summary(const DecimateFacts& facts, const std::string& output, double seconds);

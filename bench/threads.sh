@@ -1,0 +1,141 @@
+#!/usr/bin/env bash
+# Parallel decimation benchmark: `meshstream decimate --threads 1` against `--threads 2` (and any
+# THREADS given) on the generated meshes, with meshoptimizer 1.2 (`bench/ref_meshopt`, whole mesh
+# in memory, exact weld, `simplifyWithUpdate` to the same count) in the same run. Prints per row
+# the median of RUNS runs of wall time, CPU time (user + system) and peak RSS, the speed-up over
+# one thread, and the symmetric RMS error against the input (meshstream compare, % of the bbox
+# diagonal) with its ratio to one thread's. The load average before and after the runs is printed
+# too: the machine may be shared, and wall times mean little when it is busy.
+#
+#   bench/threads.sh                        # 10 M generated mesh at 10 % and 1 %, 1 and 2 threads
+#   SIZES=1000000 RUNS=1 THREADS="1 2 4" bench/threads.sh
+#
+# Environment:
+#   BENCH_DIR  work dir for meshes and outputs (default /tmp/meshstream-bench)
+#   BUILD_DIR  build dir, configured here with -DMESHSTREAM_BUILD_BENCH=ON (default $BENCH_DIR/build)
+#   SIZES      generated mesh sizes in triangles (default 10000000)
+#   RATIOS     decimation ratios (default "0.1 0.01")
+#   THREADS    --threads values (default "1 2"; the first is the reference of the ratios)
+#   RUNS       runs per measurement, median reported (default 3)
+#   MESHOPT    0 to leave out meshoptimizer (default 1)
+#   DECIMATE_ARGS  extra options for `meshstream decimate`
+# Needs: cmake, g++, libmeshoptimizer-dev, GNU time (/usr/bin/time) and python3.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+src=$(pwd)
+
+BENCH_DIR=${BENCH_DIR:-/tmp/meshstream-bench}
+BUILD_DIR=${BUILD_DIR:-$BENCH_DIR/build}
+SIZES=${SIZES:-10000000}
+RATIOS=${RATIOS:-"0.1 0.01"}
+THREADS=${THREADS:-"1 2"}
+RUNS=${RUNS:-3}
+MESHOPT=${MESHOPT:-1}
+DECIMATE_ARGS=${DECIMATE_ARGS:-}
+
+die() { echo "bench/threads.sh: $*" >&2; exit 1; }
+[ -x /usr/bin/time ] || die "GNU time is missing: apt-get install time"
+command -v python3 >/dev/null || die "python3 is missing"
+mkdir -p "$BENCH_DIR"
+
+echo "== building in $BUILD_DIR" >&2
+cmake -S "$src" -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release -DMESHSTREAM_BUILD_BENCH=ON -DMESHSTREAM_BUILD_TESTS=OFF >/dev/null
+cmake --build "$BUILD_DIR" -j"$(nproc)" >/dev/null || die "build failed (run: cmake --build $BUILD_DIR)"
+ms=$BUILD_DIR/tools/meshstream
+gen=$BUILD_DIR/tools/meshstream-gen
+ref_meshopt=$BUILD_DIR/bench/ref_meshopt
+"$ms" decimate --help | grep -q -- --threads || die "'meshstream decimate' has no --threads in this build"
+if [ "$MESHOPT" = 1 ] && [ ! -x "$ref_meshopt" ]; then
+  echo "bench/threads.sh: no ref_meshopt (apt-get install libmeshoptimizer-dev): meshoptimizer rows skipped" >&2
+  MESHOPT=0
+fi
+
+results=$BENCH_DIR/threads.tsv
+: >"$results"
+load() { cut -d' ' -f1-3 /proc/loadavg; }
+load_before=$(load)
+
+# measure CMD...: runs CMD under GNU time; prints "wall_s<TAB>cpu_s<TAB>rss_kb"
+measure() {
+  local log=$BENCH_DIR/time.log
+  if ! /usr/bin/time -v -o "$log" "$@" >"$BENCH_DIR/cmd.out" 2>"$BENCH_DIR/cmd.err"; then
+    cat "$BENCH_DIR/cmd.err" >&2
+    die "failed: $*"
+  fi
+  python3 - "$log" <<'EOF'
+import re, sys
+text = open(sys.argv[1]).read()
+wall = re.search(r"Elapsed \(wall clock\) time .*: (\S+)", text).group(1).split(":")
+seconds = sum(float(x) * 60 ** i for i, x in enumerate(reversed(wall)))
+cpu = float(re.search(r"User time \(seconds\): (\S+)", text).group(1)) + \
+      float(re.search(r"System time \(seconds\): (\S+)", text).group(1))
+rss = int(re.search(r"Maximum resident set size \(kbytes\): (\d+)", text).group(1))
+print(f"{seconds}\t{cpu}\t{rss}")
+EOF
+}
+
+rms_of() {  # INPUT OUTPUT: prints the symmetric RMS error in % of the bbox diagonal
+  "$ms" -q compare --json "$1" "$2" >"$BENCH_DIR/compare.json" || die "compare failed: $1 $2"
+  python3 -c 'import json, sys; print("%.6f" % json.load(open(sys.argv[1]))["symmetric"]["rms_pct"])' "$BENCH_DIR/compare.json"
+}
+
+for n in $SIZES; do
+  in=$BENCH_DIR/gen_$n.stl
+  if [ ! -s "$in" ]; then
+    echo "== generating $in" >&2
+    "$gen" -q --triangles "$n" "$in"
+  fi
+  count=$("$ms" -q info --json "$in" | python3 -c 'import json,sys; print(json.load(sys.stdin)["triangles"])')
+  for ratio in $RATIOS; do
+    target=$(python3 -c "print(round($ratio * $count))")
+    tools=""
+    for t in $THREADS; do tools="$tools threads-$t"; done
+    if [ "$MESHOPT" = 1 ]; then tools="$tools meshopt"; fi
+    # Alternated run by run, so that a change in the machine's load reaches every tool alike.
+    for ((r = 0; r < RUNS; r++)); do
+      for tool in $tools; do
+        out=$BENCH_DIR/threads_${n}_${ratio}_$tool.stl
+        case $tool in
+          threads-*) m=$(measure "$ms" -q decimate $DECIMATE_ARGS --threads "${tool#threads-}" "$in" "$out" --ratio "$ratio") ;;
+          meshopt) m=$(measure "$ref_meshopt" "$in" "$out" --target "$target") ;;
+        esac
+        echo "== $tool $n ratio $ratio run $((r + 1)): $m" >&2
+        printf '%s\t%s\t%s\t%s\n' "$n" "$ratio" "$tool" "$m" >>"$BENCH_DIR/threads_runs.tsv.$$"
+      done
+    done
+    for tool in $tools; do
+      out=$BENCH_DIR/threads_${n}_${ratio}_$tool.stl
+      out_n=$("$ms" -q info --json "$out" | python3 -c 'import json,sys; print(json.load(sys.stdin)["triangles"])')
+      printf '%s\t%s\t%s\t%s\t%s\n' "$n" "$ratio" "$tool" "$out_n" "$(rms_of "$in" "$out")" >>"$results"
+    done
+  done
+done
+load_after=$(load)
+
+python3 - "$results" "$BENCH_DIR/threads_runs.tsv.$$" "$RUNS" "$load_before" "$load_after" <<'EOF'
+import statistics, sys
+results, runs_file, runs, before, after = sys.argv[1:]
+runs_rows = [l.rstrip("\n").split("\t") for l in open(runs_file) if l.strip()]
+med = {}
+for n, ratio, tool, wall, cpu, rss in runs_rows:
+    med.setdefault((n, ratio, tool), []).append((float(wall), float(cpu), float(rss)))
+rows = [l.rstrip("\n").split("\t") for l in open(results) if l.strip()]
+print(f"median of {runs} runs (alternated); load average (1/5/15 min) before: {before}, after: {after}")
+print("RMS = meshstream compare against the input (symmetric, % of bbox diagonal); x1 = ratio to --threads of the first row")
+head = ["triangles", "ratio", "tool", "out", "wall s", "CPU s", "peak RSS MB", "speed-up x1", "RMS %", "RMS x1"]
+table, ref = [], {}
+for n, ratio, tool, out, rms in rows:
+    m = med[(n, ratio, tool)]
+    wall, cpu, rss = (statistics.median(x[i] for x in m) for i in range(3))
+    if (n, ratio) not in ref: ref[(n, ratio)] = (wall, float(rms))
+    w1, r1 = ref[(n, ratio)]
+    table.append([n, ratio, tool, out, f"{wall:.2f}", f"{cpu:.2f}", f"{rss / 1024:.0f}", f"{w1 / wall:.2f}", rms,
+                  f"{float(rms) / r1:.3f}"])
+widths = [max(len(str(r[i])) for r in table + [head]) for i in range(len(head))]
+print(" | ".join(h.ljust(w) for h, w in zip(head, widths)))
+print("-|-".join("-" * w for w in widths))
+for r in table:
+    print(" | ".join(str(c).ljust(w) for c, w in zip(r, widths)))
+EOF
+rm -f "$BENCH_DIR/threads_runs.tsv.$$"
+echo "(raw rows: $results)" >&2
