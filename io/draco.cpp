@@ -130,18 +130,24 @@ class DracoWriter final : public Writer {
 
 public:
     DracoWriter(ByteSink& sink, const WriteOptions& options)
-        : sink_(sink), options_(options), indexer_(sink.name(), "Draco", options.channels, options.strict) {
+        : sink_(sink),
+          options_(options),
+          indexer_(sink.name(), "Draco", options.channels, options.strict),
+          budget_(sink.name(), options, kWhy) {
         check_draco_settings(sink.name(), options);
         budget_check_up_front(sink.name(), options, kWhy, draco_encode_estimate_bytes);
     }
 
     void write_chunk(const TriangleChunk& chunk) override {
+        if (budget_.counting()) return budget_.count(chunk.size());
         indexer_.add(chunk);
-        budget_check(sink_.name(), options_, kWhy, indexer_.input_triangle_count(),
-                     draco_encode_estimate_bytes(indexer_.vertex_count(), indexer_.triangle_count(), options_));
+        if (budget_.check(indexer_.input_triangle_count(),
+                          draco_encode_estimate_bytes(indexer_.vertex_count(), indexer_.triangle_count(), options_)))
+            indexer_ = MeshIndexer(sink_.name(), "Draco", options_.channels, options_.strict);  // frees the tables
     }
 
     void finish_output() override {
+        if (budget_.counting()) budget_.fail();
         IndexedMesh mesh = indexer_.take();
         if (options_.strict)
             if (const int64_t t = first_repeated_vertex(mesh.indices); t >= 0)
@@ -175,6 +181,7 @@ private:
     ByteSink& sink_;
     WriteOptions options_;
     MeshIndexer indexer_;
+    WholeMeshBudget budget_;
 };
 
 const char* kind_name(DracoAttribute::Kind kind) {
@@ -320,7 +327,7 @@ const Format kDracoFormat = {
     &probe_draco,
     &open_draco_reader,
     &open_draco_writer,
-    Format::kAlwaysDraco,
+    Format::kAlwaysDraco | Format::kWholeMesh,
     nullptr,
     &drc_keep_channels,
 };

@@ -215,6 +215,7 @@ struct Format {
     enum Trait : uint8_t {
         kAlwaysDraco = 2,     // Draco-compressed (reorders triangles; takes --draco-* and --normals)
         kDracoUnlessOff = 4,  // the same unless --compress meshopt|none (glTF; takes --compress)
+        kWholeMesh = 8,       // the writer holds the whole mesh until finish (WholeMeshBudget)
     };
     uint8_t traits = 0;
     // For formats without magic bytes: a weaker test, tried only when no probe and no

@@ -17,7 +17,7 @@ const Format kGlbFormat = {
     &probe_glb,
     &gltf_detail::open_gltf_reader,
     &gltf_detail::open_glb_writer,
-    Format::kDracoUnlessOff,
+    Format::kDracoUnlessOff | Format::kWholeMesh,
     nullptr,
     &gltf_detail::gltf_keep_channels,
 };
@@ -29,7 +29,7 @@ const Format kGltfFormat = {
     &probe_gltf_json,
     &gltf_detail::open_gltf_reader,
     &gltf_detail::open_gltf_writer,
-    Format::kDracoUnlessOff,
+    Format::kDracoUnlessOff | Format::kWholeMesh,
     nullptr,
     &gltf_detail::gltf_keep_channels,
     &gltf_detail::gltf_side_files,

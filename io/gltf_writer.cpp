@@ -476,7 +476,8 @@ public:
         : sink_(sink),
           options_(options),
           binary_(binary),
-          indexer_(sink.name(), "glTF", options.channels, options.strict) {
+          indexer_(sink.name(), "glTF", options.channels, options.strict),
+          budget_(sink.name(), options, kWhy) {
 #if !MESHSTREAM_WITH_DRACO
         if (options_.compression == WriteOptions::Compression::kDraco)
             options_.compression = WriteOptions::Compression::kNone;
@@ -497,6 +498,7 @@ public:
     }
 
     void write_chunk(const TriangleChunk& chunk) override {
+        if (budget_.counting()) return budget_.count(chunk.size());
         indexer_.add(chunk);
         const uint64_t v = indexer_.vertex_count(), f = indexer_.triangle_count();
         uint64_t need;
@@ -509,7 +511,8 @@ public:
             need = indexer_.memory_bytes() + v * (4 + 2 * uint64_t(CornerLayout(options_.channels).bytes())) + f * 12 +
                    out + (meshopt_ ? out + v * 16 + f * 12 : 0) + (inline_buffer_ ? 6 * out : 0);
         }
-        budget_check(sink_.name(), options_, kWhy, indexer_.input_triangle_count(), need);
+        if (budget_.check(indexer_.input_triangle_count(), need))
+            indexer_ = MeshIndexer(sink_.name(), "glTF", options_.channels, options_.strict);  // frees the tables
     }
 
     void finish_output() override;
@@ -535,6 +538,7 @@ private:
     bool draco_ = false, meshopt_ = false;
     bool inline_buffer_ = false;  // a .gltf on stdout: the buffer is a base64 data URI
     MeshIndexer indexer_;
+    WholeMeshBudget budget_;
     std::map<uint32_t, int> material_json_;  // material table index -> glTF material
 };
 
@@ -666,6 +670,7 @@ Json GltfWriter::draco_primitive(Document& doc, PartData& d, const Channels& ch,
 #endif
 
 void GltfWriter::finish_output() {
+    if (budget_.counting()) budget_.fail();
     IndexedMesh mesh = indexer_.take();
     notes_ = indexer_.notes();
     const std::vector<std::string> image_files =

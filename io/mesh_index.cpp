@@ -324,14 +324,37 @@ void budget_check_up_front(const std::string& file, const WriteOptions& options,
                           "M or more");
 }
 
-void budget_check(const std::string& file, const WriteOptions& options, const char* why, uint64_t triangles,
-                  uint64_t need) {
-    if (need <= options.memory_budget_bytes) return;
-    const std::string budget = binary_size(options.memory_budget_bytes), estimate = binary_size(need);
-    throw Error(file, std::string(why) + ": " + std::to_string(triangles) + " triangles so far need " +
-                          (estimate == budget ? "a little more than the memory budget of " + budget
-                                              : "about " + estimate + ", over the memory budget of " + budget) +
-                          "; raise --memory");
+WholeMeshBudget::WholeMeshBudget(std::string file, const WriteOptions& options, const char* why)
+    : file_(std::move(file)),
+      why_(why),
+      budget_(options.memory_budget_bytes),
+      total_(options.triangle_count ? options.triangle_count : options.expected_triangle_count) {}
+
+bool WholeMeshBudget::check(uint64_t triangles, uint64_t need) {
+    if (need <= budget_ || counting_) return false;
+    triangles_ = triangles;
+    need_ = need;
+    if (total_ && *total_ > triangles) refuse(*total_);
+    counting_ = true;
+    counted_ = triangles;
+    return true;
+}
+
+void WholeMeshBudget::fail() const { refuse(counted_); }
+
+void WholeMeshBudget::refuse(uint64_t total) const {
+    // The bytes held grow with the triangles (and with the vertices, which follow them).
+    const long double scaled =
+        (long double)need_ * (long double)std::max(total, triangles_) / (long double)std::max<uint64_t>(triangles_, 1);
+    const uint64_t all = scaled >= 1.8e19L ? UINT64_MAX : uint64_t(std::ceil(scaled));
+    const uint64_t mib = all / (uint64_t{1} << 20) + (all % (uint64_t{1} << 20) != 0 ? 1 : 0);
+    throw Error(file_, std::string(why_) + ": the " + std::to_string(total) + " triangles " +
+                           (counting_ ? "given" : "to be written") + " need about " + binary_size(all) +
+                           (total > triangles_
+                                ? " (the first " + std::to_string(triangles_) + " took " + binary_size(need_) + ")"
+                                : std::string()) +
+                           ", over the memory budget of " + binary_size(budget_) + "; give --memory " +
+                           std::to_string(mib) + "M or more");
 }
 
 }  // namespace meshstream::io

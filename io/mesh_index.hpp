@@ -68,16 +68,42 @@ struct IndexedMesh {
 // for the writers' --memory estimates.
 uint64_t indexed_mesh_bytes(uint64_t vertices, uint64_t triangles, const Channels& channels);
 
-// For the whole-mesh writers' --memory checks. `need(vertices, triangles)` is a writer's
-// estimate of the bytes it holds for a mesh of that size; `why` says why it holds the whole mesh
-// ("Draco encodes the whole mesh in memory"). Throws io::Error naming `file`:
-// - budget_check_up_front: when even the smallest mesh of `options`' expected (or promised)
-//   triangle count, a closed surface with half as many vertices, needs more than the budget;
-// - budget_check: when the `triangles` read so far need more (`need` bytes).
+// For the whole-mesh writers' --memory check before any triangle: `need(vertices, triangles)` is
+// a writer's estimate of the bytes it holds for a mesh of that size; `why` says why it holds the
+// whole mesh ("Draco encodes the whole mesh in memory"). Throws io::Error naming `file` when
+// even the smallest mesh of `options`' expected (or promised) triangle count, a closed surface
+// with half as many vertices, needs more than the budget, with the budget that would do.
 void budget_check_up_front(const std::string& file, const WriteOptions& options, const char* why,
                            uint64_t (*need)(uint64_t vertices, uint64_t triangles, const WriteOptions& options));
-void budget_check(const std::string& file, const WriteOptions& options, const char* why, uint64_t triangles,
-                  uint64_t need);
+
+// A whole-mesh writer's --memory budget while it takes triangles: check() after each chunk with
+// the triangles taken so far and the bytes held for them. Past the budget the error says how
+// much all the triangles need ("give --memory 1188M or more"), the bytes held scaled to their
+// count: at once when that count is known (`options`' promised or expected count, while more
+// are to come); otherwise check() returns true, the writer frees its tables and passes only
+// counts from then on (count()), and fail() at finish throws with the count then known. Memory
+// while counting: none.
+class WholeMeshBudget {
+public:
+    WholeMeshBudget(std::string file, const WriteOptions& options, const char* why);
+    // True when `need` bytes for `triangles` pass the budget and their total is not known: the
+    // caller stops holding triangles. Throws io::Error when the total is known.
+    bool check(uint64_t triangles, uint64_t need);
+    bool counting() const { return counting_; }
+    void count(uint64_t triangles) { counted_ += triangles; }
+    // Throws the error for all the triangles counted (call once the input ended).
+    [[noreturn]] void fail() const;
+
+private:
+    [[noreturn]] void refuse(uint64_t total) const;
+    std::string file_;
+    const char* why_;
+    uint64_t budget_;
+    std::optional<uint64_t> total_;  // the triangles to come, when known
+    bool counting_ = false;
+    uint64_t triangles_ = 0, need_ = 0;  // when the budget was passed
+    uint64_t counted_ = 0;               // all the triangles, while counting
+};
 
 class MeshIndexer {
 public:

@@ -8,11 +8,13 @@
 #include <sys/ioctl.h>
 #include <sys/stat.h>
 #include <unistd.h>
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <iterator>
 #include <limits>
 
 namespace meshstream::tools {
@@ -198,9 +200,37 @@ double physical_memory_bytes() {
     return pages > 0 && page_bytes > 0 ? double(pages) * double(page_bytes) : 0;
 }
 
+uint64_t whole_mesh_memory(std::string_view meminfo) {
+    size_t at = 0;
+    while (at < meminfo.size()) {
+        size_t end = meminfo.find('\n', at);
+        if (end == std::string_view::npos) end = meminfo.size();
+        std::string_view line = meminfo.substr(at, end - at);
+        at = end + 1;
+        if (!line.starts_with("MemAvailable:")) continue;
+        line.remove_prefix(13);
+        while (!line.empty() && line.front() == ' ') line.remove_prefix(1);
+        uint64_t kib = 0;
+        const auto [p, ec] = std::from_chars(line.data(), line.data() + line.size(), kib);
+        if (ec != std::errc() || std::string_view(p, line.data() + line.size()) != " kB") break;
+        const uint64_t half = kib > (UINT64_MAX >> 10) ? UINT64_MAX : (kib << 10) / 2;
+        return std::clamp(half, kStreamingMemory, kWholeMeshMemoryCeiling);
+    }
+    return kStreamingMemory;
+}
+
+uint64_t whole_mesh_memory() {
+    const char* path = std::getenv("MESHSTREAM_MEMINFO");
+    std::ifstream in(path != nullptr && *path != '\0' ? path : "/proc/meminfo");
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    return whole_mesh_memory(text);
+}
+
+uint64_t ReadFlags::budget() const { return memory.empty() ? kStreamingMemory : parse_bytes(memory); }
+
 io::ReadOptions ReadFlags::options() const {
     io::ReadOptions o;
-    o.memory_budget_bytes = parse_bytes(memory);
+    o.memory_budget_bytes = budget();
     // Tables and sort runs reserve their share of the budget up front (untouched pages cost
     // nothing), so a budget past the machine's memory failed as a bare "out of memory" even on
     // a tiny input.
@@ -265,9 +295,8 @@ void add_drop_flag(CLI::App* cmd, ReadFlags& flags) {
 void add_read_flags(CLI::App* cmd, ReadFlags& flags) {
     cmd->add_option("--memory", flags.memory,
                     "memory budget, e.g. 512M or 2G (default 256M)\n"
-                    "Bounds the tables of indexed formats (PLY, OBJ), sort runs and spills, and the whole-mesh "
-                    "writers (Draco, glTF); K, M, G, T are binary multiples. A budget above this machine's memory is "
-                    "refused")
+                    "Bounds the tables of indexed formats (PLY, OBJ), sort runs and spills; K, M, G, T are binary "
+                    "multiples. A budget above this machine's memory is refused")
         ->type_name("SIZE");
     cmd->add_option("--tmpdir", flags.tmpdir, "where temporary files go (default: $TMPDIR or /tmp)")
         ->type_name("DIR")
@@ -282,6 +311,15 @@ void add_read_flags(CLI::App* cmd, ReadFlags& flags) {
                   "Input a reader repairs (faces of fewer than 3 vertices), and what the output format cannot "
                   "hold (e.g. triangles Draco drops)")
         ->group(kMoreOptions);
+}
+
+void describe_memory_for_writing(CLI::App* cmd) {
+    cmd->get_option("--memory")
+        ->description(
+            "memory budget, e.g. 512M or 2G (default 256M; Draco, glTF: half the available)\n"
+            "Bounds the tables of indexed formats (PLY, OBJ), sort runs and spills (default 256M), and the mesh a "
+            "Draco or glTF writer holds (default: half of the memory available, MemAvailable in /proc/meminfo, from "
+            "256M to 64G); K, M, G, T are binary multiples. A budget above this machine's memory is refused");
 }
 
 void strict_refuses_dropped_triangles(CLI::App* cmd) {
@@ -301,9 +339,11 @@ void strict_reports_bad_triangles(CLI::App* cmd) {
             "face of fewer than 3 vertices) an error; without it they are counted as they are");
 }
 
-io::WriteOptions WriteFlags::options(const ReadFlags& read) const {
+io::WriteOptions WriteFlags::options(const ReadFlags& read, const io::Format& output) const {
     io::WriteOptions o;
-    o.memory_budget_bytes = parse_bytes(read.memory);
+    o.memory_budget_bytes = !read.memory.empty()                       ? read.options().memory_budget_bytes
+                            : (output.traits & io::Format::kWholeMesh) ? whole_mesh_memory()
+                                                                       : kStreamingMemory;
     o.tmpdir = read.tmpdir;
     o.strict = read.strict;
     o.compression = compression();

@@ -14,6 +14,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace meshstream::tools {
@@ -30,14 +31,18 @@ uint64_t parse_bytes(const std::string& text);
 
 // Options every command that reads a mesh accepts.
 struct ReadFlags {
-    std::string from;  // --from: force the input format
-    std::string memory = "256M";
+    std::string from;    // --from: force the input format
+    std::string memory;  // --memory as given; empty: the default (kStreamingMemory, WholeMeshMemory)
     std::string tmpdir;
     bool strict = false;
     std::string drop;  // --drop (convert, sort): channel kinds not read
     io::ReadOptions options() const;
+    // --memory's bytes, or kStreamingMemory when it is not given.
+    uint64_t budget() const;
 };
 void add_read_flags(CLI::App* cmd, ReadFlags& flags);
+// For commands that write a mesh: --memory's help adds the whole-mesh writers' default.
+void describe_memory_for_writing(CLI::App* cmd);
 // --drop's list, "normals,colors,uvs,extra,materials" (any of them, comma separated): the
 // channel kinds to read, all but those named. Throws CLI::ValidationError naming an unknown
 // name.
@@ -61,7 +66,10 @@ struct WriteFlags {
     int draco_qp = 14, draco_qn = 10, draco_qt = 12, draco_qc = 10, draco_cl = 7;
     // The glTF compression asked for: --compress, --no-draco, else Draco.
     io::WriteOptions::Compression compression() const;
-    io::WriteOptions options(const ReadFlags& read) const;
+    // With --memory's budget, or, when it is not given, the default for `output`: the
+    // whole-mesh one for a writer that holds the whole mesh (Format::kWholeMesh), else
+    // kStreamingMemory.
+    io::WriteOptions options(const ReadFlags& read, const io::Format& output) const;
 };
 // `with_memory`: false when add_read_flags already added --memory/--tmpdir to `cmd`.
 void add_write_flags(CLI::App* cmd, WriteFlags& flags);
@@ -92,6 +100,18 @@ void refuse_output_over_inputs(const std::string& output, const io::Format& form
 InputFiles input_files(const std::string& path, const io::MeshHeader& header);
 // This machine's memory (0 when the system does not say).
 double physical_memory_bytes();
+
+// --memory's default for streaming work: the tables of indexed formats, sort runs, spills.
+inline constexpr uint64_t kStreamingMemory = uint64_t{256} << 20;
+// --memory's default for the writers that hold the whole mesh (Draco, glTF): half of the memory
+// available (the MemAvailable line of `meminfo`, the text of /proc/meminfo), at least
+// kStreamingMemory and at most kWholeMeshMemoryCeiling; kStreamingMemory when the text has no
+// such line.
+inline constexpr uint64_t kWholeMeshMemoryCeiling = uint64_t{64} << 30;
+uint64_t whole_mesh_memory(std::string_view meminfo);
+// The same for this machine, from /proc/meminfo, or from the file that the environment variable
+// MESHSTREAM_MEMINFO names (for tests).
+uint64_t whole_mesh_memory();
 class Warnings;
 // Notes Draco/glTF options given for an output of another format, and --gzip-level for an
 // output not named *.gz (they do nothing there).

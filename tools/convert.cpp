@@ -28,13 +28,14 @@ void run_convert(const ConvertOptions& opt) {
     const io::Format& out_format = resolve_output_format(opt.output, opt.write);
     io::TriangleInput in = open_triangle_input(opt.input, opt.read, Command::kConvert, opt.clean);
     const io::MeshHeader& header = in.header();
-    io::WriteOptions wo = opt.write.options(opt.read);
+    io::WriteOptions wo = opt.write.options(opt.read, out_format);
     // Every triangle is kept unless --clean: the input's count is then the output's, promised
     // to the writer (binary STL and PLY put it first and need not patch or spool). With
     // --clean it is an upper bound: a writer that puts a count first patches it (files) or
     // spools the body until it knows (stdout, gzip).
     if (!opt.clean) wo.triangle_count = header.triangle_count;
-    wo.expected_triangle_count = header.triangle_count;
+    // PLY states its faces, each at least one triangle.
+    wo.expected_triangle_count = header.triangle_count ? header.triangle_count : header.triangle_estimate;
     wo.sorted_axis = header.sorted_axis;
     // --drop's channels are not read: their loss is asked for, so it goes unsaid.
     const io::Channels wanted = opt.read.options().channels.of(header.channels);
@@ -93,6 +94,7 @@ void add_convert(CLI::App& app) {
     add_drop_flag(cmd, opt->read);
     add_json_flag(cmd, opt->json);
     add_read_flags(cmd, opt->read);
+    describe_memory_for_writing(cmd);
     cmd->footer(
         "  meshstream convert scan.ply scan.glb --compress meshopt\n"
         "  meshstream convert scan.stl - --to ply | gzip > scan.ply.gz");

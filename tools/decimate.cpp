@@ -436,11 +436,13 @@ void run_decimate(const DecimateOptions& opt) {
         }
     }
 
-    io::WriteOptions wo = opt.write.options(opt.read);
-    // The output count, for whole-mesh writers to refuse a --memory too small before the work.
-    if (input_count)
+    io::WriteOptions wo = opt.write.options(opt.read, out_format);
+    // The output count, for whole-mesh writers to refuse a --memory too small before the work
+    // (and to say how much the output needs when it passes the budget): from the header's
+    // count, a PLY's faces (each at least one triangle) or the count of the first pass.
+    if (const std::optional<uint64_t> in_count = cut_count)
         wo.expected_triangle_count =
-            options.target ? *options.target : decimate::StreamDecimator::expected_output(options.ratio, *input_count);
+            options.target ? *options.target : decimate::StreamDecimator::expected_output(options.ratio, *in_count);
     // No output count is promised to the writer: the decimator lands on round(p·N_in) except
     // when the in-core rest is closed and one triangle too many is left (collapses remove two
     // faces; it then ends one over, with a warning), and skipped input triangles change N_in.
@@ -688,6 +690,7 @@ void add_decimate(CLI::App& app) {
     add_json_flag(cmd, opt->json);
     add_write_flags(cmd, opt->write);
     add_read_flags(cmd, opt->read);
+    describe_memory_for_writing(cmd);
     cmd->get_option("--tmpdir")->group("Options");
     strict_refuses_dropped_triangles(cmd);
     cmd->add_option("--seed", opt->seed, "random seed (default 1): same input, options and seed, same output")

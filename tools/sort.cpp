@@ -197,7 +197,8 @@ void run_sort(const SortOptions& opt) {
     const io::MeshHeader header = in.header();
     const std::string input_name = in.name();  // the reader is released before the merge
     const RunFile input_file{opt.input, std::string(in.format().name), in.source().gzip()};
-    refuse_output_over_inputs(opt.output, out_format, opt.write.options(opt.read), {input_files(opt.input, header)});
+    refuse_output_over_inputs(opt.output, out_format, opt.write.options(opt.read, out_format),
+                              {input_files(opt.input, header)});
     const int axis = opt.axis == "auto"
                          ? longest_axis(input_bounds(opt.input, opt.read.from, ro))
                          : static_cast<int>(std::find(std::begin(kAxisNames), std::end(kAxisNames), opt.axis) -
@@ -208,7 +209,7 @@ void run_sort(const SortOptions& opt) {
     // Only the channels the output keeps are carried through the runs.
     // --drop's channels are not read: their loss is asked for, so it goes unsaid.
     const io::Channels wanted = ro.channels.of(header.channels);
-    so.channels = io::writable_channels(out_format, wanted, opt.write.options(opt.read));
+    so.channels = io::writable_channels(out_format, wanted, opt.write.options(opt.read, out_format));
     const std::string dropped = io::describe_missing(wanted, so.channels);
     const size_t record_bytes = sort::ExternalSorter::record_bytes_for(so.channels);
     // The pipe's chunks are part of the sorter's share: each at most 1/64 of the budget.
@@ -221,8 +222,9 @@ void run_sort(const SortOptions& opt) {
         uint64_t least = pipe_bytes * 4 / 3;
         while (least - least / 4 <= pipe_bytes) ++least;
         const uint64_t least_kib = (least + 1023) / 1024;
-        throw UsageError(input_name + ": --memory " + opt.read.memory + " is too small to sort: give at least " +
-                         std::to_string(least_kib) + "K");
+        throw UsageError(input_name + ": --memory " +
+                         (opt.read.memory.empty() ? std::string("256M") : opt.read.memory) +
+                         " is too small to sort: give at least " + std::to_string(least_kib) + "K");
     }
     so.memory_budget_bytes = budget - budget / 4 - pipe_bytes;
 
@@ -272,8 +274,9 @@ void run_sort(const SortOptions& opt) {
     const double sort_seconds = seconds_since(t0) - input_seconds;
     const uint64_t total = sorter.triangle_count();
 
-    io::WriteOptions wo = opt.write.options(opt.read);
-    wo.memory_budget_bytes = budget / 4;
+    io::WriteOptions wo = opt.write.options(opt.read, out_format);
+    // A glTF writer holds the whole mesh: without --memory it gets the whole-mesh default.
+    if (!opt.read.memory.empty() || !(out_format.traits & io::Format::kWholeMesh)) wo.memory_budget_bytes = budget / 4;
     wo.tmpdir = tmpdir;
     wo.triangle_count = total;
     wo.sorted_axis = axis;
@@ -362,7 +365,8 @@ void add_sort(CLI::App& app) {
     cmd->get_option("--memory")
         ->description(
             "memory for runs and merge buffers, e.g. 64M, 1G (default 256M)\n"
-            "A quarter goes to the reader's and writer's own tables; K, M, G, T are binary multiples");
+            "A quarter goes to the reader's and writer's own tables (a glTF writer without --memory gets "
+            "half of the memory available, from 256M to 64G); K, M, G, T are binary multiples");
     cmd->get_option("--tmpdir")
         ->group("Options")
         ->description(

@@ -188,7 +188,7 @@ TEST(DracoWriter, RefusesPastMemoryBudgetAndLeavesNoFile) {
         FAIL() << "no memory error";
     } catch (const io::Error& e) {
         EXPECT_EQ(e.file(), dir / "b.drc");
-        EXPECT_NE(std::string(e.what()).find("over the memory budget of 1 MiB; raise --memory"), std::string::npos)
+        EXPECT_NE(std::string(e.what()).find("over the memory budget of 1 MiB; give --memory "), std::string::npos)
             << e.what();
     }
     EXPECT_TRUE(fs::is_empty(dir.path()));

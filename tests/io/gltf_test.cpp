@@ -925,7 +925,7 @@ TEST(GltfWriter, RefusesPastMemoryBudget) {
             write_soup(bunny, dir / "b.glb", o);
             ADD_FAILURE() << "no memory error";
         } catch (const io::Error& e) {
-            EXPECT_NE(std::string(e.what()).find("raise --memory"), std::string::npos) << e.what();
+            EXPECT_NE(std::string(e.what()).find("; give --memory "), std::string::npos) << e.what();
         }
     }
     EXPECT_TRUE(fs::is_empty(dir.path()));

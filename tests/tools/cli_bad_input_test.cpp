@@ -465,12 +465,12 @@ TEST(CliBadInput, DracoBitCountsWhoseTablesPassTheBudgetAreRefusedUpFront) {
     write_file(dir / "in.stl", binary_stl(grid(4)));
     for (const char* out : {"out.drc", "out.glb"}) {
         for (const auto& [flags, message] : std::vector<std::pair<std::string, std::string>>{
-                 {"--draco-qp 28",
+                 {"--draco-qp 28 --memory 256M",
                   "Draco's coding tables for --draco-qp 28 at --draco-cl 7 take about 1 GiB (they "
                   "double with each bit), over the memory budget of 256 MiB: give fewer bits (float "
                   "positions hold 24) or --memory 1025M or more"},
                  {"--draco-qp 24 --draco-cl 10 --memory 150M", "take about 192 MiB"},
-                 {"--normals --draco-qn 27",
+                 {"--normals --draco-qn 27 --memory 256M",
                   "Draco's coding tables for --draco-qp 14 and --draco-qn 27 at --draco-cl 7"},
              }) {
             CliRun r = run("convert " + flags + " " + dir / "in.stl" + " " + dir / out);

@@ -44,5 +44,35 @@ TEST(DropList, SetsTheReadOptionsChannels) {
     EXPECT_FALSE(read.color.has_value());
 }
 
+// --memory's default for Draco and glTF output: half of MemAvailable, from 256 MiB to 64 GiB.
+TEST(WholeMeshMemory, IsHalfTheAvailableMemoryWithinAFloorAndACeiling) {
+    const uint64_t mib = uint64_t{1} << 20;
+    EXPECT_EQ(whole_mesh_memory("MemTotal:       32768000 kB\nMemFree:         1000000 kB\n"
+                                "MemAvailable:    8388608 kB\nBuffers:           12 kB\n"),
+              4096 * mib);
+    EXPECT_EQ(whole_mesh_memory("MemAvailable: 2000000 kB"), 2000000 * uint64_t{1024} / 2);
+    EXPECT_EQ(whole_mesh_memory("MemAvailable:     262144 kB\n"), 256 * mib);    // 128 MiB: the floor
+    EXPECT_EQ(whole_mesh_memory("MemAvailable:  268435456 kB\n"), 65536 * mib);  // 128 GiB: the ceiling
+    // Without a MemAvailable line (kernels before 3.14), or one not understood: the floor.
+    EXPECT_EQ(whole_mesh_memory("MemTotal:       32768000 kB\nMemFree:        16000000 kB\n"), 256 * mib);
+    EXPECT_EQ(whole_mesh_memory("MemAvailable:    lots kB\n"), 256 * mib);
+    EXPECT_EQ(whole_mesh_memory(""), 256 * mib);
+}
+
+// An explicit --memory is the writer's budget whatever the output; without it only a writer
+// that holds the whole mesh gets the larger default.
+TEST(WholeMeshMemory, AppliesToWholeMeshWritersWithoutMemoryOnly) {
+    ReadFlags read;
+    WriteFlags write;
+    const io::Format& glb = *io::find_format("glb");
+    const io::Format& stl = *io::find_format("stl");
+    EXPECT_EQ(write.options(read, glb).memory_budget_bytes, whole_mesh_memory());
+    EXPECT_EQ(write.options(read, stl).memory_budget_bytes, kStreamingMemory);
+    EXPECT_EQ(read.options().memory_budget_bytes, kStreamingMemory);
+    read.memory = "64M";
+    EXPECT_EQ(write.options(read, glb).memory_budget_bytes, uint64_t{64} << 20);
+    EXPECT_EQ(write.options(read, stl).memory_budget_bytes, uint64_t{64} << 20);
+}
+
 }  // namespace
 }  // namespace meshstream::tools
