@@ -276,7 +276,9 @@ void StreamDecimator::make_room(const Emit& out) {
     follow_dropped();
     if (options_.sorted_axis) sweep();
     const RoomPlan plan = plan_full_buffer(buffer_.face_capacity(), budget());
-    rate_pending(buffer_, queue_);
+    // The seam pass has nothing to decimate where the ranges' output is at the ratio already: its
+    // edges are rated only when a collapse is due (each vertex stays listed until then).
+    if (options_.part != Part::kSeams || buffer_.face_count() > plan.decimate_to) rate_pending(buffer_, queue_);
     if (options_.part == Part::kWhole) {
         while (buffer_.face_count() > plan.decimate_to && collapse_cheapest(buffer_, queue_)) ++stats_.collapses;
     } else {
