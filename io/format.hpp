@@ -172,6 +172,9 @@ struct ReadOptions {
 
 struct WriteOptions {
     uint64_t memory_budget_bytes = uint64_t{256} << 20;  // for writers that weld or spool
+    // The budget is --memory divided by this (sort gives its writer a quarter): the --memory a
+    // budget error asks for is the bytes needed times this.
+    uint32_t memory_budget_divisor = 1;
     std::string tmpdir;
     std::optional<uint64_t> triangle_count;  // total to be written, when known up front
     // About how many triangles will be written, when known before any are (an input header's

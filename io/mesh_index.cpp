@@ -308,6 +308,21 @@ IndexedMesh MeshIndexer::take() {
     return out;
 }
 
+namespace {
+
+// The budget, and the share of --memory it is when it is not all of it.
+std::string budget_text(uint64_t budget, uint32_t divisor) {
+    return binary_size(budget) + (divisor > 1 ? " (1/" + std::to_string(divisor) + " of --memory)" : std::string());
+}
+
+// The --memory, in whole MiB, that gives a writer `bytes`.
+std::string memory_option_mib(uint64_t bytes, uint32_t divisor) {
+    const long double all = (long double)bytes * (long double)std::max<uint32_t>(divisor, 1);
+    return std::to_string(uint64_t(std::ceil(all / (long double)(uint64_t{1} << 20))));
+}
+
+}  // namespace
+
 void budget_check_up_front(const std::string& file, const WriteOptions& options, const char* why,
                            uint64_t (*need)(uint64_t vertices, uint64_t triangles, const WriteOptions& options)) {
     const std::optional<uint64_t> n = options.triangle_count ? options.triangle_count : options.expected_triangle_count;
@@ -317,17 +332,17 @@ void budget_check_up_front(const std::string& file, const WriteOptions& options,
     const uint64_t counted = std::min(*n, uint64_t{1} << 40);
     const uint64_t least = need(counted / 2, counted, options);
     if (least <= options.memory_budget_bytes) return;
-    const uint64_t mib = (least + (uint64_t{1} << 20) - 1) >> 20;
     throw Error(file, std::string(why) + ": the " + std::to_string(*n) + " triangles to be written need at least " +
                           binary_size(least) + ", over the memory budget of " +
-                          binary_size(options.memory_budget_bytes) + "; give --memory " + std::to_string(mib) +
-                          "M or more");
+                          budget_text(options.memory_budget_bytes, options.memory_budget_divisor) + "; give --memory " +
+                          memory_option_mib(least, options.memory_budget_divisor) + "M or more");
 }
 
 WholeMeshBudget::WholeMeshBudget(std::string file, const WriteOptions& options, const char* why)
     : file_(std::move(file)),
       why_(why),
       budget_(options.memory_budget_bytes),
+      divisor_(options.memory_budget_divisor),
       total_(options.triangle_count ? options.triangle_count : options.expected_triangle_count) {}
 
 bool WholeMeshBudget::check(uint64_t triangles, uint64_t need) {
@@ -347,14 +362,13 @@ void WholeMeshBudget::refuse(uint64_t total) const {
     const long double scaled =
         (long double)need_ * (long double)std::max(total, triangles_) / (long double)std::max<uint64_t>(triangles_, 1);
     const uint64_t all = scaled >= 1.8e19L ? UINT64_MAX : uint64_t(std::ceil(scaled));
-    const uint64_t mib = all / (uint64_t{1} << 20) + (all % (uint64_t{1} << 20) != 0 ? 1 : 0);
     throw Error(file_, std::string(why_) + ": the " + std::to_string(total) + " triangles " +
                            (counting_ ? "given" : "to be written") + " need about " + binary_size(all) +
                            (total > triangles_
                                 ? " (the first " + std::to_string(triangles_) + " took " + binary_size(need_) + ")"
                                 : std::string()) +
-                           ", over the memory budget of " + binary_size(budget_) + "; give --memory " +
-                           std::to_string(mib) + "M or more");
+                           ", over the memory budget of " + budget_text(budget_, divisor_) + "; give --memory " +
+                           memory_option_mib(all, divisor_) + "M or more");
 }
 
 }  // namespace meshstream::io

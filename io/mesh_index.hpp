@@ -99,6 +99,7 @@ private:
     std::string file_;
     const char* why_;
     uint64_t budget_;
+    uint32_t divisor_;               // WriteOptions::memory_budget_divisor
     std::optional<uint64_t> total_;  // the triangles to come, when known
     bool counting_ = false;
     uint64_t triangles_ = 0, need_ = 0;  // when the budget was passed

@@ -276,7 +276,10 @@ void run_sort(const SortOptions& opt) {
 
     io::WriteOptions wo = opt.write.options(opt.read, out_format);
     // A glTF writer holds the whole mesh: without --memory it gets the whole-mesh default.
-    if (!opt.read.memory.empty() || !(out_format.traits & io::Format::kWholeMesh)) wo.memory_budget_bytes = budget / 4;
+    if (!opt.read.memory.empty() || !(out_format.traits & io::Format::kWholeMesh)) {
+        wo.memory_budget_bytes = budget / 4;
+        wo.memory_budget_divisor = 4;
+    }
     wo.tmpdir = tmpdir;
     wo.triangle_count = total;
     wo.sorted_axis = axis;

@@ -1,7 +1,8 @@
 // --memory for the outputs that hold the whole mesh (Draco, glTF), through the `meshstream`
 // binary: past the budget the error says how much would do ("give --memory NM or more") for
 // every input, STL and PLY (whose faces stand in for its count) up front, and an input of no
-// stated count once it is counted; the figure given does; without --memory the budget is half
+// stated count once it is counted; the figure given does (for sort too, whose writer gets a
+// quarter of --memory); without --memory the budget is half
 // of the memory available (MESHSTREAM_MEMINFO stands in for /proc/meminfo), and --memory wins.
 #include "cli_util.hpp"
 
@@ -161,6 +162,22 @@ TEST(CliMemory, TheWholeMeshDefaultIsHalfTheAvailableMemoryAndMemoryWins) {
     EXPECT_EQ(floor.code, 1) << floor.err;
     EXPECT_NE(floor.err.find("over the memory budget of 256 MiB"), std::string::npos) << floor.err;
     EXPECT_EQ(listing(dir.path()), (std::vector<std::string>{"huge.ply", "meminfo"}));
+}
+
+// sort gives its writer a quarter of --memory: the figure is for --memory, and it does.
+TEST(CliMemory, SortsFigureIsForTheMemoryItsWriterGetsAQuarterOf) {
+    TempDir dir;
+    spit(dir / "in.stl", binary_stl(grid(100)));  // 20000 triangles
+    CliRun r = run("sort --axis x --memory 1M --compress none " + dir / "in.stl" + " " + dir / "out.glb");
+    EXPECT_EQ(r.code, 1) << r.err;
+    EXPECT_NE(r.err.find("the 20000 triangles to be written need at least "), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("over the memory budget of 256 KiB (1/4 of --memory); give --memory "), std::string::npos)
+        << r.err;
+    const uint64_t mib = figure(r.err);
+    EXPECT_GE(mib, 4u) << r.err;
+    CliRun again = run("sort -q --axis x --memory " + std::to_string(mib) + "M --compress none " + dir / "in.stl" +
+                       " " + dir / "out.glb");
+    EXPECT_EQ(again.code, 0) << again.err;
 }
 
 }  // namespace
