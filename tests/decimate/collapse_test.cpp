@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <set>
 
 using namespace meshstream::decimate;
@@ -425,4 +426,93 @@ TEST(Collapse, BestOfAllTakesTheCheapestValidCollapse) {
         brute.position(v, b);
         EXPECT_EQ(std::vector<double>(a, a + 3), std::vector<double>(b, b + 3)) << v;
     }
+}
+
+// One test per veto of collapse_valid, each called directly on a case that trips it and one
+// that does not.
+
+TEST(CollapseVeto, SharesApexFindsTwoFacesBackToBack) {
+    HalfEdgeBuffer pillow(64, 0);
+    add_indexed(pillow, {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {{0, 1, 2}, {1, 0, 2}});
+    ASSERT_EQ(pillow.face_count(), 2u);
+    for (const uint32_t h : live_half_edges(pillow)) EXPECT_TRUE(shares_apex(pillow, h));
+    HalfEdgeBuffer octahedron(64, 0);
+    add_indexed(octahedron, octahedron_points(), octahedron_faces());
+    for (const uint32_t h : live_half_edges(octahedron)) EXPECT_FALSE(shares_apex(octahedron, h));
+}
+
+TEST(CollapseVeto, CollapsesTetrahedronOnlyForAVertexOfThreeFacesClosingOne) {
+    HalfEdgeBuffer tetrahedron(64, 0);
+    add_indexed(tetrahedron, {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}},
+                {{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {0, 3, 2}});
+    const std::vector<uint32_t> edges = live_half_edges(tetrahedron);
+    ASSERT_EQ(edges.size(), 12u);
+    for (const uint32_t h : edges) EXPECT_TRUE(collapses_tetrahedron(tetrahedron, h));
+    // The octahedron's vertices are in four faces each: nothing to close.
+    HalfEdgeBuffer octahedron(64, 0);
+    add_indexed(octahedron, octahedron_points(), octahedron_faces());
+    for (const uint32_t h : live_half_edges(octahedron)) EXPECT_FALSE(collapses_tetrahedron(octahedron, h));
+}
+
+// A closed cone over a 40-gon whose base is a fan from ring vertex 0: the apex is in 40 faces
+// (more than the link test's small-fan limit, so collapses into it take the hub path), and ring
+// vertex 0 is a neighbour of every ring vertex, so many collapses pinch. pinches_link must agree
+// with the brute-force link condition on every half-edge, hub or not.
+TEST(CollapseVeto, PinchesLinkAgreesWithTheLinkConditionOnHubsAndSmallFans) {
+    constexpr int n = 40;
+    static_assert(n > kMaxMovedFaces);
+    std::vector<std::array<float, 3>> points;
+    for (int i = 0; i < n; ++i) {
+        const double a = 2 * 3.141592653589793 * i / n;
+        points.push_back({float(std::cos(a)), float(std::sin(a)), 0});
+    }
+    points.push_back({0, 0, 1});
+    std::vector<std::array<int, 3>> faces;
+    for (int i = 0; i < n; ++i) faces.push_back({i, (i + 1) % n, n});
+    for (int i = 1; i + 1 < n; ++i) faces.push_back({0, i + 1, i});
+    HalfEdgeBuffer buffer(256, 0);
+    add_indexed(buffer, points, faces);
+    ASSERT_EQ(buffer.face_count(), size_t{2 * n - 2});
+    int pinched = 0, clear = 0, hub_pinched = 0, hub_clear = 0;
+    for (const uint32_t h : live_half_edges(buffer)) {
+        const uint32_t p = buffer.corner_vertex(h), q = buffer.corner_vertex(next_in_face(h));
+        if (shares_apex(buffer, h) || collapses_tetrahedron(buffer, h)) continue;
+        const std::set<uint32_t> np = neighbours(buffer, p), nq = neighbours(buffer, q);
+        size_t common = 0;
+        for (const uint32_t x : np) common += nq.count(x);
+        const bool pinch = common > 2;
+        EXPECT_EQ(pinches_link(buffer, h), pinch) << "half-edge " << p << "->" << q;
+        const bool hub = buffer.vertex(q).face_count > 32;
+        (pinch ? (hub ? hub_pinched : pinched) : (hub ? hub_clear : clear))++;
+    }
+    // Both outcomes seen on both paths.
+    EXPECT_GT(pinched, 0);
+    EXPECT_GT(clear, 0);
+    EXPECT_GT(hub_pinched, 0);
+    EXPECT_GT(hub_clear, 0);
+}
+
+TEST(CollapseVeto, MayDoubleWrittenEdgeOnlyIntoAWrittenVertexWithAnotherWrittenNeighbour) {
+    HalfEdgeBuffer buffer(64, 0);
+    add_grid(buffer);
+    const uint32_t centre = vertex_at(buffer, {2, 2, 0});
+    const uint32_t west = vertex_at(buffer, {1, 2, 0.1f}), east = vertex_at(buffer, {3, 2, 0.1f});
+    const uint32_t h = half_edge(buffer, centre, west);
+    // Nothing written: no veto.
+    EXPECT_FALSE(may_double_written_edge(buffer, h));
+    // A written neighbour of p, but q is not written: the new edge is in core, no veto.
+    buffer.freeze(east, 0);
+    EXPECT_FALSE(may_double_written_edge(buffer, h));
+    // q written and p's other neighbour written: west–east may already be in the output.
+    buffer.freeze(west, 1);
+    EXPECT_TRUE(may_double_written_edge(buffer, h));
+    // The written neighbours r and s of the edge itself do not count.
+    HalfEdgeBuffer other(64, 0);
+    add_grid(other);
+    const uint32_t c = vertex_at(other, {2, 2, 0}), w = vertex_at(other, {1, 2, 0.1f});
+    const uint32_t g = half_edge(other, c, w);
+    const uint32_t r = other.corner_vertex(prev_in_face(g));  // the third vertex of g's face
+    other.freeze(w, 2);
+    other.freeze(r, 3);
+    EXPECT_FALSE(may_double_written_edge(other, g));
 }
