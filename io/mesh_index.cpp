@@ -263,7 +263,7 @@ void MeshIndexer::add(const TriangleChunk& chunk) {
         }
         if (mesh_.indices.size() + 3 > kMaxIndexCount)
             throw Error(file_name_, "more than 2^32 - 1 indices (" + std::to_string(input_triangles_ + 1) +
-                                        " triangles): glTF and Draco use 32-bit indices; split the mesh");
+                                        " triangles): " + format_ + " uses 32-bit indices; split the mesh");
         uint32_t v[3];
         for (int k = 0; k < 3; ++k) {
             if (layout_.bytes()) {

@@ -108,8 +108,8 @@ private:
 
 class MeshIndexer {
 public:
-    // `file_name` names the output in error messages, `format` the format in them ("Draco",
-    // "glTF"). `channels`: those of the chunks to come (vertex ids are decided by the first
+    // `file_name` names the file in error messages, `format` what holds the mesh in them
+    // ("Draco", "glTF", "an indexed mesh"). `channels`: those of the chunks to come (vertex ids are decided by the first
     // non-empty chunk); the record of each vertex keeps the per-corner ones, `materials()` the
     // per-triangle material. `strict`: a non-finite coordinate is an error instead of a drop.
     MeshIndexer(std::string file_name, std::string format, const Channels& channels, bool strict);

@@ -8,6 +8,7 @@
 #include <meshstream/io/error.hpp>
 #include <meshstream/io/format.hpp>
 #include <meshstream/io/mesh_index.hpp>
+#include <meshstream/io/read_indexed.hpp>
 #include <meshstream/io/triangle_input.hpp>
 #include <meshstream/sort/external_sort.hpp>
 
