@@ -4,6 +4,7 @@
 
 #include "io/byte_stream.hpp"
 #include "io/error.hpp"
+#include "io/line_reader.hpp"
 #include "io/text_number.hpp"
 
 #include <fcntl.h>
@@ -51,18 +52,6 @@ void add_once(std::vector<std::string>& list, std::string item) {
 }
 
 // The whole file, refused past kMaxMtlBytes or when it is not text.
-std::string read_text_file(const std::string& path) {
-    std::unique_ptr<ByteSource> source = ByteSource::open(path);
-    std::string text;
-    char buf[1 << 16];
-    for (size_t n; (n = source->read(buf, sizeof buf)) > 0;) {
-        if (text.size() + n > kMaxMtlBytes)
-            throw Error(path, "larger than " + binary_size(kMaxMtlBytes) + ": not an MTL file");
-        text.append(buf, n);
-    }
-    return text;
-}
-
 // The bytes of a regular file, or false when it does not exist or is not a regular file.
 // Throws io::Error when it exists but cannot be read.
 bool read_image(const std::string& path, uint64_t* budget, std::vector<std::byte>& bytes, bool* over_budget) {
@@ -115,37 +104,22 @@ public:
     MtlParser(const std::string& path, const std::string& uri_dir, uint64_t* image_budget, MtlFindings& findings)
         : path_(path), uri_dir_(uri_dir), dir_(parent_dir(path)), budget_(image_budget), findings_(findings) {}
 
-    std::vector<Material> parse(std::string_view text) {
-        for (char c : text) {
-            const auto u = static_cast<unsigned char>(c);
-            if (u < 0x20 && c != '\t' && c != '\n' && c != '\r' && c != '\v' && c != '\f')
-                throw Error(path_, "is not text (a byte " + std::to_string(u) + " in it): not an MTL file");
-        }
-        std::string joined;
-        size_t pos = 0;
-        uint64_t physical = 0;
-        while (pos < text.size()) {
-            size_t nl = text.find('\n', pos);
-            std::string_view line = text.substr(pos, nl == std::string_view::npos ? std::string_view::npos : nl - pos);
-            pos = nl == std::string_view::npos ? text.size() : nl + 1;
-            ++physical;
-            if (joined.empty()) line_ = physical;
-            line = trim(line);
-            if (!line.empty() && line.back() == '\\') {  // continuation: join with the next line
-                line.remove_suffix(1);
-                joined.append(line);
-                joined += ' ';
-                continue;
+    // Reads statements until the end of `source`: one logical line each (io::LineReader:
+    // continuation lines joined). Throws io::Error naming the line.
+    std::vector<Material> parse(ByteSource& source) {
+        LineReader lines(source, /*join_continuations=*/true);
+        std::string_view line;
+        while (lines.next(line)) {
+            line_ = lines.line_number();
+            if (source.offset() > kMaxMtlBytes)
+                throw Error(path_, "larger than " + binary_size(kMaxMtlBytes) + ": not an MTL file");
+            for (char c : line) {
+                const auto u = static_cast<unsigned char>(c);
+                if (u < 0x20 && c != '\t' && c != '\v' && c != '\f')
+                    fail("is not text (a byte " + std::to_string(u) + " in it): not an MTL file");
             }
-            if (!joined.empty()) {
-                joined.append(line);
-                statement(joined);
-                joined.clear();
-            } else {
-                statement(line);
-            }
+            statement(trim(line));
         }
-        if (!joined.empty()) statement(joined);
         finish_material();
         return std::move(materials_);
     }
@@ -287,8 +261,8 @@ private:
 
 std::vector<Material> read_mtl(const std::string& path, const std::string& uri_dir, uint64_t* image_budget_bytes,
                                MtlFindings& findings) {
-    const std::string text = read_text_file(path);
-    return MtlParser(path, uri_dir, image_budget_bytes, findings).parse(text);
+    std::unique_ptr<ByteSource> source = ByteSource::open(path);
+    return MtlParser(path, uri_dir, image_budget_bytes, findings).parse(*source);
 }
 
 std::string write_mtl(std::span<const Material> materials, std::span<const std::string> names,

@@ -7,6 +7,7 @@
 
 #include "io/error.hpp"
 #include "io/hash.hpp"
+#include "io/line_reader.hpp"
 #include "io/mtl.hpp"
 #include "io/text_number.hpp"
 #include "io/triangulate.hpp"
@@ -32,10 +33,6 @@ constexpr uint32_t kNoMaterial = ~uint32_t{0};
 constexpr const char* kDefaultMaterial = "default";
 // The header note key of what the reader skipped or filled in (one sentence each).
 constexpr const char* kObjWarningNote = "warning";
-
-constexpr const char* kCarriageReturnOnly =
-    "carriage return inside a line: lines ending in CR alone (classic Mac OS) are not supported "
-    "(tr '\\r' '\\n' converts them)";
 
 bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
 
@@ -241,61 +238,16 @@ private:
 
     // Reads the next logical line into line_; false at the end of the input.
     bool next_line() {
-        scratch_.clear();
-        bool joined = false;
-        for (;;) {
-            auto w = src_.window();
-            if (w.empty()) {
-                if (!joined) {
-                    if (unterminated_ && !noted_unterminated_) {
-                        header_.notes.emplace_back(kLastLineNote, kLastLineText);
-                        noted_unterminated_ = true;
-                    }
-                    return false;
-                }
-                line_ = scratch_;
-                return true;
+        if (!lines_.next(line_)) {
+            if (lines_.unterminated() && !noted_unterminated_) {
+                header_.notes.emplace_back(kLastLineNote, kLastLineText);
+                noted_unterminated_ = true;
             }
-            const char* p = reinterpret_cast<const char*>(w.data());
-            const void* nl = std::memchr(p, '\n', w.size());
-            if (!nl && w.size() < ByteSource::kBufferBytes) {
-                w = src_.peek(ByteSource::kBufferBytes);
-                p = reinterpret_cast<const char*>(w.data());
-                nl = std::memchr(p, '\n', w.size());
-            }
-            if (!joined) {
-                line_offset_ = src_.offset();
-                line_no_ = physical_lines_ + 1;
-            }
-            if (!nl && w.size() >= ByteSource::kBufferBytes) {
-                line_no_ = physical_lines_ + 1;
-                if (std::memchr(p, '\r', w.size())) fail(kCarriageReturnOnly);
-                fail("line longer than 1 MiB");
-            }
-            size_t len = nl ? static_cast<size_t>(static_cast<const char*>(nl) - p) : w.size();
-            std::string_view view(p, len);
-            src_.consume(nl ? len + 1 : len);
-            ++physical_lines_;
-            while (!view.empty() && is_space(view.back())) view.remove_suffix(1);
-            unterminated_ = !nl && !view.empty();
-            // A CR inside a line: a file whose lines end in CR alone would otherwise read as one
-            // line (its first statement only).
-            if (std::memchr(view.data(), '\r', view.size())) fail(kCarriageReturnOnly);
-            if (!view.empty() && view.back() == '\\') {  // continuation: join with the next line
-                view.remove_suffix(1);
-                scratch_.append(view);
-                scratch_ += ' ';
-                joined = true;
-                continue;
-            }
-            if (joined) {
-                scratch_.append(view);
-                line_ = scratch_;
-            } else {
-                line_ = view;
-            }
-            return true;
+            return false;
         }
+        line_offset_ = lines_.line_offset();
+        line_no_ = lines_.line_number();
+        return true;
     }
 
     // Handles statements up to the next face of three corners or more, which it leaves in
@@ -763,10 +715,10 @@ private:
     ByteSource& src_;
     ReadOptions options_;
     std::string dir_;  // where mtllib names are looked for
-    std::string scratch_;
+    LineReader lines_{src_, /*join_continuations=*/true};
     std::string_view line_;
-    uint64_t line_no_ = 0, physical_lines_ = 0, line_offset_ = 0;
-    bool unterminated_ = false, noted_unterminated_ = false;  // the last line read had no '\n'
+    uint64_t line_no_ = 0, line_offset_ = 0;  // where line_ began
+    bool noted_unterminated_ = false;
 
     // Tables (created by their first statement) and what the first face decided.
     std::unique_ptr<VertexTable> positions_, uvs_, normals_;  // x y z (+ r g b); u v 0; x y z

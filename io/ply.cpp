@@ -11,6 +11,7 @@
 
 #include "io/endian.hpp"
 #include "io/error.hpp"
+#include "io/line_reader.hpp"
 #include "io/text_number.hpp"
 #include "io/vertex_table.hpp"
 #include "io/weld.hpp"
@@ -184,26 +185,11 @@ public:
 private:
     // ---- header ----
     std::string header_line() {
-        for (;;) {
-            auto w = src_.window();
-            const char* p = reinterpret_cast<const char*>(w.data());
-            const void* nl = std::memchr(p, '\n', w.size());
-            if (!nl && w.size() < ByteSource::kBufferBytes) {
-                w = src_.peek(ByteSource::kBufferBytes);
-                p = reinterpret_cast<const char*>(w.data());
-                nl = std::memchr(p, '\n', w.size());
-            }
-            if (!nl) {
-                if (w.size() >= ByteSource::kBufferBytes) header_fail("header line longer than 1 MiB");
-                header_fail("file ends inside the header (no end_header line)");
-            }
-            size_t len = static_cast<size_t>(static_cast<const char*>(nl) - p);
-            std::string line(p, len);
-            src_.consume(len + 1);
-            ++line_;
-            while (!line.empty() && is_blank(line.back())) line.pop_back();
-            return line;
-        }
+        std::string_view line;
+        if (!header_lines_.next(line) || header_lines_.unterminated())
+            header_fail("file ends inside the header (no end_header line)");
+        line_ = header_lines_.physical_lines();
+        return std::string(line);
     }
 
     [[noreturn]] void header_fail(const std::string& message) const {
@@ -211,6 +197,15 @@ private:
     }
 
     void parse_header() {
+        // The magic first, from the raw bytes: random bytes are "not a PLY file", whatever a
+        // line reader would say of them.
+        const auto head = src_.peek(64);
+        const std::string_view first(reinterpret_cast<const char*>(head.data()), head.size());
+        const std::string_view magic_text = first.substr(0, 3);
+        if (magic_text != std::string_view("ply").substr(0, magic_text.size()) ||
+            (first.size() > 3 && !is_blank(first[3])))
+            throw Error(src_.name(), 0, 0,
+                        "not a PLY file (first line is " + quote_token(first.substr(0, first.find('\n'))) + ")");
         std::string magic = header_line();
         if (magic != "ply") throw Error(src_.name(), 0, 0, "not a PLY file (first line is " + quote_token(magic) + ")");
         bool have_format = false;
@@ -915,6 +910,7 @@ private:
     }
 
     ByteSource& src_;
+    LineReader header_lines_{src_, /*join_continuations=*/false, "header line"};
     ReadOptions options_;
     Encoding encoding_ = Encoding::kAscii;
     bool swap_ = false;

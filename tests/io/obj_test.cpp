@@ -670,7 +670,7 @@ TEST(ObjReader, BadAttributesAndMaterialStatementsNameFileLineAndOffset) {
         {"newmtl a\n\nmap_Kd -s 1 1 1 -clamp on\n", "'map_Kd' without a file name", 3, 0},
         {"newmtl a\nKd 1 1 1 1\n", "'Kd' with more than 3 numbers", 2, 0},
         {"newmtl a\r\nKd 1 \\\r\n 1 z\r\n", "expected a colour component after 'Kd', found 'z'", 2, 0},
-        {"newmtl a\n\x01\x02\x03", "is not text (a byte 1 in it): not an MTL file", 0, 0},
+        {"newmtl a\n\x01\x02\x03", "is not text (a byte 1 in it): not an MTL file", 2, 0},
         {"newmtl a\n\xff\xfe Kd\n", "not an MTL statement: '\\xff\\xfe'", 2, 0},
     };
     for (const Case& c : mtl_cases) {
