@@ -15,6 +15,7 @@
 #   SIZES      input sizes of the scaling plot (default "1000000 10000000 100000000")
 #   RATIOS     ratios of the error plots (default "0.5 0.2 0.1 0.05 0.02 0.01")
 #   RUNS       runs per scaling point, median plotted (default 3)
+#   THREADS    decimate --threads of both plots (default 1: one core, as the in-core references)
 #   OUT_DIR    where the SVGs go (default docs/images)
 #   REUSE      1: keep the measurements an earlier run left in BENCH_DIR (error, scaling, sort),
 #              measuring only what is missing (default 0: measure everything)
@@ -26,6 +27,7 @@ BENCH_DIR=${BENCH_DIR:-/tmp/meshstream-plots}
 SIZES=${SIZES:-"1000000 10000000 100000000"}
 RATIOS=${RATIOS:-"0.5 0.2 0.1 0.05 0.02 0.01"}
 RUNS=${RUNS:-3}
+THREADS=${THREADS:-1}
 REUSE=${REUSE:-0}
 OUT_DIR=${OUT_DIR:-docs/images}
 command -v gnuplot >/dev/null || { echo "bench/plots.sh: gnuplot is missing: apt-get install gnuplot-nox" >&2; exit 1; }
@@ -35,14 +37,14 @@ mkdir -p "$BENCH_DIR" "$OUT_DIR"
 error_rows=$BENCH_DIR/error/results.tsv
 if [ "$REUSE" != 1 ] || [ ! -s "$error_rows" ]; then
   BUILD_DIR=$BENCH_DIR/build BENCH_DIR=$BENCH_DIR/error SIZES=1000000 RATIOS=$RATIOS RUNS=1 \
-    bash bench/decimate.sh >"$BENCH_DIR/error.txt"
+    DECIMATE_ARGS="--threads $THREADS" bash bench/decimate.sh >"$BENCH_DIR/error.txt"
 fi
 
 # 2. Decimate to 1 % against input size, medians of RUNS, no compare (speed and memory only).
 scaling_rows=$BENCH_DIR/scaling/results.tsv
 if [ "$REUSE" != 1 ] || [ ! -s "$scaling_rows" ]; then
   BUILD_DIR=$BENCH_DIR/build BENCH_DIR=$BENCH_DIR/scaling SIZES=$SIZES RATIOS=0.01 RUNS=$RUNS CGAL_MAX=0 COMPARE=0 \
-    bash bench/decimate.sh >"$BENCH_DIR/scaling.txt"
+    DECIMATE_ARGS="--threads $THREADS" bash bench/decimate.sh >"$BENCH_DIR/scaling.txt"
 fi
 
 # 3. Sort throughput on the same generated meshes (written in generator order; sort along the
@@ -113,12 +115,12 @@ set xlabel "input triangles"
 set key top left
 set title "time, file to file (median of $RUNS)"
 set ylabel "seconds"
-plot "$BENCH_DIR/scale_meshstream.dat" using 1:2 with linespoints lw 2 pt 7 title "meshstream decimate -r 0.01", \
+plot "$BENCH_DIR/scale_meshstream.dat" using 1:2 with linespoints lw 2 pt 7 title "meshstream decimate -r 0.01 --threads $THREADS", \
      "$BENCH_DIR/scale_meshopt.dat" using 1:2 with linespoints lw 2 pt 5 title "meshoptimizer 1.2, 1 %", \
      "$BENCH_DIR/scale_sort.dat" using 1:2 with linespoints lw 2 pt 9 title "meshstream sort --memory 1G"
 set title "peak resident memory"
 set ylabel "MB"
-plot "$BENCH_DIR/scale_meshstream.dat" using 1:3 with linespoints lw 2 pt 7 title "meshstream decimate -r 0.01", \
+plot "$BENCH_DIR/scale_meshstream.dat" using 1:3 with linespoints lw 2 pt 7 title "meshstream decimate -r 0.01 --threads $THREADS", \
      "$BENCH_DIR/scale_meshopt.dat" using 1:3 with linespoints lw 2 pt 5 title "meshoptimizer 1.2, 1 %", \
      "$BENCH_DIR/scale_sort.dat" using 1:3 with linespoints lw 2 pt 9 title "meshstream sort --memory 1G"
 unset multiplot
