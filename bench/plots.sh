@@ -15,10 +15,11 @@
 #   SIZES      input sizes of the scaling plot (default "1000000 10000000 100000000")
 #   RATIOS     ratios of the error plots (default "0.5 0.2 0.1 0.05 0.02 0.01")
 #   RUNS       runs per scaling point, median plotted (default 3)
+#   LARGE_RUNS runs per scaling point above LARGE input triangles (default RUNS; LARGE default 20 M)
 #   THREADS    decimate --threads of both plots (default 1: one core, as the in-core references)
 #   OUT_DIR    where the SVGs go (default docs/images)
-#   REUSE      1: keep the measurements an earlier run left in BENCH_DIR (error, scaling, sort),
-#              measuring only what is missing (default 0: measure everything)
+#   REUSE      1: keep the measurements an earlier run left in BENCH_DIR (the error rows; the
+#              scaling and sort rows of each size), measuring only what is missing (default 0)
 # Needs what bench/decimate.sh needs, and gnuplot (Debian: gnuplot-nox).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -28,6 +29,9 @@ SIZES=${SIZES:-"1000000 10000000 100000000"}
 RATIOS=${RATIOS:-"0.5 0.2 0.1 0.05 0.02 0.01"}
 RUNS=${RUNS:-3}
 THREADS=${THREADS:-1}
+LARGE=${LARGE:-20000000}
+LARGE_RUNS=${LARGE_RUNS:-$RUNS}
+runs_for() { if [ "$1" -gt "$LARGE" ]; then echo "$LARGE_RUNS"; else echo "$RUNS"; fi; }
 REUSE=${REUSE:-0}
 OUT_DIR=${OUT_DIR:-docs/images}
 command -v gnuplot >/dev/null || { echo "bench/plots.sh: gnuplot is missing: apt-get install gnuplot-nox" >&2; exit 1; }
@@ -40,12 +44,16 @@ if [ "$REUSE" != 1 ] || [ ! -s "$error_rows" ]; then
     DECIMATE_ARGS="--threads $THREADS" bash bench/decimate.sh >"$BENCH_DIR/error.txt"
 fi
 
-# 2. Decimate to 1 % against input size, medians of RUNS, no compare (speed and memory only).
-scaling_rows=$BENCH_DIR/scaling/results.tsv
-if [ "$REUSE" != 1 ] || [ ! -s "$scaling_rows" ]; then
-  BUILD_DIR=$BENCH_DIR/build BENCH_DIR=$BENCH_DIR/scaling SIZES=$SIZES RATIOS=0.01 RUNS=$RUNS CGAL_MAX=0 COMPARE=0 \
-    DECIMATE_ARGS="--threads $THREADS" bash bench/decimate.sh >"$BENCH_DIR/scaling.txt"
-fi
+# 2. Decimate to 1 % against input size, medians of RUNS (LARGE_RUNS), no compare (speed and
+# memory only), one size at a time.
+scaling_rows=$BENCH_DIR/scaling.tsv
+[ "$REUSE" = 1 ] && [ -s "$scaling_rows" ] || : >"$scaling_rows"
+for n in $SIZES; do
+  grep -q "^gen_$n	" "$scaling_rows" && continue
+  BUILD_DIR=$BENCH_DIR/build BENCH_DIR=$BENCH_DIR/scaling SIZES=$n RATIOS=0.01 RUNS=$(runs_for "$n") CGAL_MAX=0 \
+    COMPARE=0 DECIMATE_ARGS="--threads $THREADS" bash bench/decimate.sh >>"$BENCH_DIR/scaling.txt"
+  grep "^gen_" "$BENCH_DIR/scaling/results.tsv" >>"$scaling_rows"
+done
 
 # 3. Sort throughput on the same generated meshes (written in generator order; sort along the
 # longest axis), median of RUNS by wall time.
@@ -55,11 +63,12 @@ sort_rows=$BENCH_DIR/sort.tsv
 for n in $SIZES; do
   grep -q "^$n " "$sort_rows" && continue
   in=$BENCH_DIR/scaling/gen_$n.stl
-  for ((r = 0; r < RUNS; r++)); do
+  runs=$(runs_for "$n")
+  for ((r = 0; r < runs; r++)); do
     rm -f "$BENCH_DIR/sorted.stl"
     /usr/bin/time -f "%e %M" -o "$BENCH_DIR/time.txt" "$ms" -q sort --memory 1G "$in" "$BENCH_DIR/sorted.stl"
     echo "$n $(cat "$BENCH_DIR/time.txt")"
-  done | sort -k2 -n | awk -v runs="$RUNS" 'NR == int((runs + 1) / 2)' >>"$sort_rows"
+  done | sort -k2 -n | awk -v runs="$runs" 'NR == int((runs + 1) / 2)' >>"$sort_rows"
   rm -f "$BENCH_DIR/sorted.stl"
 done
 
@@ -105,6 +114,8 @@ EOF
 error_plot bunny "Stanford bunny (69 451 triangles)"
 error_plot 1m "generated surface (1 M triangles)"
 
+median_note="$RUNS runs"
+[ "$LARGE_RUNS" = "$RUNS" ] || median_note="$RUNS runs, $LARGE_RUNS above $((LARGE / 1000000)) M"
 gnuplot <<EOF
 set terminal svg size 960,420 dynamic font "sans,12"
 set output "$OUT_DIR/scaling.svg"
@@ -113,7 +124,7 @@ set logscale xy
 set grid
 set xlabel "input triangles"
 set key top left
-set title "time, file to file (median of $RUNS)"
+set title "time, file to file (median of $median_note)"
 set ylabel "seconds"
 plot "$BENCH_DIR/scale_meshstream.dat" using 1:2 with linespoints lw 2 pt 7 title "meshstream decimate -r 0.01 --threads $THREADS", \
      "$BENCH_DIR/scale_meshopt.dat" using 1:2 with linespoints lw 2 pt 5 title "meshoptimizer 1.2, 1 %", \
