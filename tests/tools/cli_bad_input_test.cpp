@@ -6,6 +6,7 @@
 // the process) gives a clear error instead of death by SIGXFSZ.
 #include "format_util.hpp"
 #include "tools/cli_util.hpp"
+#include "tools/mesh_files.hpp"
 
 #include <gtest/gtest.h>
 
@@ -34,38 +35,13 @@ namespace fs = std::filesystem;
 
 namespace {
 
+using cli_test::binary_stl;
 using cli_test::CliRun;
+using cli_test::grid;
 using cli_test::listing;
 using cli_test::run;
 using cli_test::slurp;
 using cli_test::TempDir;
-
-// A binary STL of `tris` (9 floats each), zero normals.
-std::string binary_stl(const std::vector<float>& tris) {
-    std::string s(80, ' ');
-    uint32_t n = static_cast<uint32_t>(tris.size() / 9);
-    s.append(reinterpret_cast<const char*>(&n), 4);
-    for (size_t t = 0; t < n; ++t) {
-        s.append(12, '\0');
-        s.append(reinterpret_cast<const char*>(&tris[9 * t]), 36);
-        s.append(2, '\0');
-    }
-    return s;
-}
-
-// A height-field grid of 2·k² triangles in row order (a stream the decimator can work on).
-std::vector<float> grid(int k) {
-    std::vector<float> tris;
-    tris.reserve(size_t(18) * k * k);
-    auto z = [](int x, int y) { return 0.01f * float((x * 7 + y * 13) % 11); };
-    for (int y = 0; y < k; ++y)
-        for (int x = 0; x < k; ++x) {
-            const float x0 = float(x), x1 = float(x + 1), y0 = float(y), y1 = float(y + 1);
-            tris.insert(tris.end(), {x0, y0, z(x, y), x1, y0, z(x + 1, y), x1, y1, z(x + 1, y + 1)});
-            tris.insert(tris.end(), {x0, y0, z(x, y), x1, y1, z(x + 1, y + 1), x0, y1, z(x, y + 1)});
-        }
-    return tris;
-}
 
 // Replaces every `token` in `text` by `value`, scanning forward. Tokens are braced: a bare
 // OUT replaced by a temporary directory that happened to be named ...-jOUT2b looped forever.

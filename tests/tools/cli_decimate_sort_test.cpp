@@ -6,6 +6,7 @@
 #include "compare/metro.hpp"
 #include "io/format.hpp"
 #include "tools/cli_util.hpp"
+#include "tools/mesh_files.hpp"
 
 #include <gtest/gtest.h>
 
@@ -19,9 +20,8 @@ using cli_test::CliRun;
 using cli_test::run;
 using cli_test::slurp;
 using cli_test::TempDir;
+using cli_test::triangles_of;
 using namespace meshstream;
-
-uint64_t triangles_of(const std::string& path) { return *io::open_input(path).reader->triangle_count(); }
 
 double rms_against(const std::string& original, const std::string& decimated) {
     compare::CompareOptions co;

@@ -4,6 +4,7 @@
 #include "compare/metro.hpp"
 #include "io/format.hpp"
 #include "tools/cli_util.hpp"
+#include "tools/mesh_files.hpp"
 
 #include <gtest/gtest.h>
 
@@ -16,18 +17,10 @@
 namespace {
 
 using cli_test::CliRun;
+using cli_test::edges_of;
 using cli_test::run;
 using cli_test::TempDir;
 using namespace meshstream;
-
-compare::EdgeCounts edges_of(const std::string& path) {
-    io::Input in = io::open_input(path);
-    io::TriangleChunk chunk;
-    compare::EdgeCounter counter;
-    while (in.reader->next(chunk))
-        for (size_t t = 0; t < chunk.size(); ++t) counter.add_triangle(&chunk.xyz()[9 * t]);
-    return counter.finish();
-}
 
 // Triangles whose three corners (as positions, in any order) another triangle also has.
 size_t duplicate_triangles(const std::string& path) {

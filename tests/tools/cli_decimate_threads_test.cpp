@@ -8,6 +8,7 @@
 #include "compare/topology.hpp"
 #include "io/format.hpp"
 #include "tools/cli_util.hpp"
+#include "tools/mesh_files.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -22,22 +23,13 @@
 namespace {
 
 using cli_test::CliRun;
+using cli_test::edges_of;
 using cli_test::listing;
 using cli_test::run;
 using cli_test::slurp;
 using cli_test::TempDir;
+using cli_test::triangles_of;
 using namespace meshstream;
-
-compare::EdgeCounts edges_of(const std::string& path) {
-    io::Input in = io::open_input(path);
-    io::TriangleChunk chunk;
-    compare::EdgeCounter counter;
-    while (in.reader->next(chunk))
-        for (size_t t = 0; t < chunk.size(); ++t) counter.add_triangle(&chunk.xyz()[9 * t]);
-    return counter.finish();
-}
-
-uint64_t triangles_of(const std::string& path) { return *io::open_input(path).reader->triangle_count(); }
 
 double rms_error(const std::string& original, const std::string& decimated) {
     compare::CompareOptions co;

@@ -5,6 +5,7 @@
 // quarter of --memory); without --memory the budget is half
 // of the memory available (MESHSTREAM_MEMINFO stands in for /proc/meminfo), and --memory wins.
 #include "cli_util.hpp"
+#include "mesh_files.hpp"
 
 #include <gtest/gtest.h>
 
@@ -17,31 +18,6 @@ namespace {
 
 using namespace cli_test;
 using meshstream::test::spit;
-
-// A height-field grid of 2·k² triangles, 9 floats each.
-std::vector<float> grid(int k) {
-    std::vector<float> tris;
-    auto z = [](int x, int y) { return 0.01f * float((x * 7 + y * 13) % 11); };
-    for (int y = 0; y < k; ++y)
-        for (int x = 0; x < k; ++x) {
-            const float x0 = float(x), x1 = float(x + 1), y0 = float(y), y1 = float(y + 1);
-            tris.insert(tris.end(), {x0, y0, z(x, y), x1, y0, z(x + 1, y), x1, y1, z(x + 1, y + 1)});
-            tris.insert(tris.end(), {x0, y0, z(x, y), x1, y1, z(x + 1, y + 1), x0, y1, z(x, y + 1)});
-        }
-    return tris;
-}
-
-std::string binary_stl(const std::vector<float>& tris) {
-    std::string s(80, ' ');
-    const uint32_t n = static_cast<uint32_t>(tris.size() / 9);
-    s.append(reinterpret_cast<const char*>(&n), 4);
-    for (size_t t = 0; t < n; ++t) {
-        s.append(12, '\0');
-        s.append(reinterpret_cast<const char*>(&tris[9 * t]), 36);
-        s.append(2, '\0');
-    }
-    return s;
-}
 
 // ASCII STL: no count up front.
 std::string ascii_stl(const std::vector<float>& tris) {

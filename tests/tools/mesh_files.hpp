@@ -1,0 +1,58 @@
+// Meshes the CLI tests write and check: a generated height-field grid, its binary STL, and
+// what a written file holds (triangle count, edge counts).
+#pragma once
+
+#include "compare/topology.hpp"
+#include "io/format.hpp"
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace cli_test {
+
+// A height-field grid of 2·k² triangles in row order (a stream the decimator can work on), 9
+// floats each.
+inline std::vector<float> grid(int k) {
+    std::vector<float> tris;
+    tris.reserve(size_t(18) * size_t(k) * size_t(k));
+    auto z = [](int x, int y) { return 0.01f * float((x * 7 + y * 13) % 11); };
+    for (int y = 0; y < k; ++y)
+        for (int x = 0; x < k; ++x) {
+            const float x0 = float(x), x1 = float(x + 1), y0 = float(y), y1 = float(y + 1);
+            tris.insert(tris.end(), {x0, y0, z(x, y), x1, y0, z(x + 1, y), x1, y1, z(x + 1, y + 1)});
+            tris.insert(tris.end(), {x0, y0, z(x, y), x1, y1, z(x + 1, y + 1), x0, y1, z(x, y + 1)});
+        }
+    return tris;
+}
+
+// A binary STL of `tris` (9 floats each), zero normals.
+inline std::string binary_stl(const std::vector<float>& tris) {
+    std::string s(80, ' ');
+    const uint32_t n = static_cast<uint32_t>(tris.size() / 9);
+    s.append(reinterpret_cast<const char*>(&n), 4);
+    for (size_t t = 0; t < n; ++t) {
+        s.append(12, '\0');
+        s.append(reinterpret_cast<const char*>(&tris[9 * t]), 36);
+        s.append(2, '\0');
+    }
+    return s;
+}
+
+// The edge counts (boundary, non-manifold) of the mesh in `path`.
+inline meshstream::compare::EdgeCounts edges_of(const std::string& path) {
+    namespace io = meshstream::io;
+    io::Input in = io::open_input(path);
+    io::TriangleChunk chunk;
+    meshstream::compare::EdgeCounter counter;
+    while (in.reader->next(chunk))
+        for (size_t t = 0; t < chunk.size(); ++t) counter.add_triangle(&chunk.xyz()[9 * t]);
+    return counter.finish();
+}
+
+// The triangle count `path`'s header states.
+inline uint64_t triangles_of(const std::string& path) {
+    return *meshstream::io::open_input(path).reader->triangle_count();
+}
+
+}  // namespace cli_test
