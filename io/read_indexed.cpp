@@ -17,6 +17,7 @@ IndexedFile read_indexed(const std::string& path, const ReadOptions& options, st
     while (input.next(chunk)) indexer.add(chunk);
     out.header = input.header();
     out.non_finite_triangles = indexer.non_finite_count();
+    out.non_finite_attributes = indexer.non_finite_attribute_count();
     out.mesh = indexer.take();
     return out;
 }

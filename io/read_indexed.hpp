@@ -5,7 +5,7 @@
 // readers that index, the same vertex id) and equal attributes are one vertex, so UV and normal
 // seams stay apart. Every triangle is kept in file order, degenerate ones too, except those with
 // a NaN or infinite coordinate, which are dropped and counted (an io::Error under
-// ReadOptions::strict).
+// ReadOptions::strict); NaN or infinite attribute values are stored as 0 and counted.
 // Memory: the whole mesh (see io::IndexedMesh), plus the reader's own buffers while reading.
 #pragma once
 
@@ -23,8 +23,9 @@ struct IndexedFile {
     // The file's header once read to the end: its material table (which mesh.materials
     // indexes), variant, notes and the reader's counted warnings.
     MeshHeader header;
-    const Format* format = nullptr;     // the format the file was read as
-    uint64_t non_finite_triangles = 0;  // dropped for a NaN or infinite coordinate
+    const Format* format = nullptr;      // the format the file was read as
+    uint64_t non_finite_triangles = 0;   // dropped for a NaN or infinite coordinate
+    uint64_t non_finite_attributes = 0;  // normal, colour, uv or scalar values that were NaN or infinite: 0 in the mesh
 };
 
 // Reads `path` ("-": standard input) as format `from` (empty: detected, as the commands do).

@@ -107,6 +107,17 @@ TEST(ReadIndexed, NonFiniteTrianglesAreDroppedAndCountedOrRefusedUnderStrict) {
     EXPECT_EQ(f.mesh.triangle_count(), 2u);
     EXPECT_EQ(f.mesh.vertex_count(), 4u);
     EXPECT_EQ(f.non_finite_triangles, 1u);
+    EXPECT_EQ(f.non_finite_attributes, 0u);
+    // A NaN normal is kept as 0 and counted.
+    const std::string normals = dir / "nan_normal.ply";
+    spit(normals,
+         "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+         "property float nx\nproperty float ny\nproperty float nz\nelement face 1\n"
+         "property list uchar int vertex_indices\nend_header\n"
+         "0 0 0 0 0 1\n1 0 0 nan 0 1\n0 1 0 0 0 1\n3 0 1 2\n");
+    const io::IndexedFile n = io::read_indexed(normals);
+    EXPECT_EQ(n.mesh.triangle_count(), 1u);
+    EXPECT_EQ(n.non_finite_attributes, 1u);
     io::ReadOptions strict;
     strict.strict = true;
     try {
