@@ -133,8 +133,8 @@ public:
         : sink_(sink),
           options_(options),
           indexer_(sink.name(), "Draco", options.channels, options.strict),
+          settings_(check_draco_settings(sink.name(), options)),
           budget_(sink.name(), options, kWhy) {
-        check_draco_settings(sink.name(), options);
         budget_check_up_front(sink.name(), options, kWhy, draco_encode_estimate_bytes);
     }
 
@@ -164,10 +164,10 @@ public:
             values.normals = std::move(normals);
             channels.normal = true;
         }
-        DracoEncoded encoded = encode_draco(mesh.positions, mesh.indices, values, channels, options_, sink_.name());
+        DracoEncoded encoded = encode_draco(mesh.positions, mesh.indices, values, channels, settings_, sink_.name());
         sink_.write(encoded.bytes.data(), encoded.bytes.size());
         notes_ = indexer_.notes();
-        for (std::string& note : draco_notes(encoded, mesh.triangle_count(), options_))
+        for (std::string& note : draco_notes(encoded, mesh.triangle_count(), settings_))
             notes_.push_back(std::move(note));
     }
     std::vector<std::string> notes() const override {
@@ -181,6 +181,7 @@ private:
     ByteSink& sink_;
     WriteOptions options_;
     MeshIndexer indexer_;
+    DracoSettings settings_;
     WholeMeshBudget budget_;
 };
 
@@ -318,18 +319,24 @@ Channels drc_keep_channels(const Channels& in, const WriteOptions& options) {
     return draco_keep_channels(in, options, false);
 }
 
+// Draco's connectivity coder puts the triangles in an order of its own.
+std::string drc_reorders_triangles(const WriteOptions&) { return "Draco compression reorders triangles"; }
+
+bool drc_takes_options(const std::type_info& type, const WriteOptions&) { return type == typeid(DracoSettings); }
+
 }  // namespace
 
 const Format kDracoFormat = {
-    "draco",
-    "drc",
-    "Draco compressed mesh (whole mesh in memory)",
-    &probe_draco,
-    &open_draco_reader,
-    &open_draco_writer,
-    Format::kAlwaysDraco | Format::kWholeMesh,
-    nullptr,
-    &drc_keep_channels,
+    .name = "draco",
+    .extensions = "drc",
+    .description = "Draco compressed mesh (whole mesh in memory)",
+    .probe = &probe_draco,
+    .open_reader = &open_draco_reader,
+    .open_writer = &open_draco_writer,
+    .traits = Format::kWholeMesh,
+    .keep_channels = &drc_keep_channels,
+    .reorders_triangles = &drc_reorders_triangles,
+    .takes_options = &drc_takes_options,
 };
 
 bool probe_draco(std::span<const std::byte> head, std::optional<uint64_t>) {
@@ -352,17 +359,17 @@ namespace {
 // 22-29): about 4 bytes per quantized value of positions (levels 0-8; 11 at levels 9 and 10,
 // more than twice that at 30 bits) and of normals, for meshes past a few thousand vertices.
 // Texture coordinates, float colours and generic attributes are quantized the same way.
-uint64_t draco_table_bytes(const WriteOptions& options) {
-    const uint64_t per_value = options.draco_level < 9 ? 4 : options.draco_position_bits < 30 ? 12 : 24;
+uint64_t draco_table_bytes(const WriteOptions& options, const DracoSettings& settings) {
+    const uint64_t per_value = settings.level < 9 ? 4 : settings.position_bits < 30 ? 12 : 24;
     const Channels& ch = options.channels;
     const bool float_colors = ch.color && ch.color->type == ScalarType::kFloat32;
     const bool float_scalars = std::any_of(
         ch.vertex_scalars.begin(), ch.vertex_scalars.end(),
         [](const ScalarChannel& s) { return s.type == ScalarType::kFloat32 || s.type == ScalarType::kFloat64; });
-    return per_value * (uint64_t{1} << options.draco_position_bits) +
-           (options.normals || ch.normal ? 4 * (uint64_t{1} << options.draco_normal_bits) : 0) +
-           (ch.uv_sets > 0 ? 4 * (uint64_t{1} << options.draco_texcoord_bits) : 0) +
-           (float_colors || float_scalars ? 4 * (uint64_t{1} << options.draco_color_bits) : 0);
+    return per_value * (uint64_t{1} << settings.position_bits) +
+           (options.normals || ch.normal ? 4 * (uint64_t{1} << settings.normal_bits) : 0) +
+           (ch.uv_sets > 0 ? 4 * (uint64_t{1} << settings.texcoord_bits) : 0) +
+           (float_colors || float_scalars ? 4 * (uint64_t{1} << settings.color_bits) : 0);
 }
 
 }  // namespace
@@ -376,28 +383,29 @@ uint64_t draco_encode_estimate_bytes(uint64_t vertex_count, uint64_t triangle_co
     // float or double) and Draco's copy of them, so about four records a vertex.
     const bool normals = options.normals || options.channels.normal;
     return vertex_count * (96 + (normals ? 88 : 0) + 4 * uint64_t(CornerLayout(options.channels).bytes())) +
-           triangle_count * (76 + (options.channels.material ? 4 : 0)) + draco_table_bytes(options);
+           triangle_count * (76 + (options.channels.material ? 4 : 0)) +
+           draco_table_bytes(options, options.format_options.get<DracoSettings>());
 }
 
-void check_draco_settings(const std::string& file, const WriteOptions& options) {
-    if (options.draco_position_bits < 1 || options.draco_position_bits > 30)
-        throw Error(file, "--draco-qp must be 1-30, got " + std::to_string(options.draco_position_bits));
-    if (options.draco_normal_bits < 2 || options.draco_normal_bits > 30)
-        throw Error(file, "--draco-qn must be 2-30, got " + std::to_string(options.draco_normal_bits));
-    if (options.draco_texcoord_bits < 1 || options.draco_texcoord_bits > 30)
-        throw Error(file, "--draco-qt must be 1-30, got " + std::to_string(options.draco_texcoord_bits));
-    if (options.draco_color_bits < 1 || options.draco_color_bits > 30)
-        throw Error(file, "--draco-qc must be 1-30, got " + std::to_string(options.draco_color_bits));
-    if (options.draco_level < 0 || options.draco_level > 10)
-        throw Error(file, "--draco-cl must be 0-10, got " + std::to_string(options.draco_level));
-    const uint64_t tables = draco_table_bytes(options);
-    if (tables <= options.memory_budget_bytes) return;
+DracoSettings check_draco_settings(const std::string& file, const WriteOptions& options) {
+    const DracoSettings s = options.format_options.get<DracoSettings>();
+    auto check = [&](int value, int low, int high, const char* flag) {
+        if (value < low || value > high)
+            throw Error(file, std::string(flag) + " must be " + std::to_string(low) + "-" + std::to_string(high) +
+                                  ", got " + std::to_string(value));
+    };
+    check(s.position_bits, 1, 30, "--draco-qp");
+    check(s.normal_bits, 2, 30, "--draco-qn");
+    check(s.texcoord_bits, 1, 30, "--draco-qt");
+    check(s.color_bits, 1, 30, "--draco-qc");
+    check(s.level, 0, 10, "--draco-cl");
+    const uint64_t tables = draco_table_bytes(options, s);
+    if (tables <= options.memory_budget_bytes) return s;
     throw Error(
         file,
-        "Draco's coding tables for --draco-qp " + std::to_string(options.draco_position_bits) +
-            (options.normals || options.channels.normal ? " and --draco-qn " + std::to_string(options.draco_normal_bits)
-                                                        : "") +
-            " at --draco-cl " + std::to_string(options.draco_level) + " take about " + binary_size(tables) +
+        "Draco's coding tables for --draco-qp " + std::to_string(s.position_bits) +
+            (options.normals || options.channels.normal ? " and --draco-qn " + std::to_string(s.normal_bits) : "") +
+            " at --draco-cl " + std::to_string(s.level) + " take about " + binary_size(tables) +
             " (they double with each bit), over the memory budget of " + binary_size(options.memory_budget_bytes) +
             ": give fewer bits (float positions hold 24) or --memory " + std::to_string((tables >> 20) + 1) +
             "M or more");
@@ -411,7 +419,7 @@ int64_t first_repeated_vertex(const std::vector<uint32_t>& indices) {
 }
 
 DracoEncoded encode_draco(const std::vector<float>& positions, const std::vector<uint32_t>& indices,
-                          const VertexValues& values, const Channels& channels, const WriteOptions& options,
+                          const VertexValues& values, const Channels& channels, const DracoSettings& settings,
                           const std::string& file_name, bool flip_v) {
     // Draco's encoder drops triangles with a repeated vertex: left out here, so they are counted.
     std::vector<uint32_t> kept;
@@ -438,7 +446,7 @@ DracoEncoded encode_draco(const std::vector<float>& positions, const std::vector
         // decoded to one point far away). Refused, as Draco's own encoder cannot do them.
         float range = 0;
         for (int a = 0; a < 3; ++a) range = std::max(range, box.max[a] - box.min[a]);
-        const float max_q = float((uint32_t{1} << options.draco_position_bits) - 1);
+        const float max_q = float((uint32_t{1} << settings.position_bits) - 1);
         if (!std::isfinite(range))
             throw Error(file_name,
                         "the mesh is wider along an axis than a float can hold (3.4e38): Draco cannot "
@@ -446,7 +454,7 @@ DracoEncoded encode_draco(const std::vector<float>& positions, const std::vector
         if (range > 0 && !std::isfinite(max_q / range)) {
             std::string extent;
             append_number(extent, range);
-            throw Error(file_name, "the mesh is too small for Draco's " + std::to_string(options.draco_position_bits) +
+            throw Error(file_name, "the mesh is too small for Draco's " + std::to_string(settings.position_bits) +
                                        "-bit quantization (largest extent " + extent +
                                        "): write it with fewer --draco-qp bits, or without Draco");
         }
@@ -499,15 +507,15 @@ DracoEncoded encode_draco(const std::vector<float>& positions, const std::vector
     }
 
     draco::Encoder encoder;
-    encoder.SetAttributeQuantization(draco::GeometryAttribute::POSITION, options.draco_position_bits);
-    if (channels.normal) encoder.SetAttributeQuantization(draco::GeometryAttribute::NORMAL, options.draco_normal_bits);
+    encoder.SetAttributeQuantization(draco::GeometryAttribute::POSITION, settings.position_bits);
+    if (channels.normal) encoder.SetAttributeQuantization(draco::GeometryAttribute::NORMAL, settings.normal_bits);
     if (channels.uv_sets > 0)
-        encoder.SetAttributeQuantization(draco::GeometryAttribute::TEX_COORD, options.draco_texcoord_bits);
+        encoder.SetAttributeQuantization(draco::GeometryAttribute::TEX_COORD, settings.texcoord_bits);
     // Quantization applies to float attributes only: integer colours and scalars stay exact.
-    if (channels.color) encoder.SetAttributeQuantization(draco::GeometryAttribute::COLOR, options.draco_color_bits);
+    if (channels.color) encoder.SetAttributeQuantization(draco::GeometryAttribute::COLOR, settings.color_bits);
     if (!channels.vertex_scalars.empty())
-        encoder.SetAttributeQuantization(draco::GeometryAttribute::GENERIC, options.draco_color_bits);
-    const int speed = 10 - options.draco_level;
+        encoder.SetAttributeQuantization(draco::GeometryAttribute::GENERIC, settings.color_bits);
+    const int speed = 10 - settings.level;
     encoder.SetSpeedOptions(speed, speed);
     encoder.SetTrackEncodedProperties(true);
     draco::EncoderBuffer buffer;
@@ -525,7 +533,7 @@ DracoEncoded encode_draco(const std::vector<float>& positions, const std::vector
     for (int id : generic_atts) out.generic_ids.push_back(static_cast<int>(dm.attribute(id)->unique_id()));
     // The decoded positions' bounds, computed with Draco's own quantizer on the input bounds.
     draco::AttributeQuantizationTransform q;
-    if (!q.ComputeParameters(*dm.attribute(pos_att), options.draco_position_bits))
+    if (!q.ComputeParameters(*dm.attribute(pos_att), settings.position_bits))
         throw Error(file_name, "Draco rejected the position quantization settings");
     for (int a = 0; a < 3; ++a) {
         out.decoded_bounds.min[a] = draco_roundtrip(box.min[a], q, a);
@@ -550,7 +558,7 @@ DracoEncoded encode_draco(const std::vector<float>& positions, const std::vector
     return out;
 }
 
-std::vector<std::string> draco_notes(const DracoEncoded& encoded, uint64_t triangles, const WriteOptions& options) {
+std::vector<std::string> draco_notes(const DracoEncoded& encoded, uint64_t triangles, const DracoSettings& settings) {
     std::vector<std::string> out;
     if (encoded.dropped)
         out.push_back(std::to_string(encoded.dropped) + " of the " + std::to_string(triangles) +
@@ -559,7 +567,7 @@ std::vector<std::string> draco_notes(const DracoEncoded& encoded, uint64_t trian
     if (encoded.flattened)
         out.push_back(std::to_string(encoded.flattened) + " of the " + std::to_string(triangles) +
                       " triangles have zero area once decoded: thinner than Draco's " +
-                      std::to_string(options.draco_position_bits) +
+                      std::to_string(settings.position_bits) +
                       "-bit quantization step (the largest extent / (2^bits - 1)); raise --draco-qp, or write without "
                       "Draco");
     return out;

@@ -8,11 +8,12 @@
 // Attributes, read and written: normal, color (uint8, uint16 or float; 3 or 4 components),
 // tex_coord (each set one attribute, up to 4) and generic (each vertex scalar channel one
 // 1-component attribute named by its "name" metadata entry, as Draco's own tools do).
-// Writer settings: position quantization --draco-qp (default 14 bits), normals --draco-qn
-// (10), texture coordinates --draco-qt (12), float colours and generic attributes --draco-qc
-// (10; integer ones are stored exactly), compression level --draco-cl 0–10 (default 7; Draco
-// speed = 10 - level, as draco_encoder does); --normals adds area-weighted smooth normals to a
-// mesh without them. Draco's encoder drops triangles with a repeated vertex and no quantization
+// Writer settings (DracoSettings, in WriteOptions::format_options): position quantization
+// --draco-qp (default 14 bits), normals --draco-qn (10), texture coordinates --draco-qt (12),
+// float colours and generic attributes --draco-qc (10; integer ones are stored exactly),
+// compression level --draco-cl 0–10 (default 7; Draco speed = 10 - level, as draco_encoder
+// does); --normals (WriteOptions::normals) adds area-weighted smooth normals to a mesh
+// without them. Draco's encoder drops triangles with a repeated vertex and no quantization
 // holds a NaN: both are counted in the writer's notes (errors under --strict).
 // Reader: triangles in Draco's decoded order, the point number as vertex id; MeshHeader::notes
 // gets the bitstream version, the connectivity method (edgebreaker/sequential), the position
@@ -34,6 +35,17 @@ namespace meshstream::io {
 
 extern const Format kDracoFormat;  // "draco": .drc
 
+// Draco's own write options, for the .drc writer and glTF's KHR_draco_mesh_compression: set
+// them with WriteOptions::format_options.set(DracoSettings{...}); unset, these defaults apply.
+// Quantization applies to float attributes only.
+struct DracoSettings {
+    int position_bits = 14;  // --draco-qp, 1–30
+    int normal_bits = 10;    // --draco-qn, 2–30 (Draco's octahedral normal coder fails at 1)
+    int texcoord_bits = 12;  // --draco-qt, 1–30
+    int color_bits = 10;     // --draco-qc, 1–30: float colours and generic attributes
+    int level = 7;           // --draco-cl, 0–10 (Draco speed = 10 - level)
+};
+
 // True when `head` starts with the magic "DRACO".
 bool probe_draco(std::span<const std::byte> head, std::optional<uint64_t> file_size);
 
@@ -42,8 +54,9 @@ bool probe_draco(std::span<const std::byte> head, std::optional<uint64_t> file_s
 // its entropy coder's tables, which double with each quantization bit).
 uint64_t draco_encode_estimate_bytes(uint64_t vertex_count, uint64_t triangle_count, const WriteOptions& options);
 
-// Refuses --draco-qp/-qn/-qt/-qc/-cl out of range, and bit counts whose tables alone pass --memory.
-void check_draco_settings(const std::string& file, const WriteOptions& options);
+// The DracoSettings of `options`, checked: throws io::Error naming `file` and the setting for
+// one out of its range, and for bit counts whose coding tables alone pass the memory budget.
+DracoSettings check_draco_settings(const std::string& file, const WriteOptions& options);
 
 // The channels a Draco bitstream written with `options` keeps of `in` (per corner: normal,
 // colour, texture coordinates, scalars; `gltf`: no scalars, which glTF names differently).
@@ -64,17 +77,17 @@ struct DracoEncoded {
 };
 // The notes a writer gives for what the encoding lost (flattened or dropped triangles), each
 // a sentence; empty when nothing was.
-std::vector<std::string> draco_notes(const DracoEncoded& encoded, uint64_t triangles, const WriteOptions& options);
+std::vector<std::string> draco_notes(const DracoEncoded& encoded, uint64_t triangles, const DracoSettings& settings);
 
 // Encodes a mesh: `positions` (3 per vertex), `indices` (3 per triangle), the per-vertex
 // `values` of the channels `channels` names (normal, colour in its source type, uv sets,
-// scalars), with the Draco settings of `options`. `flip_v`: texture coordinates are written
-// as v' = 1 - v (glTF's convention; the chunk's v points up). Triangles with a repeated vertex
-// are left out (Draco's encoder drops them) and counted in `dropped` (a writer under --strict
-// refuses them before, with first_repeated_vertex). Throws io::Error naming `file_name` when
-// Draco refuses (e.g. an empty mesh).
+// scalars), with `settings` (as check_draco_settings gives them). `flip_v`: texture
+// coordinates are written as v' = 1 - v (glTF's convention; the chunk's v points up).
+// Triangles with a repeated vertex are left out (Draco's encoder drops them) and counted in `dropped` (a writer under
+// --strict refuses them before, with first_repeated_vertex). Throws io::Error naming `file_name` when Draco refuses
+// (e.g. an empty mesh).
 DracoEncoded encode_draco(const std::vector<float>& positions, const std::vector<uint32_t>& indices,
-                          const VertexValues& values, const Channels& channels, const WriteOptions& options,
+                          const VertexValues& values, const Channels& channels, const DracoSettings& settings,
                           const std::string& file_name, bool flip_v = false);
 
 // The first triangle of `indices` (3 per triangle) with a repeated vertex, or -1.

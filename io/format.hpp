@@ -6,6 +6,7 @@
 #include "io/byte_stream.hpp"
 #include "io/chunk.hpp"
 
+#include <any>
 #include <array>
 #include <cstdint>
 #include <memory>
@@ -14,6 +15,7 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <typeinfo>
 #include <utility>
 #include <vector>
 
@@ -170,6 +172,34 @@ struct ReadOptions {
     ChannelKinds channels;
 };
 
+// Options that belong to one format (io/draco.hpp's DracoSettings, io/gltf.hpp's
+// GltfSettings): each a small struct that its format defines, documents and checks, held here
+// at most once per type. The generic code carries them without looking inside; a writer reads
+// its own with get<T>(), which gives T's defaults when none was set, and ignores the others.
+class FormatOptions {
+public:
+    // Sets the options of type T, replacing any set before.
+    template <class T>
+    void set(T value) {
+        for (std::any& entry : entries_)
+            if (T* held = std::any_cast<T>(&entry)) {
+                *held = std::move(value);
+                return;
+            }
+        entries_.emplace_back(std::move(value));
+    }
+    // The options of type T that were set, else T's defaults.
+    template <class T>
+    T get() const {
+        for (const std::any& entry : entries_)
+            if (const T* held = std::any_cast<T>(&entry)) return *held;
+        return T{};
+    }
+
+private:
+    std::vector<std::any> entries_;  // at most one of each type
+};
+
 struct WriteOptions {
     uint64_t memory_budget_bytes = uint64_t{256} << 20;  // for writers that weld or spool
     // The budget is --memory divided by this (sort gives its writer a quarter): the --memory a
@@ -190,17 +220,11 @@ struct WriteOptions {
     // with Format::keep_channels), and the material table their material channel indexes.
     Channels channels;
     std::vector<Material> materials;
-    // Draco / glTF
-    int draco_position_bits = 14;  // --draco-qp
-    int draco_normal_bits = 10;    // --draco-qn
-    int draco_texcoord_bits = 12;  // --draco-qt
-    int draco_color_bits = 10;     // --draco-qc: float colours and generic attributes
-    int draco_level = 7;           // --draco-cl, 0–10
-    bool normals = false;          // --normals: write smooth vertex normals where supported
-    // glTF (--compress): KHR_draco_mesh_compression, EXT_meshopt_compression with
-    // KHR_mesh_quantization, or plain accessors.
-    enum class Compression : uint8_t { kDraco, kMeshopt, kNone };
-    Compression compression = Compression::kDraco;
+    // Add area-weighted smooth normals to a mesh without normals of its own, where the format
+    // can (--normals: Draco, glTF).
+    bool normals = false;
+    // Options of one format only (Draco's quantization, glTF's compression); see FormatOptions.
+    FormatOptions format_options;
 };
 
 struct Format {
@@ -216,9 +240,7 @@ struct Format {
     std::unique_ptr<Writer> (*open_writer)(ByteSink& sink, const WriteOptions& options);
     // What the writer keeps or does beyond positions, for the commands' checks and warnings.
     enum Trait : uint8_t {
-        kAlwaysDraco = 2,     // Draco-compressed (reorders triangles; takes --draco-* and --normals)
-        kDracoUnlessOff = 4,  // the same unless --compress meshopt|none (glTF; takes --compress)
-        kWholeMesh = 8,       // the writer holds the whole mesh until finish (WholeMeshBudget)
+        kWholeMesh = 1,  // the writer holds the whole mesh until finish (WholeMeshBudget)
     };
     uint8_t traits = 0;
     // For formats without magic bytes: a weaker test, tried only when no probe and no
@@ -230,6 +252,19 @@ struct Format {
     // The files the writer creates or replaces beside an output at `path` (a .gltf's .bin),
     // so the commands can refuse an output that would overwrite an input. Null: none.
     std::vector<std::string> (*side_files)(const std::string& path, const WriteOptions& options) = nullptr;
+    // Why the writer, with `options`, does not keep the order of the triangles it is given
+    // ("Draco compression reorders triangles"), so that a sorted stream would lose its order;
+    // empty when it keeps it (at least for a stream sorted along WriteOptions::sorted_axis).
+    // Null: it keeps the order.
+    std::string (*reorders_triangles)(const WriteOptions& options) = nullptr;
+    // For a writer that keeps a sorted order but has no place to record
+    // WriteOptions::sorted_axis: why, for the sort command's warning ("glTF has no place for
+    // the sorted axis"). Empty: the file records the axis (or the order is lost anyway).
+    std::string_view sorted_axis_unrecorded = {};
+    // True when the writer, with `options`, reads the format options of `type` (a struct kept
+    // in WriteOptions::format_options), for the commands' warnings about options that do
+    // nothing. Null: it reads none.
+    bool (*takes_options)(const std::type_info& type, const WriteOptions& options) = nullptr;
 };
 
 // All registered formats, in probe priority order.

@@ -1,6 +1,7 @@
 // glTF's format descriptors and content probes; the reader and writer live in
 // io/gltf_reader.cpp and io/gltf_writer.cpp.
 #include "io/gltf.hpp"
+#include "io/draco.hpp"
 #include "io/gltf_internal.hpp"
 
 #include <cstring>
@@ -10,29 +11,52 @@ namespace meshstream::io {
 
 using gltf_detail::kGlbMagic;
 
+namespace {
+
+// Draco's connectivity coder puts the triangles in an order of its own; meshopt's vertex cache
+// order is not applied to a sorted stream.
+std::string gltf_reorders_triangles(const WriteOptions& options) {
+    return gltf_detail::writer_compression(options) == GltfSettings::Compression::kDraco
+               ? "Draco compression reorders triangles"
+               : "";
+}
+
+bool gltf_takes_options(const std::type_info& type, const WriteOptions& options) {
+    return type == typeid(GltfSettings) || (type == typeid(DracoSettings) && gltf_detail::writer_compression(options) ==
+                                                                                 GltfSettings::Compression::kDraco);
+}
+
+constexpr std::string_view kNoSortedAxis = "glTF has no place for the sorted axis";
+
+}  // namespace
+
 const Format kGlbFormat = {
-    "glb",
-    "glb",
-    "binary glTF 2.0 (Draco by default; whole mesh in memory)",
-    &probe_glb,
-    &gltf_detail::open_gltf_reader,
-    &gltf_detail::open_glb_writer,
-    Format::kDracoUnlessOff | Format::kWholeMesh,
-    nullptr,
-    &gltf_detail::gltf_keep_channels,
+    .name = "glb",
+    .extensions = "glb",
+    .description = "binary glTF 2.0 (Draco by default; whole mesh in memory)",
+    .probe = &probe_glb,
+    .open_reader = &gltf_detail::open_gltf_reader,
+    .open_writer = &gltf_detail::open_glb_writer,
+    .traits = Format::kWholeMesh,
+    .keep_channels = &gltf_detail::gltf_keep_channels,
+    .reorders_triangles = &gltf_reorders_triangles,
+    .sorted_axis_unrecorded = kNoSortedAxis,
+    .takes_options = &gltf_takes_options,
 };
 
 const Format kGltfFormat = {
-    "gltf",
-    "gltf",
-    "glTF 2.0 JSON + .bin (Draco by default; whole mesh in memory)",
-    &probe_gltf_json,
-    &gltf_detail::open_gltf_reader,
-    &gltf_detail::open_gltf_writer,
-    Format::kDracoUnlessOff | Format::kWholeMesh,
-    nullptr,
-    &gltf_detail::gltf_keep_channels,
-    &gltf_detail::gltf_side_files,
+    .name = "gltf",
+    .extensions = "gltf",
+    .description = "glTF 2.0 JSON + .bin (Draco by default; whole mesh in memory)",
+    .probe = &probe_gltf_json,
+    .open_reader = &gltf_detail::open_gltf_reader,
+    .open_writer = &gltf_detail::open_gltf_writer,
+    .traits = Format::kWholeMesh,
+    .keep_channels = &gltf_detail::gltf_keep_channels,
+    .side_files = &gltf_detail::gltf_side_files,
+    .reorders_triangles = &gltf_reorders_triangles,
+    .sorted_axis_unrecorded = kNoSortedAxis,
+    .takes_options = &gltf_takes_options,
 };
 
 bool probe_glb(std::span<const std::byte> head, std::optional<uint64_t>) {

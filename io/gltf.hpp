@@ -11,9 +11,10 @@
 // "meshstream <version>". Every triangle is kept, degenerate ones too, except with Draco,
 // whose encoder drops those with a repeated vertex, and those with a NaN or infinite
 // coordinate, which no accessor may hold: both are counted in notes() (errors under --strict).
-// --compress (WriteOptions::compression) chooses the encoding:
+// --compress (GltfSettings, in WriteOptions::format_options) chooses the encoding:
 // - draco (the default): each primitive carries KHR_draco_mesh_compression (in extensionsUsed
-//   and extensionsRequired); its accessors have no bufferView but the decoded count, min and max;
+//   and extensionsRequired), encoded with io/draco.hpp's DracoSettings; its accessors have no
+//   bufferView but the decoded count, min and max (in a build without Draco: none instead);
 // - meshopt: as gltfpack -cc: positions quantized to 14-bit unsigned integers
 //   (KHR_mesh_quantization) over the mesh's bounding cube, the node's translation and uniform
 //   scale undoing it; triangles reordered for the vertex cache (meshopt_optimizeVertexCacheStrip,
@@ -55,6 +56,15 @@ namespace meshstream::io {
 
 extern const Format kGlbFormat;   // "glb": binary glTF
 extern const Format kGltfFormat;  // "gltf": JSON glTF with a .bin side file
+
+// glTF's own write options: set them with WriteOptions::format_options.set(GltfSettings{...});
+// unset, these defaults apply.
+struct GltfSettings {
+    // --compress: KHR_draco_mesh_compression, EXT_meshopt_compression with
+    // KHR_mesh_quantization, or plain accessors.
+    enum class Compression : uint8_t { kDraco, kMeshopt, kNone };
+    Compression compression = Compression::kDraco;
+};
 
 // True for the GLB magic "glTF".
 bool probe_glb(std::span<const std::byte> head, std::optional<uint64_t> file_size);

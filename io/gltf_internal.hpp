@@ -4,6 +4,7 @@
 #pragma once
 
 #include "io/format.hpp"
+#include "io/gltf.hpp"
 
 #include <cstdint>
 #include <memory>
@@ -34,6 +35,9 @@ std::unique_ptr<Writer> open_gltf_writer(ByteSink& sink, const WriteOptions& opt
 // The files a .gltf output at `path` writes beside it: its .bin and its materials' texture
 // images (none when written in place).
 std::vector<std::string> gltf_side_files(const std::string& path, const WriteOptions& options);
+// The compression a glTF writer uses with `options`: GltfSettings's, except that Draco's is
+// none in a build without Draco.
+GltfSettings::Compression writer_compression(const WriteOptions& options);
 // The channels a glTF writer keeps (the same with every --compress).
 Channels gltf_keep_channels(const Channels& in, const WriteOptions& options);
 

@@ -452,7 +452,9 @@ class GltfWriter final : public Writer {
         return indexed_mesh_bytes(vertices, triangles, options.channels) +
                4 * std::bit_ceil(std::max<uint64_t>(2 * vertices, 1024)) +
                vertices * (4 + 2 * uint64_t(CornerLayout(options.channels).bytes())) + triangles * 12 + out +
-               (options.compression == WriteOptions::Compression::kMeshopt ? out + vertices * 16 + triangles * 12 : 0);
+               (writer_compression(options) == GltfSettings::Compression::kMeshopt
+                    ? out + vertices * 16 + triangles * 12
+                    : 0);
     }
     static uint64_t buffer_bytes(uint64_t vertices, uint64_t triangles, const WriteOptions& options) {
         return vertices * vertex_out_bytes(options.channels, options.normals) + triangles * 12;
@@ -478,14 +480,10 @@ public:
           binary_(binary),
           indexer_(sink.name(), "glTF", options.channels, options.strict),
           budget_(sink.name(), options, kWhy) {
-#if !MESHSTREAM_WITH_DRACO
-        if (options_.compression == WriteOptions::Compression::kDraco)
-            options_.compression = WriteOptions::Compression::kNone;
-#endif
-        draco_ = options_.compression == WriteOptions::Compression::kDraco;
-        meshopt_ = options_.compression == WriteOptions::Compression::kMeshopt;
+        draco_ = writer_compression(options_) == GltfSettings::Compression::kDraco;
+        meshopt_ = writer_compression(options_) == GltfSettings::Compression::kMeshopt;
 #if MESHSTREAM_WITH_DRACO
-        if (draco_) check_draco_settings(sink.name(), options_);
+        if (draco_) draco_settings_ = check_draco_settings(sink.name(), options_);
 #endif
         // Written in place (stdout, a pipe, a device), the .gltf has no directory entry of its
         // own that a .bin could sit beside: the buffer goes inside, as a data URI.
@@ -536,6 +534,9 @@ private:
     WriteOptions options_;
     bool binary_;
     bool draco_ = false, meshopt_ = false;
+#if MESHSTREAM_WITH_DRACO
+    DracoSettings draco_settings_;  // checked, when draco_
+#endif
     bool inline_buffer_ = false;  // a .gltf on stdout: the buffer is a base64 data URI
     MeshIndexer indexer_;
     WholeMeshBudget budget_;
@@ -630,7 +631,8 @@ Json GltfWriter::plain_primitive(Document& doc, PartData& d, const Channels& ch,
 
 #if MESHSTREAM_WITH_DRACO
 Json GltfWriter::draco_primitive(Document& doc, PartData& d, const Channels& ch, DracoEncoded* sums) {
-    DracoEncoded enc = encode_draco(d.positions, d.indices, d.values, ch, options_, sink_.name(), /*flip_v=*/true);
+    DracoEncoded enc =
+        encode_draco(d.positions, d.indices, d.values, ch, draco_settings_, sink_.name(), /*flip_v=*/true);
     sums->dropped += enc.dropped;
     sums->flattened += enc.flattened;
     sums->face_count += enc.face_count;
@@ -726,7 +728,7 @@ void GltfWriter::finish_output() {
         }
 #if MESHSTREAM_WITH_DRACO
         if (draco_)
-            for (std::string& note : draco_notes(sums, mesh.triangle_count(), options_))
+            for (std::string& note : draco_notes(sums, mesh.triangle_count(), draco_settings_))
                 notes_.push_back(std::move(note));
 #endif
         Json node = {{"mesh", 0}};
@@ -845,6 +847,14 @@ std::vector<std::string> gltf_side_files(const std::string& path, const WriteOpt
 
 std::unique_ptr<Writer> open_gltf_writer(ByteSink& sink, const WriteOptions& options) {
     return std::make_unique<GltfWriter>(sink, options, false);
+}
+
+GltfSettings::Compression writer_compression(const WriteOptions& options) {
+    const GltfSettings::Compression c = options.format_options.get<GltfSettings>().compression;
+#if !MESHSTREAM_WITH_DRACO
+    if (c == GltfSettings::Compression::kDraco) return GltfSettings::Compression::kNone;
+#endif
+    return c;
 }
 
 Channels gltf_keep_channels(const Channels& in, const WriteOptions&) {

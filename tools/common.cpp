@@ -95,25 +95,31 @@ void note_unused_write_flags(const WriteFlags& flags, const io::Format& output, 
     auto add_to = [](std::string& list, bool set, const char* name) {
         if (set) list += (list.empty() ? "" : ", ") + std::string(name);
     };
-    add_to(draco_given, flags.draco_qp != defaults.draco_qp, "--draco-qp");
-    add_to(draco_given, flags.draco_qn != defaults.draco_qn, "--draco-qn");
-    add_to(draco_given, flags.draco_qt != defaults.draco_qt, "--draco-qt");
-    add_to(draco_given, flags.draco_qc != defaults.draco_qc, "--draco-qc");
-    add_to(draco_given, flags.draco_cl != defaults.draco_cl, "--draco-cl");
+    add_to(draco_given, flags.draco.position_bits != defaults.draco.position_bits, "--draco-qp");
+    add_to(draco_given, flags.draco.normal_bits != defaults.draco.normal_bits, "--draco-qn");
+    add_to(draco_given, flags.draco.texcoord_bits != defaults.draco.texcoord_bits, "--draco-qt");
+    add_to(draco_given, flags.draco.color_bits != defaults.draco.color_bits, "--draco-qc");
+    add_to(draco_given, flags.draco.level != defaults.draco.level, "--draco-cl");
     const bool compress_given = !flags.compress.empty() || flags.no_draco;
     auto verb = [](const std::string& list) { return list.find(',') == std::string::npos ? " applies" : " apply"; };
-    if (output.traits & io::Format::kAlwaysDraco) {
-        if (compress_given && flags.compression() != io::WriteOptions::Compression::kDraco)
+    // Which of these options the output's writer reads, as the format says.
+    io::WriteOptions given_options;
+    given_options.format_options = flags.format_options();
+    auto takes = [&](const std::type_info& type) {
+        return output.takes_options != nullptr && output.takes_options(type, given_options);
+    };
+    const bool takes_draco = takes(typeid(io::DracoSettings)), takes_gltf = takes(typeid(io::GltfSettings));
+    if (takes_draco && !takes_gltf) {  // .drc
+        if (compress_given && flags.compression() != io::GltfSettings::Compression::kDraco)
             warnings.note("unused_option", std::string(flags.no_draco ? "--no-draco" : "--compress") +
                                                " applies to glTF outputs; a .drc is always Draco");
         return;
     }
-    if (output.traits & io::Format::kDracoUnlessOff) {
-        const auto c = flags.compression();
-        if (!draco_given.empty() && c != io::WriteOptions::Compression::kDraco)
-            warnings.note("unused_option", draco_given + verb(draco_given) +
-                                               " to Draco compression: ignored with --compress " +
-                                               (c == io::WriteOptions::Compression::kMeshopt ? "meshopt" : "none"));
+    if (takes_gltf) {
+        if (!draco_given.empty() && !takes_draco)
+            warnings.note("unused_option",
+                          draco_given + verb(draco_given) + " to Draco compression: ignored with --compress " +
+                              (flags.compression() == io::GltfSettings::Compression::kMeshopt ? "meshopt" : "none"));
         return;
     }
     std::string given;
@@ -346,20 +352,22 @@ io::WriteOptions WriteFlags::options(const ReadFlags& read, const io::Format& ou
                                                                        : kStreamingMemory;
     o.tmpdir = read.tmpdir;
     o.strict = read.strict;
-    o.compression = compression();
     o.normals = normals;
-    o.draco_position_bits = draco_qp;
-    o.draco_normal_bits = draco_qn;
-    o.draco_texcoord_bits = draco_qt;
-    o.draco_color_bits = draco_qc;
-    o.draco_level = draco_cl;
+    o.format_options = format_options();
     return o;
 }
 
-io::WriteOptions::Compression WriteFlags::compression() const {
-    if (compress == "meshopt") return io::WriteOptions::Compression::kMeshopt;
-    if (compress == "none" || (compress.empty() && no_draco)) return io::WriteOptions::Compression::kNone;
-    return io::WriteOptions::Compression::kDraco;
+io::GltfSettings::Compression WriteFlags::compression() const {
+    if (compress == "meshopt") return io::GltfSettings::Compression::kMeshopt;
+    if (compress == "none" || (compress.empty() && no_draco)) return io::GltfSettings::Compression::kNone;
+    return io::GltfSettings::Compression::kDraco;
+}
+
+io::FormatOptions WriteFlags::format_options() const {
+    io::FormatOptions o;
+    o.set(draco);
+    o.set(io::GltfSettings{compression()});
+    return o;
 }
 
 void add_write_flags(CLI::App* cmd, WriteFlags& flags) {
@@ -387,26 +395,27 @@ void add_write_flags(CLI::App* cmd, WriteFlags& flags) {
     cmd->add_flag("--no-draco", flags.no_draco, "the same as --compress none")->group(kWebOptions)->excludes(compress);
     cmd->add_flag("--normals", flags.normals, "add smooth vertex normals to a mesh without normals of its own")
         ->group(kWebOptions);
-    cmd->add_option("--draco-qp", flags.draco_qp, "Draco position quantization bits, 1-30 (default 14)")
+    cmd->add_option("--draco-qp", flags.draco.position_bits, "Draco position quantization bits, 1-30 (default 14)")
         ->type_name("N")
         ->group(kWebOptions)
         ->check(CLI::Range(1, 30));
     // Draco's octahedral normal coder needs 2 bits or more (1 fails inside its encoder).
-    cmd->add_option("--draco-qn", flags.draco_qn, "Draco normal quantization bits, 2-30 (default 10)")
+    cmd->add_option("--draco-qn", flags.draco.normal_bits, "Draco normal quantization bits, 2-30 (default 10)")
         ->type_name("N")
         ->group(kWebOptions)
         ->check(CLI::Range(2, 30));
-    cmd->add_option("--draco-qt", flags.draco_qt, "Draco texture coordinate quantization bits, 1-30 (default 12)")
+    cmd->add_option("--draco-qt", flags.draco.texcoord_bits,
+                    "Draco texture coordinate quantization bits, 1-30 (default 12)")
         ->type_name("N")
         ->group(kWebOptions)
         ->check(CLI::Range(1, 30));
-    cmd->add_option("--draco-qc", flags.draco_qc,
+    cmd->add_option("--draco-qc", flags.draco.color_bits,
                     "Draco bits of float colours and named scalars, 1-30 (default 10)\n"
                     "Integer colours and scalars are kept exactly")
         ->type_name("N")
         ->group(kWebOptions)
         ->check(CLI::Range(1, 30));
-    cmd->add_option("--draco-cl", flags.draco_cl,
+    cmd->add_option("--draco-cl", flags.draco.level,
                     "Draco compression level 0-10 (default 7)\n"
                     "Higher is slower, and usually smaller")
         ->type_name("N")

@@ -4,7 +4,9 @@
 #pragma once
 
 #include "io/byte_stream.hpp"
+#include "io/draco.hpp"
 #include "io/format.hpp"
+#include "io/gltf.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -63,9 +65,11 @@ struct WriteFlags {
     std::string compress;   // --compress draco|meshopt|none (glTF); empty: not given (Draco)
     bool no_draco = false;  // --no-draco: the old spelling of --compress none
     bool normals = false;
-    int draco_qp = 14, draco_qn = 10, draco_qt = 12, draco_qc = 10, draco_cl = 7;
+    io::DracoSettings draco;  // --draco-qp, --draco-qn, --draco-qt, --draco-qc, --draco-cl
     // The glTF compression asked for: --compress, --no-draco, else Draco.
-    io::WriteOptions::Compression compression() const;
+    io::GltfSettings::Compression compression() const;
+    // The formats' own options given (Draco's and glTF's), for WriteOptions::format_options.
+    io::FormatOptions format_options() const;
     // With --memory's budget, or, when it is not given, the default for `output`: the
     // whole-mesh one for a writer that holds the whole mesh (Format::kWholeMesh), else
     // kStreamingMemory.

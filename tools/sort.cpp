@@ -163,13 +163,16 @@ void run_sort(const SortOptions& opt) {
     const auto t0 = std::chrono::steady_clock::now();
     if (opt.json) refuse_json_with_stdout_output(opt.output);
     const io::Format& out_format = resolve_output_format(opt.output, opt.write);
-    // Draco's connectivity coder reorders the triangles: the sorted order would be lost.
-    if ((out_format.traits & io::Format::kAlwaysDraco) ||
-        ((out_format.traits & io::Format::kDracoUnlessOff) &&
-         opt.write.compression() == io::WriteOptions::Compression::kDraco))
-        throw UsageError((opt.output == "-" ? std::string("<stdout>") : opt.output) +
-                         ": Draco compression reorders triangles, so the sorted order would be lost: write STL, PLY "
-                         "or OBJ (or glTF with --compress meshopt or none)");
+    // A writer that puts the triangles in an order of its own (Draco's connectivity coder)
+    // would lose the sorted order.
+    if (out_format.reorders_triangles != nullptr) {
+        io::WriteOptions given;
+        given.format_options = opt.write.format_options();
+        if (const std::string why = out_format.reorders_triangles(given); !why.empty())
+            throw UsageError((opt.output == "-" ? std::string("<stdout>") : opt.output) + ": " + why +
+                             ", so the sorted order would be lost: write STL, PLY or OBJ (or glTF with --compress "
+                             "meshopt or none)");
+    }
     // Runs go beside a file output; a pipe or device (/dev/null, /dev/stdout) has no directory
     // of its own for them: /dev is memory.
     const bool output_stream = io::is_stream(opt.output);
@@ -317,12 +320,12 @@ void run_sort(const SortOptions& opt) {
     Warnings warnings;
     note_unused_write_flags(opt.write, *out.format, opt.output, warnings);
     if (!dropped.empty()) warnings.note("channels_dropped", dropped_channels_text(dropped, *out.format, so.channels));
-    // Only STL, PLY and OBJ have a place for the axis (a header or a comment).
-    if (out.format->traits & io::Format::kDracoUnlessOff)
-        warnings.note("sorted_axis_not_recorded",
-                      std::string(opt.output == "-" ? "<stdout>" : opt.output) +
-                          ": glTF has no place for the sorted axis: decimate it with --sorted-axis " + "xyz"[axis] +
-                          ", or sort to STL, PLY or OBJ, which record it");
+    // STL, PLY and OBJ have a place for the axis (a header or a comment); glTF has none.
+    if (!out.format->sorted_axis_unrecorded.empty())
+        warnings.note("sorted_axis_not_recorded", std::string(opt.output == "-" ? "<stdout>" : opt.output) + ": " +
+                                                      std::string(out.format->sorted_axis_unrecorded) +
+                                                      ": decimate it with --sorted-axis " + "xyz"[axis] +
+                                                      ", or sort to STL, PLY or OBJ, which record it");
     note_dropped_triangles(dropped_triangles(in), "removed (--clean)", warnings);
     note_input_changes(end_header, input_name, warnings);
     warnings.print();

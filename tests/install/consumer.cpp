@@ -11,6 +11,12 @@
 #include <meshstream/io/read_indexed.hpp>
 #include <meshstream/io/triangle_input.hpp>
 #include <meshstream/sort/external_sort.hpp>
+#if MESHSTREAM_WITH_DRACO
+#include <meshstream/io/draco.hpp>
+#endif
+#if MESHSTREAM_WITH_GLTF
+#include <meshstream/io/gltf.hpp>
+#endif
 
 #include <cstdio>
 

@@ -6,6 +6,7 @@
 
 #include "io/error.hpp"
 #include "io/format.hpp"
+#include "io/gltf.hpp"
 #include "web_test_util.hpp"
 
 #include <gtest/gtest.h>
@@ -120,7 +121,7 @@ TEST(DracoWriter, RoundTripStaysWithinQuantizationBound) {
     for (int qp : {14, 11}) {
         SCOPED_TRACE(qp);
         io::WriteOptions o;
-        o.draco_position_bits = qp;
+        o.format_options.set(io::DracoSettings{.position_bits = qp});
         write_soup(bunny, dir / "b.drc", o);
         io::MeshHeader h;
         Soup back = read_soup(dir / "b.drc", io::TriangleChunk::kDefaultCapacity, &h);
@@ -140,7 +141,7 @@ TEST(DracoWriter, LevelZeroIsSequentialAndDecoderAgrees) {
     TempDir dir;
     Soup elephant = read_soup(fixture("drc/elephant_normals_sequential_cl0.drc"));
     io::WriteOptions o;
-    o.draco_level = 0;
+    o.format_options.set(io::DracoSettings{.level = 0});
     o.normals = true;
     write_soup(elephant, dir / "e.drc", o);
     io::MeshHeader h;
@@ -245,7 +246,7 @@ TEST(DracoWriter, RefusesExtentsItsQuantizerCannotStepThrough) {
     }
     // Fewer bits step through the tiny mesh exactly (its corners are the box's corners).
     io::WriteOptions o;
-    o.draco_position_bits = 8;
+    o.format_options.set(io::DracoSettings{.position_bits = 8});
     write_soup(tiny, dir / "tiny.drc", o);
     EXPECT_EQ(read_soup(dir / "tiny.drc").xyz, tiny.xyz);
 }
@@ -275,19 +276,91 @@ TEST(DracoWriter, SaysWhenQuantizationFlattensTriangles) {
             << notes[0];
     }
     io::WriteOptions fine;
-    fine.draco_position_bits = 20;
+    fine.format_options.set(io::DracoSettings{.position_bits = 20});
     EXPECT_TRUE(write_soup(box, dir / "fine.drc", fine).empty());
     EXPECT_TRUE(write_soup(read_soup(fixture("bunny_from_draco.bin.stl")), dir / "bunny.drc").empty());
 }
 
 TEST(DracoWriter, RejectsOutOfRangeSettings) {
+    // Each setting at the first value past either end of its range, for both writers that take
+    // DracoSettings: refused when the output is opened, naming the file and the setting, and
+    // nothing is left behind. The ends themselves are accepted.
     TempDir dir;
+    struct Case {
+        io::DracoSettings settings;
+        const char* message;
+    };
+    const Case cases[] = {
+        {{.position_bits = 0}, "--draco-qp must be 1-30, got 0"},
+        {{.position_bits = 31}, "--draco-qp must be 1-30, got 31"},
+        {{.normal_bits = 1}, "--draco-qn must be 2-30, got 1"},
+        {{.normal_bits = 31}, "--draco-qn must be 2-30, got 31"},
+        {{.texcoord_bits = 0}, "--draco-qt must be 1-30, got 0"},
+        {{.texcoord_bits = 31}, "--draco-qt must be 1-30, got 31"},
+        {{.color_bits = 0}, "--draco-qc must be 1-30, got 0"},
+        {{.color_bits = 31}, "--draco-qc must be 1-30, got 31"},
+        {{.level = -1}, "--draco-cl must be 0-10, got -1"},
+        {{.level = 11}, "--draco-cl must be 0-10, got 11"},
+    };
+    for (const char* name : {"x.drc", "x.glb"})
+        for (const Case& c : cases) {
+            SCOPED_TRACE(std::string(name) + ": " + c.message);
+            io::WriteOptions o;
+            o.format_options.set(c.settings);
+            try {
+                io::open_output(dir / name, {}, o);
+                ADD_FAILURE() << "accepted";
+            } catch (const io::Error& e) {
+                EXPECT_EQ(std::string(e.what()), dir / name + ": " + c.message);
+            }
+            EXPECT_TRUE(fs::is_empty(dir.path()));
+        }
+    // glTF without Draco takes no Draco settings, so it does not check them.
+    io::WriteOptions plain;
+    plain.format_options.set(io::DracoSettings{.position_bits = 31});
+    plain.format_options.set(io::GltfSettings{io::GltfSettings::Compression::kNone});
+    EXPECT_NO_THROW(io::open_output(dir / "plain.glb", {}, plain));
+    io::WriteOptions ends;
+    ends.memory_budget_bytes = uint64_t{64} << 30;  // 30 bits' coding tables take about 4 GiB
+    ends.format_options.set(
+        io::DracoSettings{.position_bits = 30, .normal_bits = 2, .texcoord_bits = 1, .color_bits = 30, .level = 0});
+    EXPECT_NO_THROW(io::open_output(dir / "ends.drc", {}, ends));
+}
+
+TEST(FormatOptions, HoldOneSetOfEachFormatsOptionsAndGiveDefaultsOtherwise) {
     io::WriteOptions o;
-    o.draco_level = 11;
-    EXPECT_THROW(io::open_output(dir / "x.drc", {}, o), io::Error);
-    o.draco_level = 7;
-    o.draco_position_bits = 31;
-    EXPECT_THROW(io::open_output(dir / "x.drc", {}, o), io::Error);
+    EXPECT_EQ(o.format_options.get<io::DracoSettings>().position_bits, 14);
+    EXPECT_EQ(o.format_options.get<io::GltfSettings>().compression, io::GltfSettings::Compression::kDraco);
+    o.format_options.set(io::DracoSettings{.position_bits = 9});
+    o.format_options.set(io::GltfSettings{io::GltfSettings::Compression::kMeshopt});
+    o.format_options.set(io::DracoSettings{.normal_bits = 5});  // replaces the first
+    const io::WriteOptions copy = o;
+    const io::DracoSettings d = copy.format_options.get<io::DracoSettings>();
+    EXPECT_EQ(d.position_bits, 14);
+    EXPECT_EQ(d.normal_bits, 5);
+    EXPECT_EQ(copy.format_options.get<io::GltfSettings>().compression, io::GltfSettings::Compression::kMeshopt);
+}
+
+TEST(DracoWriter, SettingsReachTheGltfWritersDracoEncoding) {
+    // The Draco settings given for a .glb reach its KHR_draco_mesh_compression primitive: the
+    // reader reports the primitive's quantization, and 11 bits move the coordinates of the
+    // bunny (a 14-bit Draco decode, which 14 bits keep) within their bound.
+    TempDir dir;
+    Soup bunny = read_soup(fixture("bunny_from_draco.bin.stl"));
+    double worst[2] = {0, 0};
+    for (int i = 0; i < 2; ++i) {
+        const int qp = i == 0 ? 14 : 11;
+        SCOPED_TRACE(qp);
+        io::WriteOptions o;
+        o.format_options.set(io::DracoSettings{.position_bits = qp});
+        write_soup(bunny, dir / "b.glb", o);
+        io::MeshHeader h;
+        Soup back = read_soup(dir / "b.glb", io::TriangleChunk::kDefaultCapacity, &h);
+        EXPECT_NE(note(h, "draco").find("positions " + std::to_string(qp) + " bits"), std::string::npos)
+            << note(h, "draco");
+        worst[i] = expect_within_quantization_bound(bunny, back, qp);
+    }
+    EXPECT_GT(worst[1], worst[0]);
 }
 
 }  // namespace
@@ -395,7 +468,7 @@ TEST(DracoChannels, QuantizationFlagsBoundTheirChannels) {
     for (int bits : {6, 16}) {
         SCOPED_TRACE(bits);
         io::WriteOptions o;
-        o.draco_normal_bits = o.draco_texcoord_bits = o.draco_color_bits = bits;
+        o.format_options.set(io::DracoSettings{.normal_bits = bits, .texcoord_bits = bits, .color_bits = bits});
         write_mesh(box, dir / "b.drc", o);
         write_mesh(scalars, dir / "s.drc", o);
         ChannelErrors e = compare_meshes(box, read_mesh(dir / "b.drc"), 0.5 / 16383 * 1.0001);

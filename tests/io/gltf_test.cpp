@@ -27,6 +27,7 @@
 
 using namespace web_test;
 using nlohmann::json;
+using Compression = meshstream::io::GltfSettings::Compression;
 
 namespace {
 
@@ -770,7 +771,7 @@ TEST(GltfWriter, PlainGlbRoundTripsExactlyWithNormals) {
     TempDir dir;
     Soup mesh = read_soup(fixture("drc/elephant_normals_sequential_cl0.drc"));  // 5558 triangles
     io::WriteOptions o;
-    o.compression = io::WriteOptions::Compression::kNone;
+    o.format_options.set(io::GltfSettings{Compression::kNone});
     o.normals = true;
     write_soup(mesh, dir / "p.glb", o);
     expect_valid(dir / "p.glb");
@@ -786,7 +787,7 @@ TEST(GltfWriter, GltfWithBinSideFileBothWaysIsValid) {
     for (bool draco : {false, true}) {
         SCOPED_TRACE(draco);
         io::WriteOptions o;
-        o.compression = draco ? io::WriteOptions::Compression::kDraco : io::WriteOptions::Compression::kNone;
+        o.format_options.set(io::GltfSettings{draco ? Compression::kDraco : Compression::kNone});
         o.normals = draco;
         write_soup(mesh, dir / "scene one.gltf", o);
         ASSERT_TRUE(fs::exists(dir / "scene one.bin"));
@@ -805,7 +806,7 @@ TEST(GltfWriter, RefusesToReplaceAnotherFilesBuffer) {
     TempDir dir;
     Soup cube = read_soup(fixture("cube.bin.stl"));
     io::WriteOptions o;
-    o.compression = io::WriteOptions::Compression::kNone;
+    o.format_options.set(io::GltfSettings{Compression::kNone});
     // scene.bin exists, scene.gltf does not: the .bin is someone else's and stays as it was.
     std::ofstream(dir / "scene.bin") << "not mine";
     try {
@@ -839,7 +840,7 @@ TEST(GltfWriter, SmallestIndexTypeAndEmptyMeshAreValid) {
     TempDir dir;
     Soup cube = read_soup(fixture("cube.bin.stl"));
     io::WriteOptions o;
-    o.compression = io::WriteOptions::Compression::kNone;
+    o.format_options.set(io::GltfSettings{Compression::kNone});
     write_soup(cube, dir / "cube.glb", o);
     expect_valid(dir / "cube.glb");
     json doc = glb_json(dir / "cube.glb");
@@ -906,7 +907,7 @@ TEST(GltfWriter, AGltfIntoAFifoCarriesItsBuffer) {
     std::string got;
     std::thread reader([&] { got = slurp(dir / "ff.gltf"); });
     io::WriteOptions o;
-    o.compression = io::WriteOptions::Compression::kNone;
+    o.format_options.set(io::GltfSettings{Compression::kNone});
     write_soup(read_soup(fixture("cube.bin.stl")), dir / "ff.gltf", o);
     reader.join();
     const json doc = json::parse(got);
@@ -919,7 +920,7 @@ TEST(GltfWriter, RefusesPastMemoryBudget) {
     Soup bunny = read_soup(fixture("bunny_from_draco.bin.stl"));
     for (bool draco : {false, true}) {
         io::WriteOptions o;
-        o.compression = draco ? io::WriteOptions::Compression::kDraco : io::WriteOptions::Compression::kNone;
+        o.format_options.set(io::GltfSettings{draco ? Compression::kDraco : Compression::kNone});
         o.memory_budget_bytes = 1 << 20;
         try {
             write_soup(bunny, dir / "b.glb", o);
@@ -938,7 +939,7 @@ TEST(GltfWriter, MeshoptGlbIsValidAndWithinQuantizationBound) {
     TempDir dir;
     Soup bunny = read_soup(fixture("bunny_from_draco.bin.stl"));
     io::WriteOptions o;
-    o.compression = io::WriteOptions::Compression::kMeshopt;
+    o.format_options.set(io::GltfSettings{Compression::kMeshopt});
     write_soup(bunny, dir / "b.glb", o);
     expect_valid(dir / "b.glb");
     json doc = glb_json(dir / "b.glb");
@@ -976,7 +977,7 @@ TEST(GltfWriter, MeshoptGltfWithNormalsAndItsBinIsValid) {
     TempDir dir;
     Soup mesh = read_soup(fixture("drc/elephant_normals_sequential_cl0.drc"));
     io::WriteOptions o;
-    o.compression = io::WriteOptions::Compression::kMeshopt;
+    o.format_options.set(io::GltfSettings{Compression::kMeshopt});
     o.normals = true;
     write_soup(mesh, dir / "e.gltf", o);
     expect_valid(dir / "e.gltf");
@@ -1001,7 +1002,7 @@ TEST(GltfWriter, MeshoptKeepsTheTriangleOrderOfASortedStream) {
     TempDir dir;
     Soup mesh = read_soup(fixture("drc/elephant_normals_sequential_cl0.drc"));
     io::WriteOptions o;
-    o.compression = io::WriteOptions::Compression::kMeshopt;
+    o.format_options.set(io::GltfSettings{Compression::kMeshopt});
     o.sorted_axis = 1;
     const Quantization q(mesh, 14);
     auto in_order = [&](const Soup& back) {
@@ -1040,17 +1041,17 @@ Soup degenerate_soup() {
 TEST(GltfWriter, KeepsDegenerateAndZeroAreaTrianglesExceptWithDraco) {
     TempDir dir;
     const Soup soup = degenerate_soup();
-    for (auto c : {io::WriteOptions::Compression::kNone, io::WriteOptions::Compression::kMeshopt}) {
+    for (auto c : {Compression::kNone, Compression::kMeshopt}) {
         SCOPED_TRACE(int(c));
         io::WriteOptions o;
-        o.compression = c;
+        o.format_options.set(io::GltfSettings{c});
         EXPECT_TRUE(write_soup(soup, dir / "d.glb", o).empty());
         const json report = validate(dir / "d.glb");
         EXPECT_EQ(report["issues"]["numErrors"], 0) << report.dump(2);
         EXPECT_EQ(report["issues"]["numWarnings"], 0) << report.dump(2);
         Soup back = read_soup(dir / "d.glb");
         ASSERT_EQ(back.triangles(), 5u);
-        if (c == io::WriteOptions::Compression::kNone)
+        if (c == Compression::kNone)
             EXPECT_EQ(back.xyz, soup.xyz);
         else
             EXPECT_EQ(triangle_multiset(back).size(), 5u);
@@ -1073,7 +1074,7 @@ TEST(GltfWriter, KeepsDegenerateAndZeroAreaTrianglesExceptWithDraco) {
                                              ": triangle 1 has two corners at one vertex, which Draco's "
                                              "encoder drops (--strict)");
     }
-    strict.compression = io::WriteOptions::Compression::kMeshopt;
+    strict.format_options.set(io::GltfSettings{Compression::kMeshopt});
     EXPECT_TRUE(write_soup(soup, dir / "s.glb", strict).empty()) << "glTF holds them: nothing to refuse";
 }
 
@@ -1082,9 +1083,9 @@ TEST(GltfWriter, LeavesOutNonFiniteTrianglesOrRefusesThemUnderStrict) {
     Soup soup = degenerate_soup();
     soup.xyz[9 * 2 + 4] = NAN;
     soup.xyz[9 * 4] = -INFINITY;
-    for (auto c : {io::WriteOptions::Compression::kNone, io::WriteOptions::Compression::kMeshopt}) {
+    for (auto c : {Compression::kNone, Compression::kMeshopt}) {
         io::WriteOptions o;
-        o.compression = c;
+        o.format_options.set(io::GltfSettings{c});
         const std::vector<std::string> notes = write_soup(soup, dir / "n.glb", o);
         ASSERT_EQ(notes.size(), 1u);
         EXPECT_EQ(notes[0], dir / "n.glb" +
@@ -1194,21 +1195,21 @@ TEST(GltfChannels, BoxTexturedRoundTripsThroughEveryCompression) {
     TempDir dir;
     const Mesh ref = read_mesh(fixture("gltf/BoxTextured.glb"));
     struct Case {
-        io::WriteOptions::Compression compression;
+        Compression compression;
         const char* name;
         double position, normal;  // meshopt: 14-bit positions, 8-bit octahedral normals; Draco: 14 and 10 bits
     } cases[] = {
-        {io::WriteOptions::Compression::kNone, "none.glb", 0, 0},
-        {io::WriteOptions::Compression::kNone, "none.gltf", 0, 0},
-        {io::WriteOptions::Compression::kMeshopt, "meshopt.glb", 0.5 / 16383, 2.0 / 127},
-        {io::WriteOptions::Compression::kMeshopt, "meshopt.gltf", 0.5 / 16383, 2.0 / 127},
-        {io::WriteOptions::Compression::kDraco, "draco.glb", 0.5 / 16383, 4.0 / 1023},
-        {io::WriteOptions::Compression::kDraco, "draco.gltf", 0.5 / 16383, 4.0 / 1023},
+        {Compression::kNone, "none.glb", 0, 0},
+        {Compression::kNone, "none.gltf", 0, 0},
+        {Compression::kMeshopt, "meshopt.glb", 0.5 / 16383, 2.0 / 127},
+        {Compression::kMeshopt, "meshopt.gltf", 0.5 / 16383, 2.0 / 127},
+        {Compression::kDraco, "draco.glb", 0.5 / 16383, 4.0 / 1023},
+        {Compression::kDraco, "draco.gltf", 0.5 / 16383, 4.0 / 1023},
     };
     for (const Case& c : cases) {
         SCOPED_TRACE(c.name);
         io::WriteOptions o;
-        o.compression = c.compression;
+        o.format_options.set(io::GltfSettings{c.compression});
         EXPECT_TRUE(write_mesh(ref, dir / c.name, o).empty());
         expect_valid_allowing(dir / c.name, kNpot);
         const Mesh back = read_mesh(dir / c.name);
@@ -1218,7 +1219,7 @@ TEST(GltfChannels, BoxTexturedRoundTripsThroughEveryCompression) {
         EXPECT_EQ(e.material_mismatches, 0u);
         EXPECT_LE(e.normal, c.normal * 1.0001 + 1e-7);
         // Texture coordinates: float with meshopt and none, 12 bits over their range with Draco.
-        EXPECT_LE(e.uv, c.compression == io::WriteOptions::Compression::kDraco ? 0.5 * 6 / 4095 * 1.0001 + 1e-6 : 0.0);
+        EXPECT_LE(e.uv, c.compression == Compression::kDraco ? 0.5 * 6 / 4095 * 1.0001 + 1e-6 : 0.0);
         EXPECT_EQ(texture_bytes(back), box_png());
         EXPECT_EQ(std::set<uint64_t>(back.ids.begin(), back.ids.end()).size(), 24u) << "seams kept";
     }
@@ -1239,22 +1240,21 @@ TEST(GltfChannels, ColoursKeepTheirTypeAndValues) {
         ASSERT_TRUE(ref.header.channels.color);
         const io::ColorFormat format = *ref.header.channels.color;
         const bool is_float = format.type == io::ScalarType::kFloat32;
-        for (auto [c, name] : {std::pair{io::WriteOptions::Compression::kNone, "c.glb"},
-                               std::pair{io::WriteOptions::Compression::kMeshopt, "c.gltf"},
-                               std::pair{io::WriteOptions::Compression::kDraco, "d.glb"}}) {
+        for (auto [c, name] : {std::pair{Compression::kNone, "c.glb"}, std::pair{Compression::kMeshopt, "c.gltf"},
+                               std::pair{Compression::kDraco, "d.glb"}}) {
             SCOPED_TRACE(name);
             io::WriteOptions o;
-            o.compression = c;
+            o.format_options.set(io::GltfSettings{c});
             write_mesh(ref, dir / name, o);
             expect_valid(dir / name);
             const Mesh back = read_mesh(dir / name);
             ASSERT_TRUE(back.header.channels.color);
             EXPECT_EQ(*back.header.channels.color, format);
-            const bool draco = c == io::WriteOptions::Compression::kDraco;
+            const bool draco = c == Compression::kDraco;
             // Positions: 14 bits over the largest extent.
             float lo = ref.xyz[0], hi = ref.xyz[0];
             for (float x : ref.xyz) lo = std::min(lo, x), hi = std::max(hi, x);
-            const double step = c == io::WriteOptions::Compression::kNone ? 0 : (hi - lo) / 16383.0;
+            const double step = c == Compression::kNone ? 0 : (hi - lo) / 16383.0;
             const ChannelErrors e = compare_meshes(ref, back, step);
             EXPECT_EQ(e.unmatched, 0u);
             // Integer colours are stored as they are; float ones quantized by Draco (--draco-qc
@@ -1271,7 +1271,7 @@ TEST(GltfChannels, ColoursKeepTheirTypeAndValues) {
     for (int i = 0; i < 50 * 12; ++i) m.colors.push_back(float(rng() % 65536) / 65535.0f);
     write_mesh(m, dir / "u16.glb", [] {
         io::WriteOptions o;
-        o.compression = io::WriteOptions::Compression::kNone;
+        o.format_options.set(io::GltfSettings{Compression::kNone});
         return o;
     }());
     expect_valid(dir / "u16.glb");
@@ -1291,16 +1291,16 @@ TEST(GltfChannels, DracoElephantsNormalsThroughEveryCompression) {
     TempDir dir;
     const Mesh ref = read_mesh(fixture("drc/elephant_normals_sequential_cl0.drc"));
     ASSERT_TRUE(ref.header.channels.normal);
-    for (auto [c, name, normal] : {std::tuple{io::WriteOptions::Compression::kNone, "n.glb", 0.0},
-                                   std::tuple{io::WriteOptions::Compression::kMeshopt, "m.glb", 2.0 / 127},
-                                   std::tuple{io::WriteOptions::Compression::kDraco, "d.glb", 4.0 / 1023}}) {
+    for (auto [c, name, normal] :
+         {std::tuple{Compression::kNone, "n.glb", 0.0}, std::tuple{Compression::kMeshopt, "m.glb", 2.0 / 127},
+          std::tuple{Compression::kDraco, "d.glb", 4.0 / 1023}}) {
         SCOPED_TRACE(name);
         io::WriteOptions o;
-        o.compression = c;
+        o.format_options.set(io::GltfSettings{c});
         write_mesh(ref, dir / name, o);
         expect_valid(dir / name);
         const Mesh back = read_mesh(dir / name);
-        const ChannelErrors e = compare_meshes(ref, back, c == io::WriteOptions::Compression::kNone ? 0 : 2e-4);
+        const ChannelErrors e = compare_meshes(ref, back, c == Compression::kNone ? 0 : 2e-4);
         EXPECT_EQ(e.unmatched, 0u);
         EXPECT_LE(e.normal, normal);
     }
@@ -1321,20 +1321,18 @@ TEST(GltfChannels, PlyNormalsAndTextureCoordinatesThroughGlbAndDrc) {
         for (float x : ref.uvs) ulo = std::min(ulo, x), uhi = std::max(uhi, x);
         struct Case {
             const char* name;
-            io::WriteOptions::Compression compression;
+            Compression compression;
             double position, normal, uv;
         } cases[] = {
-            {"p.glb", io::WriteOptions::Compression::kNone, 0, 0, 0},
-            {"m.glb", io::WriteOptions::Compression::kMeshopt, step, 2.0 / 127, 0},
-            {"d.glb", io::WriteOptions::Compression::kDraco, step, 4.0 / 1023,
-             0.5 * (uhi - ulo) / 4095 * 1.0001 + 1e-6},
-            {"d.drc", io::WriteOptions::Compression::kDraco, step, 4.0 / 1023,
-             0.5 * (uhi - ulo) / 4095 * 1.0001 + 1e-6},
+            {"p.glb", Compression::kNone, 0, 0, 0},
+            {"m.glb", Compression::kMeshopt, step, 2.0 / 127, 0},
+            {"d.glb", Compression::kDraco, step, 4.0 / 1023, 0.5 * (uhi - ulo) / 4095 * 1.0001 + 1e-6},
+            {"d.drc", Compression::kDraco, step, 4.0 / 1023, 0.5 * (uhi - ulo) / 4095 * 1.0001 + 1e-6},
         };
         for (const Case& c : cases) {
             SCOPED_TRACE(c.name);
             io::WriteOptions o;
-            o.compression = c.compression;
+            o.format_options.set(io::GltfSettings{c.compression});
             EXPECT_TRUE(write_mesh(ref, dir / c.name, o).empty());
             if (std::string(c.name).ends_with(".glb")) expect_valid(dir / c.name);
             const Mesh back = read_mesh(dir / c.name);
@@ -1359,12 +1357,11 @@ TEST(GltfRender, WrittenFilesRenderInThreeJs) {
     TempDir dir;
     Soup bunny = read_soup(fixture("bunny_from_draco.bin.stl"));
     std::vector<std::string> files;
-    for (auto [c, name] : {std::pair{io::WriteOptions::Compression::kMeshopt, "meshopt.glb"},
-                           std::pair{io::WriteOptions::Compression::kDraco, "draco.glb"},
-                           std::pair{io::WriteOptions::Compression::kNone, "plain.glb"},
-                           std::pair{io::WriteOptions::Compression::kMeshopt, "meshopt.gltf"}}) {
+    for (auto [c, name] :
+         {std::pair{Compression::kMeshopt, "meshopt.glb"}, std::pair{Compression::kDraco, "draco.glb"},
+          std::pair{Compression::kNone, "plain.glb"}, std::pair{Compression::kMeshopt, "meshopt.gltf"}}) {
         io::WriteOptions o;
-        o.compression = c;
+        o.format_options.set(io::GltfSettings{c});
         o.normals = true;
         write_soup(bunny, dir / name, o);
         files.push_back(dir / name);
@@ -1375,11 +1372,11 @@ TEST(GltfRender, WrittenFilesRenderInThreeJs) {
     const size_t boxes = files.size();
     files.push_back(fixture("gltf/BoxTextured.glb"));
     const Mesh box = read_mesh(fixture("gltf/BoxTextured.glb"));
-    for (auto [c, name] : {std::pair{io::WriteOptions::Compression::kMeshopt, "box_meshopt.glb"},
-                           std::pair{io::WriteOptions::Compression::kDraco, "box_draco.glb"},
-                           std::pair{io::WriteOptions::Compression::kNone, "box_plain.gltf"}}) {
+    for (auto [c, name] :
+         {std::pair{Compression::kMeshopt, "box_meshopt.glb"}, std::pair{Compression::kDraco, "box_draco.glb"},
+          std::pair{Compression::kNone, "box_plain.gltf"}}) {
         io::WriteOptions o;
-        o.compression = c;
+        o.format_options.set(io::GltfSettings{c});
         write_mesh(box, dir / name, o);
         files.push_back(dir / name);
     }
