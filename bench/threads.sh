@@ -5,7 +5,9 @@
 # the median of RUNS runs of wall time, CPU time (user + system) and peak RSS, the speed-up over
 # one thread, and the symmetric RMS error against the input (meshstream compare, % of the bbox
 # diagonal) with its ratio to one thread's. The load average before and after the runs is printed
-# too: the machine may be shared, and wall times mean little when it is busy.
+# too: the machine may be shared, and wall times mean little when it is busy. Where meshstream-mpi
+# is built (MPI found) and mpirun is there, `mpirun -n K meshstream-mpi decimate` is measured too
+# (rows mpi-K; its peak RSS is the largest rank's, its CPU time every rank's and mpirun's).
 #
 #   bench/threads.sh                        # 10 M generated mesh at 10 % and 1 %, 1 and 2 threads
 #   SIZES=1000000 RUNS=1 THREADS="1 2 4" bench/threads.sh
@@ -18,6 +20,8 @@
 #   THREADS    --threads values (default "1 2"; the first is the reference of the ratios)
 #   RUNS       runs per measurement, median reported (default 3)
 #   MESHOPT    0 to leave out meshoptimizer (default 1)
+#   MPI_RANKS  ranks of the meshstream-mpi rows (default 2; empty: none)
+#   RMS        0 to leave out the error measurement (a compare of each output; default 1)
 #   DECIMATE_ARGS  extra options for `meshstream decimate`
 # Needs: cmake, g++, libmeshoptimizer-dev, GNU time (/usr/bin/time) and python3.
 set -euo pipefail
@@ -31,6 +35,8 @@ RATIOS=${RATIOS:-"0.1 0.01"}
 THREADS=${THREADS:-"1 2"}
 RUNS=${RUNS:-3}
 MESHOPT=${MESHOPT:-1}
+MPI_RANKS=${MPI_RANKS-2}
+RMS=${RMS:-1}
 DECIMATE_ARGS=${DECIMATE_ARGS:-}
 
 die() { echo "bench/threads.sh: $*" >&2; exit 1; }
@@ -44,10 +50,16 @@ cmake --build "$BUILD_DIR" -j"$(nproc)" >/dev/null || die "build failed (run: cm
 ms=$BUILD_DIR/tools/meshstream
 gen=$BUILD_DIR/tools/meshstream-gen
 ref_meshopt=$BUILD_DIR/bench/ref_meshopt
+ms_mpi=$BUILD_DIR/tools/meshstream-mpi
 "$ms" decimate --help | grep -q -- --threads || die "'meshstream decimate' has no --threads in this build"
 if [ "$MESHOPT" = 1 ] && [ ! -x "$ref_meshopt" ]; then
   echo "bench/threads.sh: no ref_meshopt (apt-get install libmeshoptimizer-dev): meshoptimizer rows skipped" >&2
   MESHOPT=0
+fi
+
+if [ -n "$MPI_RANKS" ] && { [ ! -x "$ms_mpi" ] || ! command -v mpirun >/dev/null; }; then
+  echo "bench/threads.sh: no meshstream-mpi or mpirun (apt-get install libopenmpi-dev openmpi-bin): MPI rows skipped" >&2
+  MPI_RANKS=""
 fi
 
 results=$BENCH_DIR/threads.tsv
@@ -90,6 +102,7 @@ for n in $SIZES; do
     target=$(python3 -c "print(round($ratio * $count))")
     tools=""
     for t in $THREADS; do tools="$tools threads-$t"; done
+    for k in $MPI_RANKS; do tools="$tools mpi-$k"; done
     if [ "$MESHOPT" = 1 ]; then tools="$tools meshopt"; fi
     # Alternated run by run, so that a change in the machine's load reaches every tool alike.
     for ((r = 0; r < RUNS; r++)); do
@@ -97,6 +110,8 @@ for n in $SIZES; do
         out=$BENCH_DIR/threads_${n}_${ratio}_$tool.stl
         case $tool in
           threads-*) m=$(measure "$ms" -q decimate $DECIMATE_ARGS --threads "${tool#threads-}" "$in" "$out" --ratio "$ratio") ;;
+          mpi-*) m=$(measure env OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 mpirun --oversubscribe \
+                       -n "${tool#mpi-}" "$ms_mpi" -q decimate $DECIMATE_ARGS "$in" "$out" --ratio "$ratio") ;;
           meshopt) m=$(measure "$ref_meshopt" "$in" "$out" --target "$target") ;;
         esac
         echo "== $tool $n ratio $ratio run $((r + 1)): $m" >&2
@@ -106,7 +121,9 @@ for n in $SIZES; do
     for tool in $tools; do
       out=$BENCH_DIR/threads_${n}_${ratio}_$tool.stl
       out_n=$("$ms" -q info --json "$out" | python3 -c 'import json,sys; print(json.load(sys.stdin)["triangles"])')
-      printf '%s\t%s\t%s\t%s\t%s\n' "$n" "$ratio" "$tool" "$out_n" "$(rms_of "$in" "$out")" >>"$results"
+      rms=-
+      if [ "$RMS" = 1 ]; then rms=$(rms_of "$in" "$out"); fi
+      printf '%s\t%s\t%s\t%s\t%s\n' "$n" "$ratio" "$tool" "$out_n" "$rms" >>"$results"
     done
   done
 done
@@ -127,10 +144,11 @@ table, ref = [], {}
 for n, ratio, tool, out, rms in rows:
     m = med[(n, ratio, tool)]
     wall, cpu, rss = (statistics.median(x[i] for x in m) for i in range(3))
-    if (n, ratio) not in ref: ref[(n, ratio)] = (wall, float(rms))
+    value = None if rms == "-" else float(rms)
+    if (n, ratio) not in ref: ref[(n, ratio)] = (wall, value)
     w1, r1 = ref[(n, ratio)]
     table.append([n, ratio, tool, out, f"{wall:.2f}", f"{cpu:.2f}", f"{rss / 1024:.0f}", f"{w1 / wall:.2f}", rms,
-                  f"{float(rms) / r1:.3f}"])
+                  "-" if value is None or not r1 else f"{value / r1:.3f}"])
 widths = [max(len(str(r[i])) for r in table + [head]) for i in range(len(head))]
 print(" | ".join(h.ljust(w) for h, w in zip(head, widths)))
 print("-|-".join("-" * w for w in widths))

@@ -16,9 +16,10 @@ jobs=$(nproc 2>/dev/null || echo 2)
 as_root() { if [ "$(id -u)" = 0 ]; then "$@"; else sudo "$@"; fi; }
 
 # Debian packages: build tools, libraries, and the real clients the tests check output with
-# (draco_decoder; Chromium renders the GLBs the tests write with three.js).
+# (draco_decoder; Chromium renders the GLBs the tests write with three.js); OpenMPI for
+# meshstream-mpi and its tests (mpirun).
 packages="cmake g++ make pkg-config libgtest-dev zlib1g-dev libdraco-dev draco libtinygltf-dev \
-nlohmann-json3-dev libcli11-dev libmeshoptimizer-dev chromium"
+nlohmann-json3-dev libcli11-dev libmeshoptimizer-dev chromium libopenmpi-dev openmpi-bin"
 command -v node >/dev/null 2>&1 || packages="$packages nodejs"
 command -v npm >/dev/null 2>&1 || packages="$packages npm"
 missing=""

@@ -6,9 +6,12 @@
 
 namespace meshstream::tools {
 
+class RangeProcesses;
+
 void add_info(CLI::App& app);
 void add_convert(CLI::App& app);
-void add_decimate(CLI::App& app);
+// `processes`: meshstream-mpi's, the input cut into one range per process (no --threads).
+void add_decimate(CLI::App& app, RangeProcesses* processes = nullptr);
 void add_sort(CLI::App& app);
 void add_compare(CLI::App& app);
 

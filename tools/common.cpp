@@ -535,7 +535,8 @@ std::vector<std::string> Warnings::lines() const {
 }
 
 void Warnings::print() const {
-    for (const std::string& line : lines()) std::fprintf(stderr, "meshstream: warning: %s\n", line.c_str());
+    for (const std::string& line : lines())
+        std::fprintf(stderr, "%s: warning: %s\n", global().program.c_str(), line.c_str());
 }
 
 std::string human_count(double n, int significant_digits) {

@@ -131,6 +131,7 @@ void note_input_changes(const io::MeshHeader& header, const std::string& input_n
 // Global flags (set by main before a subcommand runs).
 struct Global {
     bool quiet = false;
+    std::string program = "meshstream";  // the name diagnostics start with
 };
 Global& global();
 
@@ -189,7 +190,7 @@ public:
     };
     // In the order print() writes them; text without the count.
     std::vector<Line> all() const;
-    // The lines print() writes, without the "meshstream: warning: " prefix.
+    // The lines print() writes, without the "PROGRAM: warning: " prefix (Global::program).
     std::vector<std::string> lines() const;
     void print() const;
 

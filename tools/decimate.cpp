@@ -373,7 +373,67 @@ nlohmann::ordered_json report_error(const DecimateOptions& opt, const DecimateFa
     return {{"bbox_diagonal", r.diagonal}, {"hausdorff", r.hausdorff()}, {"mean", r.mean()}, {"rms", r.rms()}};
 }
 
-void run_decimate(const DecimateOptions& opt) {
+// The read loop decimate reads through: the decimator keeps positions only, so the reader stores
+// no attribute (a coloured PLY then costs what a plain one does), while the header still lists
+// what is dropped.
+io::ReadOptions decimate_read_options(const DecimateOptions& opt) {
+    io::ReadOptions read = opt.read.options();
+    read.channels = io::ChannelKinds::none();
+    return read;
+}
+
+// meshstream-mpi, every process but the first: the range process 0's plan gives it, decimated
+// and sent to process 0 (which reports everything, failures included).
+void decimate_one_range(const DecimateOptions& opt, RangeProcesses& processes) {
+    const std::optional<RangePlan> plan = processes.receive_plan();
+    if (!plan || processes.rank() >= plan->ranges) return;
+    const io::ReadOptions read = decimate_read_options(opt);
+    RangesJob job;
+    job.open = [&] { return open_triangle_input(opt.input, opt.read, read, Command::kDecimate); };
+    job.make_decimator = [](const decimate::Options& o) {
+        static const io::InputCount kNoCount;  // a range takes a ratio
+        return make_decimator(o, kNoCount);
+    };
+    job.options = plan->options;
+    job.cut_triangles = plan->cut_triangles;
+    job.ranges = plan->ranges;
+    job.stop_at_forced_write = plan->stop_at_forced_write;
+    processes.send([&](RangeSink& sink, std::atomic<bool>& stop) { run_range(job, processes.rank() - 1, sink, stop); });
+}
+
+// meshstream-mpi, process 0: the other processes wait for the plan, so they are told once,
+// whatever happens: the plan, or (when this ends without one, a failure included) that there is
+// nothing for them to do.
+class PlanSharing {
+public:
+    explicit PlanSharing(RangeProcesses* processes) : processes_(processes) {}
+    PlanSharing(const PlanSharing&) = delete;
+    PlanSharing& operator=(const PlanSharing&) = delete;
+    ~PlanSharing() { share(std::nullopt); }
+    void share(const std::optional<RangePlan>& plan) {
+        if (processes_ && !shared_) processes_->share_plan(plan);
+        shared_ = true;
+    }
+
+private:
+    RangeProcesses* processes_;
+    bool shared_ = false;
+};
+
+void run_decimate(const DecimateOptions& opt, RangeProcesses* processes) {
+    if (processes && processes->rank() > 0) return decimate_one_range(opt, *processes);
+    PlanSharing sharing(processes);
+    if (processes) {
+        // Every process opens the input by its name, and each decimates a range of it as read.
+        if (!is_regular_file(opt.input))
+            throw UsageError((opt.input == "-" ? std::string("<stdin>") : opt.input) +
+                             ": meshstream-mpi decimates a file that every rank opens by its name; give a file, "
+                             "not '-' or a pipe");
+        if (opt.sort == "always")
+            throw UsageError(
+                "--sort always: a sorted stream is decimated by one process; sort first (meshstream sort IN "
+                "SORTED.stl), then decimate the sorted file");
+    }
     const auto start = std::chrono::steady_clock::now();
     if (opt.json) refuse_json_with_stdout_output(opt.output);
     // Checked before any work: the comparison re-reads both files once the output is done.
@@ -386,10 +446,7 @@ void run_decimate(const DecimateOptions& opt) {
             throw UsageError(name + ": --report needs to re-read both files; it does not work with '-' or a pipe");
         }
     }
-    // The decimator keeps positions only: the reader stores no attribute (a coloured PLY then
-    // costs what a plain one does), while the header still lists what is dropped.
-    io::ReadOptions read = opt.read.options();
-    read.channels = io::ChannelKinds::none();
+    const io::ReadOptions read = decimate_read_options(opt);
     io::TriangleInput in = open_triangle_input(opt.input, opt.read, read, Command::kDecimate);
     std::optional<CountPass> counted;
     if (opt.target && !in.header().triangle_count && is_regular_file(opt.input)) {
@@ -407,13 +464,15 @@ void run_decimate(const DecimateOptions& opt) {
     const std::optional<uint64_t> input_count = counted ? counted->count.promised : header.triangle_count;
     const decimate::Options options = decimation_options(opt, header, input_name, in.format().name, input_count);
 
-    // --threads: a file cut into ranges of triangles (decimate_threads.hpp) by the count its
-    // header states or estimates, else by one counted in a first pass (not for a file too small
-    // to be cut, judged by its size: any format takes 8 bytes a triangle or more, uncompressed).
+    // --threads (or meshstream-mpi's processes): a file cut into ranges of triangles
+    // (decimate_threads.hpp) by the count its header states or estimates, else by one counted in
+    // a first pass (not for a file too small to be cut, judged by its size: any format takes 8
+    // bytes a triangle or more, uncompressed).
     const bool sort_first = opt.sort == "always";
     std::optional<uint64_t> cut_count = input_count ? input_count : header.triangle_estimate;
+    const unsigned cut_into = processes ? processes->count() : opt.threads;
     unsigned ranges = 1;
-    if (opt.threads > 1 && !sort_first && is_regular_file(opt.input)) {
+    if (cut_into > 1 && !sort_first && is_regular_file(opt.input)) {
         const uint64_t bytes = in.source().stored_size().value_or(0);
         const uint64_t most = in.source().gzip() ? std::numeric_limits<uint64_t>::max() : bytes / 8;
         if (!cut_count && most >= 2 * uint64_t(opt.buffer)) {
@@ -423,7 +482,7 @@ void run_decimate(const DecimateOptions& opt) {
             in = open_triangle_input(opt.input, opt.read, read, Command::kDecimate);
             cut_count = counted->count.promised;
         }
-        if (cut_count) ranges = range_count(opt.threads, *cut_count, opt.buffer);
+        if (cut_count) ranges = range_count(cut_into, *cut_count, opt.buffer);
     }
     // The ranges' outputs wait in --tmpdir: where nothing can be written, one thread decimates.
     std::string one_thread_why;
@@ -492,6 +551,14 @@ void run_decimate(const DecimateOptions& opt) {
         job.stop_at_forced_write = may_restart;
         // Output that cannot be taken back is held until no range can call for a sort any more.
         job.seams_after_ranges = may_restart && gate.holding();
+        if (processes) {
+            // Range k but the last by process k+1; the last, and the seam pass, here.
+            job.remote_ranges = ranges - 1;
+            job.receive_remote = [processes](std::span<RangeSink* const> sinks, std::atomic<bool>& stop) {
+                processes->receive(sinks, stop);
+            };
+            sharing.share(RangePlan{job.options, job.cut_triangles, job.ranges, job.stop_at_forced_write});
+        }
         threaded = decimate_in_ranges(job, emit, [&](uint64_t done) { progress.update(done); });
         if (threaded->stopped_at_forced_write) {
             outcome.kind = SortOutcome::Kind::kSorted;
@@ -499,6 +566,7 @@ void run_decimate(const DecimateOptions& opt) {
             outcome.attempt_seconds = seconds_since(attempt);
         }
     } else if (!sort_first) {
+        sharing.share(std::nullopt);  // the other processes have nothing to do
         decimator = make_decimator(options, decimator_count(in.count()));
         const auto attempt = std::chrono::steady_clock::now();
         const ChunkSource next = [&](io::TriangleChunk& chunk) {
@@ -526,6 +594,7 @@ void run_decimate(const DecimateOptions& opt) {
         }
     }
     if (sort_first || outcome.kind == SortOutcome::Kind::kSorted) {
+        sharing.share(std::nullopt);
         threaded.reset();  // the sorted stream is decimated by one thread
         if (decimator || outcome.kind == SortOutcome::Kind::kSorted) {
             // The attempt is dropped: its decimator, and its output (held back, or a
@@ -586,7 +655,8 @@ void run_decimate(const DecimateOptions& opt) {
     DecimateFacts facts;
     facts.stats = threaded ? threaded->stats : decimator->stats();
     facts.ratio = threaded ? threaded->ratio : decimator->ratio();
-    facts.threads = threaded ? ranges : 1;
+    facts.threads = threaded && !processes ? ranges : 1;
+    if (processes) facts.processes = threaded ? ranges : 1;
     if (threaded) {
         facts.seam_buffer = seam_buffer(opt.buffer);
         facts.seam_forced_writes = threaded->seams.forced_writes;
@@ -642,7 +712,7 @@ void run_decimate(const DecimateOptions& opt) {
 
 }  // namespace
 
-void add_decimate(CLI::App& app) {
+void add_decimate(CLI::App& app, RangeProcesses* processes) {
     auto opt = std::make_shared<DecimateOptions>();
     CLI::App* cmd = app.add_subcommand(
         "decimate", "decimate a mesh of any size in one streaming pass, in fixed memory\n" + kInOutText);
@@ -679,14 +749,16 @@ void add_decimate(CLI::App& app) {
     cmd->add_flag("--report", opt->report,
                   "measure the output's error against the input at the end\n"
                   "Hausdorff, mean and RMS distance, as compare does");
-    cmd->add_option("--threads", opt->threads,
-                    "decimate a file in N ranges at once (default: every core, " + std::to_string(every_core()) +
-                        " here)\n"
-                        "Each range of at least --buffer triangles is decimated with its own --buffer, and the seams "
-                        "between them are joined by one more pass; the output depends on N, not on timing. 1: one "
-                        "stream decimator")
-        ->type_name("N")
-        ->check(CLI::Range(1u, 1024u));
+    if (!processes)
+        cmd->add_option(
+               "--threads", opt->threads,
+               "decimate a file in N ranges at once (default: every core, " + std::to_string(every_core()) +
+                   " here)\n"
+                   "Each range of at least --buffer triangles is decimated with its own --buffer, and the seams "
+                   "between them are joined by one more pass; the output depends on N, not on timing. 1: one "
+                   "stream decimator")
+            ->type_name("N")
+            ->check(CLI::Range(1u, 1024u));
     add_json_flag(cmd, opt->json);
     add_write_flags(cmd, opt->write);
     add_read_flags(cmd, opt->read);
@@ -715,7 +787,7 @@ void add_decimate(CLI::App& app) {
     cmd->footer(
         "  meshstream decimate scan.ply scan.glb -r 0.01\n"
         "  meshstream sort big.stl - | meshstream decimate - out.glb -r 0.01");
-    cmd->callback([opt] { run_decimate(*opt); });
+    cmd->callback([opt, processes] { run_decimate(*opt, processes); });
 }
 
 }  // namespace meshstream::tools

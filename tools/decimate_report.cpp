@@ -63,7 +63,8 @@ void note_decimate_warnings(const DecimateFacts& f, Warnings& warnings) {
                       "the seam pass's buffer (" + std::to_string(f.seam_buffer) +
                           " triangles) filled with triangles along seams it could not join yet: " +
                           std::to_string(f.seam_forced_writes) +
-                          " triangles force-written at full resolution there; raise --buffer or lower --threads");
+                          " triangles force-written at full resolution there; raise --buffer or " +
+                          (f.processes > 0 ? "use fewer ranks" : "lower --threads"));
     if (s.sort_violations > 0)
         warnings.note(
             "not_sorted_as_stated",
@@ -185,6 +186,7 @@ nlohmann::ordered_json decimate_details_json(const DecimateFacts& f) {
     if (f.weld_eps > 0) j["weld"] = {{"size", f.weld_eps}, {"vertices_merged", s.vertices_merged}};
     if (f.count_pass_seconds) j["count_pass_seconds"] = *f.count_pass_seconds;
     j["threads"] = f.threads;
+    if (f.processes > 0) j["processes"] = f.processes;
     if (f.sort.kind == SortOutcome::Kind::kSorted)
         j["sorted_first"] = {{"axis", std::string(1, axis_name(f.sort.axis))},
                              {"requested", f.sort.requested},
@@ -214,6 +216,11 @@ void print_decimate_summary(const DecimateFacts& f, const std::string& output, d
         std::fprintf(stderr,
                      "  threads %u: %u ranges decimated at once, seams joined by a pass through %zu triangles\n",
                      f.threads, f.threads, f.seam_buffer);
+    if (f.processes > 1)
+        std::fprintf(stderr,
+                     "  processes %u: %u ranges decimated at once by MPI ranks, seams joined by a pass through %zu "
+                     "triangles\n",
+                     f.processes, f.processes, f.seam_buffer);
     if (f.weld_eps > 0)
         std::fprintf(stderr, "  weld %.6g: %llu vertices merged\n", f.weld_eps, (unsigned long long)s.vertices_merged);
     if (f.used_axis)

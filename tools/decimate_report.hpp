@@ -51,6 +51,9 @@ struct DecimateFacts {
     // --threads: the ranges decimated at once (1: one stream decimator), the seam pass's buffer
     // and the triangles it force-wrote (kept apart from stats.forced_writes, the ranges').
     unsigned threads = 1;
+    // meshstream-mpi: the processes (MPI ranks) that decimated one range each (0: none; threads
+    // is then 1).
+    unsigned processes = 0;
     size_t seam_buffer = 0;
     uint64_t seam_forced_writes = 0;
 };

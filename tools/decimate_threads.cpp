@@ -17,27 +17,22 @@
 #include <limits>
 #include <memory>
 #include <mutex>
+#include <stdexcept>
 #include <thread>
+#include <utility>
 #include <vector>
 
 namespace meshstream::tools {
 namespace {
 
-// The pieces of a range's output, in the order the seam pass reads them: the faces on P_in read
-// first (along the seam with the range before), the decimated rest, the faces on P_in read last
-// (along the seam with the range after). Read in this order, each seam's two strips meet in the
-// seam pass at once, and they are joined before the buffer has to hold anything else.
-enum class Piece : uint8_t { kFirstSeam, kInterior, kLastSeam };
-
 // One range's output on its way to the seam pass: positions in a temporary file, and for each
 // chunk its piece, triangle count and the input triangles each of them stands for. Appended to by
-// the range's thread, read by the seam pass's.
-class RangeSpool {
+// the range's thread (or the thread receiving a remote range), read by the seam pass's.
+class RangeSpool final : public RangeSink {
 public:
     explicit RangeSpool(const std::string& tmpdir) : file_(tmpdir, "meshstream-range") {}
 
-    // The range's thread: one chunk of `piece`, each triangle standing for `weight` input triangles.
-    void append(const io::TriangleChunk& chunk, double weight, Piece piece) {
+    void append(const io::TriangleChunk& chunk, double weight, Piece piece) override {
         file_.write(chunk.xyz().data(), chunk.xyz().size_bytes());
         file_.flush();  // the seam pass reads the file directly (pread), not this object's buffer
         const std::lock_guard lock(mutex_);
@@ -45,13 +40,15 @@ public:
         written_ += chunk.xyz().size_bytes();
         changed_.notify_all();
     }
-    // The range's thread, last: its outcome (null when it ended normally or was stopped).
-    void close(std::exception_ptr error) {
+    void progress(uint64_t decimated) override { decimated_ = decimated; }
+    void close(const RangeOutcome& outcome, std::exception_ptr error) override {
         const std::lock_guard lock(mutex_);
         done_ = true;
+        outcome_ = outcome;
         error_ = std::move(error);
         changed_.notify_all();
     }
+    uint64_t decimated() const { return decimated_; }
     // The seam pass: the next chunk of `piece` into `chunk` (capacity at least the ranges' output
     // chunks) and its weight; false once the range is closed and has no more of it, or when
     // `stop` is set. Calls `waiting` now and then while it waits.
@@ -98,10 +95,14 @@ public:
             lock.lock();
         }
     }
-    // Once the range's thread is joined: its exception, if it failed.
+    // Once the range is closed: its exception, if it failed, and how it ended.
     std::exception_ptr error() {
         const std::lock_guard lock(mutex_);
         return error_;
+    }
+    RangeOutcome outcome() {
+        const std::lock_guard lock(mutex_);
+        return outcome_;
     }
 
 private:
@@ -117,26 +118,43 @@ private:
     std::vector<Chunk> chunks_;
     uint64_t written_ = 0;
     bool done_ = false;
+    RangeOutcome outcome_;
     std::exception_ptr error_;
+    std::atomic<uint64_t> decimated_{0};
     size_t cursor_[3] = {0, 0, 0};  // the seam pass's: the next chunk of each piece to look at
 };
 
-// One range and what its thread found.
+// One range and, for the last one, what its read loop found.
 struct Range {
-    uint64_t start = 0, end = 0;  // passed triangles [start, end) of the read loop
     std::unique_ptr<RangeSpool> spool;
-    std::atomic<uint64_t> decimated{0};  // triangles of the range pushed so far
-    std::atomic<bool> forced{false};     // stopped at a forced write (RangesJob::stop_at_forced_write)
-    uint64_t forced_at = 0;              // triangles of the range read by then
-    decimate::Stats stats;               // once finished
     // The last range reads the whole input: its read loop's figures are the input's.
     io::InputCount count;
     DroppedTriangles dropped;
     io::MeshHeader end_header;
 };
 
-void run_range(const RangesJob& job, unsigned k, Range& range, std::atomic<bool>& stop) {
+// Range k's triangles: [start, end) of the read loop's passed triangles.
+std::pair<uint64_t, uint64_t> range_bounds(const RangesJob& job, unsigned k) {
+    return {job.cut_triangles * k / job.ranges,
+            k + 1 == job.ranges ? std::numeric_limits<uint64_t>::max() : job.cut_triangles * (k + 1) / job.ranges};
+}
+
+// run_range() with the last range's read loop figures kept.
+void run_range(const RangesJob& job, unsigned k, RangeSink& sink, std::atomic<bool>& stop, Range* last);
+
+}  // namespace
+
+void run_range(const RangesJob& job, unsigned k, RangeSink& sink, std::atomic<bool>& stop) {
+    run_range(job, k, sink, stop, nullptr);
+}
+
+namespace {
+
+void run_range(const RangesJob& job, unsigned k, RangeSink& sink, std::atomic<bool>& stop, Range* last) {
     std::exception_ptr error;
+    RangeOutcome outcome;
+    uint64_t decimated = 0;  // triangles of the range pushed so far
+    const auto [start, end] = range_bounds(job, k);
     try {
         io::TriangleInput in = job.open();
         decimate::Options options = job.options;
@@ -150,9 +168,9 @@ void run_range(const RangesJob& job, unsigned k, Range& range, std::atomic<bool>
         uint64_t passed = 0;  // passed triangles of the read loop seen so far
         size_t first = 0;     // the range begins at this triangle of `chunk`
         bool straddles = false;
-        while (passed < range.start && !stop) {
+        while (passed < start && !stop) {
             if (!in.next(chunk)) break;
-            const size_t skip = size_t(std::min<uint64_t>(chunk.size(), range.start - passed));
+            const size_t skip = size_t(std::min<uint64_t>(chunk.size(), start - passed));
             if (axis >= 0)
                 for (size_t i = 0; i < 3 * skip; ++i) {
                     const double v = chunk.xyz()[3 * i + size_t(axis)];
@@ -168,48 +186,43 @@ void run_range(const RangesJob& job, unsigned k, Range& range, std::atomic<bool>
         if (axis >= 0 && k > 0) options.earlier_span = std::array<double, 2>{span_lo, span_hi};
         const std::unique_ptr<decimate::StreamDecimator> decimator = job.make_decimator(options);
         const double weight = 1.0 / decimator->ratio();
-        const decimate::Emit interior = [&](const io::TriangleChunk& c) {
-            range.spool->append(c, weight, Piece::kInterior);
-        };
-        const decimate::Emit first_seam = [&](const io::TriangleChunk& c) {
-            range.spool->append(c, 1.0, Piece::kFirstSeam);
-        };
-        const decimate::Emit last_seam = [&](const io::TriangleChunk& c) {
-            range.spool->append(c, 1.0, Piece::kLastSeam);
-        };
+        const decimate::Emit interior = [&](const io::TriangleChunk& c) { sink.append(c, weight, Piece::kInterior); };
+        const decimate::Emit first_seam = [&](const io::TriangleChunk& c) { sink.append(c, 1.0, Piece::kFirstSeam); };
+        const decimate::Emit last_seam = [&](const io::TriangleChunk& c) { sink.append(c, 1.0, Piece::kLastSeam); };
         // Pushes `c`; false at a forced write that stops the job.
         auto push = [&](const io::TriangleChunk& c) {
             decimator->push(c, interior);
-            range.decimated += c.size();
+            decimated += c.size();
+            sink.progress(decimated);
             if (!job.stop_at_forced_write || decimator->stats().forced_writes == 0) return true;
-            range.forced_at = range.decimated;
-            range.forced = true;
+            outcome.forced_at = decimated;
+            outcome.forced = true;
             stop = true;
             return false;
         };
         bool going = !stop;
         if (straddles && going) {
             part.clear();
-            for (size_t i = first; i < chunk.size() && passed < range.end; ++i, ++passed) part.push_copy(chunk, i);
+            for (size_t i = first; i < chunk.size() && passed < end; ++i, ++passed) part.push_copy(chunk, i);
             going = push(part);
         }
-        while (going && passed < range.end && !stop && in.next(chunk)) {
-            if (chunk.size() <= range.end - passed) {
+        while (going && passed < end && !stop && in.next(chunk)) {
+            if (chunk.size() <= end - passed) {
                 passed += chunk.size();
                 going = push(chunk);
             } else {
                 part.clear();
-                for (size_t i = 0; passed < range.end; ++i, ++passed) part.push_copy(chunk, i);
+                for (size_t i = 0; passed < end; ++i, ++passed) part.push_copy(chunk, i);
                 going = push(part);
             }
         }
         if (going && !stop) {
             decimator->finish_range(interior, first_seam, last_seam);
-            range.stats = decimator->stats();
-            if (k + 1 == job.ranges) {
-                range.count = in.count();
-                range.dropped = dropped_triangles(in);
-                range.end_header = in.header();
+            outcome.stats = decimator->stats();
+            if (last) {
+                last->count = in.count();
+                last->dropped = dropped_triangles(in);
+                last->end_header = in.header();
             }
         }
     } catch (...) {
@@ -218,7 +231,7 @@ void run_range(const RangesJob& job, unsigned k, Range& range, std::atomic<bool>
         error = std::current_exception();
         stop = true;
     }
-    range.spool->close(error);
+    sink.close(outcome, error);
 }
 
 }  // namespace
@@ -232,12 +245,11 @@ size_t seam_buffer(size_t buffer) { return std::max(buffer / 4, std::min<size_t>
 
 RangesResult decimate_in_ranges(const RangesJob& job, const decimate::Emit& emit,
                                 const std::function<void(uint64_t)>& progress) {
+    if (job.remote_ranges >= job.ranges || (job.remote_ranges > 0 && !job.receive_remote))
+        throw std::logic_error("decimate_in_ranges: the last range runs here, and remote ranges need receive_remote");
     std::vector<std::unique_ptr<Range>> ranges;
     for (unsigned k = 0; k < job.ranges; ++k) {
         auto range = std::make_unique<Range>();
-        range->start = job.cut_triangles * k / job.ranges;
-        range->end =
-            k + 1 == job.ranges ? std::numeric_limits<uint64_t>::max() : job.cut_triangles * (k + 1) / job.ranges;
         range->spool = std::make_unique<RangeSpool>(job.tmpdir);
         ranges.push_back(std::move(range));
     }
@@ -263,12 +275,29 @@ RangesResult decimate_in_ranges(const RangesJob& job, const decimate::Emit& emit
                 if (t.joinable()) t.join();
         }
     } joiner{threads, stop};
-    for (unsigned k = 0; k < job.ranges; ++k)
-        threads.emplace_back(run_range, std::cref(job), k, std::ref(*ranges[k]), std::ref(stop));
+    if (job.remote_ranges > 0) {
+        std::vector<RangeSink*> sinks;
+        for (unsigned k = 0; k < job.remote_ranges; ++k) sinks.push_back(ranges[k]->spool.get());
+        threads.emplace_back([&job, &stop, sinks = std::move(sinks)] {
+            try {
+                job.receive_remote(sinks, stop);
+            } catch (...) {
+                // The remote ranges' sinks that are still open are closed with the failure.
+                const std::exception_ptr error = std::current_exception();
+                stop = true;
+                for (RangeSink* sink : sinks) sink->close({}, error);
+            }
+        });
+    }
+    for (unsigned k = job.remote_ranges; k < job.ranges; ++k) {
+        Range* last = k + 1 == job.ranges ? ranges[k].get() : nullptr;
+        threads.emplace_back(
+            [&job, k, &stop, last, sink = ranges[k]->spool.get()] { run_range(job, k, *sink, stop, last); });
+    }
 
     auto tick = [&] {
         uint64_t n = 0;
-        for (const auto& r : ranges) n += r->decimated;
+        for (const auto& r : ranges) n += r->spool->decimated();
         progress(n);
     };
     io::TriangleChunk chunk(job.options.output_chunk_triangles, io::Channels{});
@@ -289,16 +318,18 @@ RangesResult decimate_in_ranges(const RangesJob& job, const decimate::Emit& emit
     for (const auto& r : ranges)
         if (std::exception_ptr error = r->spool->error()) std::rethrow_exception(error);
 
+    std::vector<RangeOutcome> outcomes;
+    for (const auto& r : ranges) outcomes.push_back(r->spool->outcome());
     RangesResult result;
     result.ratio = job.options.ratio;
-    for (const auto& r : ranges)
-        if (r->forced) {
+    for (unsigned k = 0; k < job.ranges; ++k)
+        if (outcomes[k].forced) {
             result.stopped_at_forced_write = true;
-            result.forced_write_at = r->start + r->forced_at;
+            result.forced_write_at = range_bounds(job, k).first + outcomes[k].forced_at;
             return result;
         }
     uint64_t triangles_in = 0;
-    for (const auto& r : ranges) triangles_in += r->stats.triangles_in;
+    for (const RangeOutcome& o : outcomes) triangles_in += o.stats.triangles_in;
     seams->finish_at(
         job.target ? *job.target : decimate::StreamDecimator::expected_output(job.options.ratio, triangles_in), emit);
 
@@ -310,9 +341,9 @@ RangesResult decimate_in_ranges(const RangesJob& job, const decimate::Emit& emit
     t.peak_buffer_triangles = t.peak_vertices = 0;
     t.forced_writes = t.premature_writes = t.degenerate_passed = t.nonmanifold_edges = 0;
     t.vertices_merged = t.vertices_finalized_by_sweep = t.sort_violations = 0;
-    t.sweep_direction = ranges.front()->stats.sweep_direction;
-    for (const auto& r : ranges) {
-        const decimate::Stats& x = r->stats;
+    t.sweep_direction = outcomes.front().stats.sweep_direction;
+    for (const RangeOutcome& o : outcomes) {
+        const decimate::Stats& x = o.stats;
         t.triangles_in += x.triangles_in;
         t.peak_buffer_triangles = std::max(t.peak_buffer_triangles, x.peak_buffer_triangles);
         t.peak_vertices = std::max(t.peak_vertices, x.peak_vertices);

@@ -1,12 +1,15 @@
 // `meshstream decimate --threads N`: one input file decimated by N stream decimators at once.
-// The input's triangles are cut into N contiguous ranges; each range is decimated on its own
-// thread by a stream decimator of its own (decimate::Part::kRange: the vertices still open at
-// the end of a range may be shared with another range, so they stay where they were read), and
-// its output spooled to a temporary file. The calling thread runs the seam pass beside them: a
-// stream decimator (decimate::Part::kSeams) over the ranges' outputs in range order, which
-// decimates the full-resolution strips along the seams down to the ratio once both sides have
-// been read, lands on the exact target count and writes the result. Output is a function of the
-// input, the options and the number of ranges only (never of timing).
+// The input's triangles are cut into N contiguous ranges; each range is decimated by a stream
+// decimator of its own (decimate::Part::kRange: the vertices still open at the end of a range may
+// be shared with another range, so they stay where they were read), and its output spooled to a
+// temporary file. The calling thread runs the seam pass beside them: a stream decimator
+// (decimate::Part::kSeams) over the ranges' outputs in range order, which decimates the
+// full-resolution strips along the seams down to the ratio once both sides have been read, lands
+// on the exact target count and writes the result. Output is a function of the input, the options
+// and the number of ranges only (never of timing, nor of where a range ran).
+//
+// A range runs on a thread of this process, or in another process (`meshstream-mpi`, one range
+// per MPI rank: RangeProcesses) that sends its pieces here as it makes them.
 //
 // Each range re-opens the input and reads its way to its range (no format has to seek): the
 // reading before a range is the serial part besides the seam pass. Memory: N decimators of
@@ -19,10 +22,13 @@
 #include "tools/common.hpp"
 #include "tools/input_filter.hpp"
 
+#include <atomic>
 #include <cstdint>
+#include <exception>
 #include <functional>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 
 namespace meshstream::tools {
@@ -41,6 +47,31 @@ unsigned range_count(unsigned threads, uint64_t triangles, size_t buffer);
 // but the whole of it up to 65 536 triangles (about 13 MB resident).
 size_t seam_buffer(size_t buffer);
 
+// The pieces of a range's output, in the order the seam pass reads them: the faces on P_in read
+// first (along the seam with the range before), the decimated rest, the faces on P_in read last
+// (along the seam with the range after). Read in this order, each seam's two strips meet in the
+// seam pass at once, and they are joined before the buffer has to hold anything else.
+enum class Piece : uint8_t { kFirstSeam, kInterior, kLastSeam };
+
+// How a range ended (besides an exception).
+struct RangeOutcome {
+    decimate::Stats stats;   // its decimator's, when it ran to its end
+    bool forced = false;     // stopped at a forced write (RangesJob::stop_at_forced_write)
+    uint64_t forced_at = 0;  // triangles of the range read by then
+};
+
+// Where a range's output goes, wherever the range runs.
+class RangeSink {
+public:
+    virtual ~RangeSink() = default;
+    // One chunk of `piece`, each triangle standing for `weight` input triangles.
+    virtual void append(const io::TriangleChunk& chunk, double weight, Piece piece) = 0;
+    // The range's triangles pushed into its decimator so far.
+    virtual void progress(uint64_t decimated) = 0;
+    // Last: how the range ended, or its exception (null when it ended normally or was stopped).
+    virtual void close(const RangeOutcome& outcome, std::exception_ptr error) = 0;
+};
+
 struct RangesJob {
     // Opens the input afresh (the read loop with decimate's policy, positions only); called once
     // on each range's thread.
@@ -57,6 +88,42 @@ struct RangesJob {
     // The seam pass starts only once every range is done (an output that cannot be taken back
     // while a forced write may still call for a sort).
     bool seams_after_ranges = false;
+    // Ranges 0 .. remote_ranges-1 run elsewhere (RangeProcesses); the rest on threads here. The
+    // last range, whose read loop counts the whole input, always runs here.
+    unsigned remote_ranges = 0;
+    // With remote ranges: called on a thread of its own with their sinks, in range order; puts
+    // what the ranges send into them and returns once every one is closed. A remote range that
+    // fails or stops at a forced write sets `stop`; once `stop` is set, the ranges still running
+    // are asked to stop.
+    std::function<void(std::span<RangeSink* const>, std::atomic<bool>& stop)> receive_remote;
+};
+
+// What the processes of a spread-out job (meshstream-mpi) share before the ranges start: the
+// job as process 0 planned it. Trivially copyable: every process runs the same build.
+struct RangePlan {
+    decimate::Options options;  // RangesJob::options
+    uint64_t cut_triangles = 0;
+    unsigned ranges = 0;
+    bool stop_at_forced_write = false;
+};
+
+// The processes of one decimation spread over processes (meshstream-mpi): process 0 runs the
+// command, the seam pass and the last range; process r (1 .. ranges-1) decimates range r-1 and
+// sends its pieces to process 0 as it makes them.
+class RangeProcesses {
+public:
+    virtual ~RangeProcesses() = default;
+    virtual unsigned count() const = 0;
+    virtual unsigned rank() const = 0;
+    // Process 0, once: the plan to every other process (none: there is nothing for them to do).
+    virtual void share_plan(const std::optional<RangePlan>& plan) = 0;
+    // Every other process, once: the plan process 0 shared.
+    virtual std::optional<RangePlan> receive_plan() = 0;
+    // Process 0: RangesJob::receive_remote for the ranges of processes 1 .. sinks.size().
+    virtual void receive(std::span<RangeSink* const> sinks, std::atomic<bool>& stop) = 0;
+    // Every other process: the sink that sends its range to process 0; sets `stop` once process
+    // 0 asks the range to stop. Returns once process 0 has received everything it sent.
+    virtual void send(const std::function<void(RangeSink&, std::atomic<bool>& stop)>& run_range) = 0;
 };
 
 struct RangesResult {
@@ -71,10 +138,14 @@ struct RangesResult {
     io::MeshHeader end_header;
 };
 
-// Runs the job: ranges on their threads, the seam pass on this one writing to `emit`, calling
-// `progress` with the input triangles decimated so far. An exception on any thread (the first
-// bad input in the file's order, whichever range met it) is rethrown here once every thread has
-// stopped; nothing is written after it.
+// Decimates range k of `job` on this thread into `sink` (closed at the end, with the exception
+// if it failed), stopping between chunks once `stop` is set.
+void run_range(const RangesJob& job, unsigned k, RangeSink& sink, std::atomic<bool>& stop);
+
+// Runs the job: ranges on their threads (or elsewhere: RangesJob::remote_ranges), the seam pass on this one writing to
+// `emit`, calling `progress` with the input triangles decimated so far. An exception on any thread (the first bad input
+// in the file's order, whichever range met it) is rethrown here once every thread has stopped; nothing is written after
+// it.
 RangesResult decimate_in_ranges(const RangesJob& job, const decimate::Emit& emit,
                                 const std::function<void(uint64_t)>& progress);
 

@@ -1,0 +1,29 @@
+// RangeProcesses over MPI (meshstream-mpi): every rank of MPI_COMM_WORLD is one process of the
+// job. Rank 0 broadcasts the plan; rank r decimates range r-1 and sends its pieces to rank 0 in
+// point-to-point messages, as it makes them; rank 0 spools them for the seam pass (on its own
+// disk: the other ranks need only read the input). Only this file and mpi_main.cpp see MPI.
+#pragma once
+
+#include "tools/decimate_threads.hpp"
+
+#include <mpi.h>
+
+namespace meshstream::tools {
+
+class MpiProcesses final : public RangeProcesses {
+public:
+    // MPI_COMM_WORLD, once MPI is initialized with at least MPI_THREAD_SERIALIZED (rank 0 receives
+    // on a thread of its own while its first thread does no MPI).
+    MpiProcesses();
+    unsigned count() const override { return count_; }
+    unsigned rank() const override { return rank_; }
+    void share_plan(const std::optional<RangePlan>& plan) override;
+    std::optional<RangePlan> receive_plan() override;
+    void receive(std::span<RangeSink* const> sinks, std::atomic<bool>& stop) override;
+    void send(const std::function<void(RangeSink&, std::atomic<bool>& stop)>& run_range) override;
+
+private:
+    unsigned count_ = 1, rank_ = 0;
+};
+
+}  // namespace meshstream::tools
