@@ -319,6 +319,7 @@ void run_sort(const SortOptions& opt) {
     progress.done();
     Warnings warnings;
     note_unused_write_flags(opt.write, *out.format, opt.output, warnings);
+    for (const std::string& note : out.writer->notes()) warnings.note("output_note", note);
     if (!dropped.empty()) warnings.note("channels_dropped", dropped_channels_text(dropped, *out.format, so.channels));
     // STL, PLY and OBJ have a place for the axis (a header or a comment); glTF has none.
     if (!out.format->sorted_axis_unrecorded.empty())

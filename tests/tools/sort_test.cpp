@@ -18,6 +18,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <random>
 #include <thread>
 #include <vector>
@@ -153,6 +154,23 @@ TEST(SortCommand, AGltfOutputSaysItCannotRecordTheAxis) {
         << g.err;
     CliRun p = run("sort --axis y " + dir / "in.stl" + " " + dir / "out.ply", dir);
     EXPECT_EQ(p.err, "");
+}
+
+TEST(SortCommand, SaysWhatTheWriterLeftOut) {
+    // A NaN corner travels through the sort; a glTF cannot store it, and its writer leaves the
+    // triangle out with a note, which sort prints as convert does (never silently dropped).
+    TempDir dir;
+    std::vector<Tri> tris = random_triangles(200, 3);
+    tris[17][4] = std::numeric_limits<float>::quiet_NaN();
+    write_stl(dir / "in.stl", tris);
+    CliRun g = run("sort --axis x --compress meshopt " + dir / "in.stl" + " " + dir / "out.glb", dir);
+    ASSERT_EQ(g.code, 0) << g.err;
+    EXPECT_NE(g.err.find("out.glb: 1 of the 200 triangles have a NaN or infinite coordinate, which glTF cannot store: "
+                         "left out"),
+              std::string::npos)
+        << g.err;
+    CliRun strict = run("sort --axis x --strict --compress meshopt " + dir / "in.stl" + " " + dir / "strict.glb", dir);
+    EXPECT_EQ(strict.code, 1) << strict.err;
 }
 
 TEST(SortCommand, AutoAxisIsTheLongestExtent) {
