@@ -3,7 +3,10 @@
 // ball, with random phases from --seed — marched slab by slab along z, so the triangle soup
 // comes out approximately sorted along z like a scanner pipeline's. --holes removes triangles
 // inside random spheres (scan occlusions); --shuffle writes the triangles in random order,
-// out of core (random buckets in temporary files, each shuffled in memory).
+// out of core (random buckets in temporary files, each shuffled in memory). --color gives every
+// corner an 8-bit RGB colour that is a function of its position (colour_at): smooth bands, and
+// one sharp border (a plane across the solid) where warm colours meet cool ones, so welded
+// corners agree and attribute-aware tools have both kinds of detail to keep.
 //
 // The case table is derived at start-up rather than copied: on each cube face the iso-line
 // cuts off every maximal run of positive corners (so a face with diagonal corners separates
@@ -381,10 +384,22 @@ struct GenOptions {
     std::string output, to;
     uint64_t triangles = 1'000'000;
     uint64_t seed = 1;
-    bool shuffle = false, holes = false, quiet = false;
+    bool shuffle = false, holes = false, quiet = false, color = false;
     unsigned threads = 0;  // 0: one per core
     std::string tmpdir;
 };
+
+// --color: the colour (RGB, 0..1, on the 8-bit grid) at a position of [-1, 1]³. Bands: a sine
+// across x and y, about 3 periods over the solid; the border: the plane z = 0.2, warm above,
+// cool below.
+void colour_at(const float* p, float* rgba) {
+    const double t = 0.5 + 0.5 * std::sin(9.0 * p[0] + 6.0 * p[1]);
+    const bool warm = p[2] >= 0.2f;
+    const double r = warm ? 0.95 : 0.10 + 0.25 * t, g = 0.20 + 0.60 * t, b = warm ? 0.10 + 0.25 * t : 0.95;
+    for (const auto& [i, v] : {std::pair{0, r}, std::pair{1, g}, std::pair{2, b}})
+        rgba[i] = float(std::round(v * 255) / 255);
+    rgba[3] = 1;
+}
 
 int run(const GenOptions& opt) {
     auto start = std::chrono::steady_clock::now();
@@ -397,8 +412,15 @@ int run(const GenOptions& opt) {
     io::WriteOptions wo;
     wo.tmpdir = opt.tmpdir;
     wo.comment = "meshstream-gen marching cubes";
+    if (opt.color) wo.channels.color = io::ColorFormat{io::ScalarType::kUInt8, false};
     io::Output out = io::open_output(opt.output, opt.to, wo);
-    io::TriangleChunk chunk;
+    io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, wo.channels);
+    // The chunk's last triangle, pushed: its corners' colours (--color).
+    auto colour_last = [&] {
+        if (!opt.color) return;
+        const size_t i = chunk.size() - 1;
+        for (int k = 0; k < 3; ++k) colour_at(&chunk.xyz()[9 * i + 3 * size_t(k)], chunk.color_at(i) + 4 * k);
+    };
     auto flush = [&] {
         out.write(chunk);
         chunk.clear();
@@ -407,6 +429,7 @@ int run(const GenOptions& opt) {
     if (!opt.shuffle) {
         count = march_parallel(table, shape, n, holes, threads, [&](const float* tri) {
             std::memcpy(chunk.push_slot(), tri, 9 * sizeof(float));
+            colour_last();
             if (chunk.full()) flush();
         });
     } else {
@@ -434,6 +457,7 @@ int run(const GenOptions& opt) {
             }
             for (size_t i = 0; i < m; ++i) {
                 std::memcpy(chunk.push_slot(), &data[9 * i], 9 * sizeof(float));
+                colour_last();
                 if (chunk.full()) flush();
             }
             file.reset();
@@ -443,9 +467,9 @@ int run(const GenOptions& opt) {
     out.finish();
     double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (!opt.quiet)
-        std::fprintf(stderr, "meshstream-gen: %llu triangles (grid %d³%s%s) in %.2f s, %.2f M triangles/s -> %s\n",
-                     (unsigned long long)count, n, opt.holes ? ", holes" : "", opt.shuffle ? ", shuffled" : "", seconds,
-                     double(count) / seconds / 1e6, opt.output.c_str());
+        std::fprintf(stderr, "meshstream-gen: %llu triangles (grid %d³%s%s%s) in %.2f s, %.2f M triangles/s -> %s\n",
+                     (unsigned long long)count, n, opt.holes ? ", holes" : "", opt.shuffle ? ", shuffled" : "",
+                     opt.color ? ", coloured" : "", seconds, double(count) / seconds / 1e6, opt.output.c_str());
     return 0;
 }
 
@@ -474,6 +498,9 @@ int main(int argc, char** argv) {
         ->check(tools::whole_number(0, "a whole number"));
     app.add_flag("--shuffle", opt.shuffle, "write the triangles in random order (out of core)");
     app.add_flag("--holes", opt.holes, "punch 40 holes into the surface, like occlusions in a scan");
+    app.add_flag("--color", opt.color,
+                 "an 8-bit RGB colour per corner, a function of its position: smooth bands and one sharp border\n"
+                 "For formats that hold vertex colours (PLY, OBJ, Draco, glTF)");
     app.add_option("--to", opt.to,
                    "output format, instead of the extension's (e.g. ply)\nOne of: " + io::format_names(true))
         ->type_name("FMT")
@@ -512,6 +539,18 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "meshstream-gen: %s: cannot tell the output format from the name (use --to, one of: %s)\n",
                      name.c_str(), io::format_names(true).c_str());
         return 2;
+    }
+    if (opt.color) {
+        const io::Format* format =
+            opt.to.empty() ? io::format_for_extension(opt.output, true) : io::find_format(opt.to);
+        io::Channels coloured;
+        coloured.color = io::ColorFormat{};
+        if (!io::writable_channels(*format, coloured, {}).color) {
+            std::fprintf(stderr,
+                         "meshstream-gen: %s: --color: %s holds no vertex colours (PLY, OBJ, Draco and glTF do)\n",
+                         opt.output == "-" ? "<stdout>" : opt.output.c_str(), std::string(format->name).c_str());
+            return 2;
+        }
     }
     try {
         return tools::run(opt);

@@ -12,9 +12,12 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -142,6 +145,51 @@ TEST(GenMesh, SameSeedSameBytesAcrossThreadCounts) {
     ASSERT_EQ(gen(dir, "-q -n 20000 --seed 2 " + (dir.path() / "c.stl").string()).exit_code, 0);
     EXPECT_EQ(slurp(dir.path() / "a.stl"), slurp(dir.path() / "b.stl"));
     EXPECT_NE(slurp(dir.path() / "a.stl"), slurp(dir.path() / "c.stl"));
+}
+
+TEST(GenMesh, ColorIsAFunctionOfPositionWithBandsAndOneSharpBorder) {
+    TempDir dir;
+    const fs::path ply = dir.path() / "c.ply";
+    GenRun r = gen(dir, "-n 20000 --color " + ply.string());
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.err.find("coloured"), std::string::npos) << r.err;
+    io::Input in = io::open_input(ply.string());
+    ASSERT_TRUE(in.reader->header().channels.color.has_value());
+    EXPECT_EQ(in.reader->header().channels.color->type, io::ScalarType::kUInt8);
+    io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, in.reader->header().channels);
+    std::map<std::array<float, 3>, std::array<float, 3>> colour_of;  // every corner at a position agrees
+    size_t warm = 0, cool = 0, across = 0, disagreeing = 0, levels = 0;
+    std::set<float> greens;
+    while (in.reader->next(chunk))
+        for (size_t t = 0; t < chunk.size(); ++t) {
+            int warm_corners = 0;
+            for (int k = 0; k < 3; ++k) {
+                const float* p = &chunk.xyz()[9 * t + 3 * size_t(k)];
+                const float* c = chunk.color_at(t) + 4 * k;
+                const std::array<float, 3> rgb{c[0], c[1], c[2]};
+                const auto [it, inserted] = colour_of.emplace(std::array<float, 3>{p[0], p[1], p[2]}, rgb);
+                if (!inserted && it->second != rgb) ++disagreeing;
+                const bool is_warm = c[0] > 0.9f && c[2]<0.4f, is_cool = c[2]> 0.9f && c[0] < 0.4f;
+                warm += is_warm;
+                cool += is_cool;
+                warm_corners += is_warm;
+                greens.insert(c[1]);
+                for (int a = 0; a < 3; ++a) levels += std::abs(c[a] * 255 - std::round(c[a] * 255)) > 1e-3f;
+            }
+            across += warm_corners == 1 || warm_corners == 2;  // the sharp border runs through it
+        }
+    EXPECT_EQ(disagreeing, 0u);
+    EXPECT_EQ(levels, 0u) << "8-bit colours";
+    EXPECT_GT(warm, 1000u);
+    EXPECT_GT(cool, 1000u);
+    EXPECT_GT(across, 20u);
+    EXPECT_GT(greens.size(), 100u) << "smooth bands: many levels of green";
+
+    // A format without vertex colours is refused, exit 2, nothing written.
+    r = gen(dir, "-n 1000 --color " + (dir.path() / "c.stl").string());
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.err.find("--color: stl holds no vertex colours"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir.path() / "c.stl"));
 }
 
 TEST(GenMesh, ExitCodes) {
