@@ -37,17 +37,8 @@ double rms_error(const std::string& original, const std::string& decimated) {
         .rms();
 }
 
-// A closed generated mesh of about 200 k triangles (made once for the suite).
-const std::string& mesh() {
-    static TempDir dir;
-    static const std::string path = [] {
-        const std::string p = dir / "g.stl";
-        const std::string cmd = std::string(MESHSTREAM_GEN_BINARY) + " -q -n 200000 " + p;
-        if (std::system(cmd.c_str()) != 0) ADD_FAILURE() << cmd;
-        return p;
-    }();
-    return path;
-}
+// A closed generated mesh of about 200 k triangles.
+const std::string& mesh() { return cli_test::generated_mesh(200000); }
 
 }  // namespace
 

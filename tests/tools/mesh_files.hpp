@@ -1,11 +1,16 @@
-// Meshes the CLI tests write and check: a generated height-field grid, its binary STL, and
-// what a written file holds (triangle count, edge counts).
+// Meshes the CLI tests write and check: a generated height-field grid, its binary STL, a
+// meshstream-gen mesh, and what a written file holds (triangle count, edge counts).
 #pragma once
 
 #include "compare/topology.hpp"
 #include "io/format.hpp"
+#include "tools/cli_util.hpp"
+
+#include <gtest/gtest.h>
 
 #include <cstdint>
+#include <cstdlib>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -54,5 +59,19 @@ inline meshstream::compare::EdgeCounts edges_of(const std::string& path) {
 inline uint64_t triangles_of(const std::string& path) {
     return *meshstream::io::open_input(path).reader->triangle_count();
 }
+
+#ifdef MESHSTREAM_GEN_BINARY
+// A closed marching-cubes mesh of about `triangles` triangles (meshstream-gen, binary STL), made
+// once per size for the test program; the path stays valid to its end.
+inline const std::string& generated_mesh(uint64_t triangles) {
+    static TempDir dir;
+    static std::map<uint64_t, std::string> made;
+    if (const auto it = made.find(triangles); it != made.end()) return it->second;
+    const std::string path = dir / ("generated_" + std::to_string(triangles) + ".stl");
+    const std::string cmd = std::string(MESHSTREAM_GEN_BINARY) + " -q -n " + std::to_string(triangles) + " " + path;
+    if (std::system(cmd.c_str()) != 0) ADD_FAILURE() << cmd;
+    return made.emplace(triangles, path).first->second;
+}
+#endif
 
 }  // namespace cli_test
