@@ -128,15 +128,9 @@ TEST(CliDecimateThreads, BadInputInAnyRangeIsTheSameErrorAsOneThreads) {
     std::filesystem::create_directories(dir / "in");
     std::filesystem::create_directories(dir / "out");
     const std::string in = dir / "in/bad.ply", out = dir / "out/o.ply";
-    ASSERT_EQ(run("convert -q " + mesh() + " " + in).code, 0);
-    std::string ply = slurp(in);
-    const size_t body = ply.find("end_header\n") + 11;
-    const uint64_t vertices = std::stoull(ply.substr(ply.find("element vertex ") + 15));
-    const uint64_t faces = std::stoull(ply.substr(ply.find("element face ") + 13));
-    const uint64_t bad = faces * 3 / 4;
-    const uint32_t index = 0x7fffffff;
-    std::memcpy(&ply[body + 12 * vertices + 13 * bad + 1], &index, 4);  // uchar count, int indices
-    std::ofstream(in, std::ios::binary | std::ios::trunc) << ply;
+    const cli_test::BadPly bad_ply = cli_test::write_ply_with_bad_index(mesh(), in, 0.75);
+    std::string ply = bad_ply.bytes;
+    const uint64_t bad = bad_ply.bad_face;
     const CliRun one = run("decimate --threads 1 --buffer 20000 -r 0.1 " + in + " " + out);
     for (const char* threads : {"2", "3"}) {
         const CliRun r = run("decimate --threads " + std::string(threads) + " --buffer 20000 -r 0.1 " + in + " " + out);

@@ -10,6 +10,8 @@
 
 #include <cstdint>
 #include <cstdlib>
+#include <cstring>
+#include <fstream>
 #include <map>
 #include <string>
 #include <vector>
@@ -73,5 +75,25 @@ inline const std::string& generated_mesh(uint64_t triangles) {
     return made.emplace(triangles, path).first->second;
 }
 #endif
+
+// `mesh` converted (meshstream convert) to a binary little-endian PLY at `path`, with one vertex
+// index of face `faces · fraction` set out of range (0x7fffffff): bad input at a known place.
+// The file's bytes and that face's index.
+struct BadPly {
+    std::string bytes;
+    uint64_t bad_face = 0;
+};
+inline BadPly write_ply_with_bad_index(const std::string& mesh, const std::string& path, double fraction) {
+    if (run("convert -q " + mesh + " " + path).code != 0) ADD_FAILURE() << "convert " << mesh;
+    BadPly ply{slurp(path), 0};
+    const size_t body = ply.bytes.find("end_header\n") + 11;
+    const uint64_t vertices = std::stoull(ply.bytes.substr(ply.bytes.find("element vertex ") + 15));
+    const uint64_t faces = std::stoull(ply.bytes.substr(ply.bytes.find("element face ") + 13));
+    ply.bad_face = uint64_t(double(faces) * fraction);
+    const uint32_t index = 0x7fffffff;
+    std::memcpy(&ply.bytes[body + 12 * vertices + 13 * ply.bad_face + 1], &index, 4);  // uchar count, int indices
+    std::ofstream(path, std::ios::binary | std::ios::trunc) << ply.bytes;
+    return ply;
+}
 
 }  // namespace cli_test
