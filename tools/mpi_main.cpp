@@ -45,6 +45,9 @@ int main(int argc, char** argv) {
             io::install_cleanup_handlers();
             code = tools::run_command_line(app, "meshstream-mpi", argc, argv, first);
         }
+        // Rank 0 failed after handing out ranges and before releasing their ranks (which wait
+        // for it): MPI_Finalize would wait for them for ever. Its output is already removed.
+        if (processes.others_waiting()) MPI_Abort(MPI_COMM_WORLD, code != 0 ? code : 1);
     }
     MPI_Finalize();
     return code;

@@ -150,6 +150,7 @@ void MpiProcesses::share_plan(const std::optional<RangePlan>& plan) {
     PlanMessage message;
     message.has_plan = plan.has_value();
     if (plan) message.plan = *plan;
+    others_waiting_ = plan && plan->ranges > 1;
     MPI_Request request;
     check(MPI_Ibcast(&message, int(sizeof message), MPI_BYTE, 0, MPI_COMM_WORLD, &request), "MPI_Ibcast");
     wait_idle(request);
@@ -238,6 +239,7 @@ void MpiProcesses::receive(std::span<RangeSink* const> sinks, std::atomic<bool>&
     }
     for (size_t i = 0; i < sinks.size(); ++i)
         check(MPI_Send(nullptr, 0, MPI_BYTE, int(i + 1), kDone, MPI_COMM_WORLD), "MPI_Send");
+    others_waiting_ = false;
     if (failure) std::rethrow_exception(failure);
 }
 

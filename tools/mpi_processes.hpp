@@ -21,9 +21,13 @@ public:
     std::optional<RangePlan> receive_plan() override;
     void receive(std::span<RangeSink* const> sinks, std::atomic<bool>& stop) override;
     void send(const std::function<void(RangeSink&, std::atomic<bool>& stop)>& run_range) override;
+    // Rank 0: other ranks were given ranges and have not been released (the job failed before
+    // receive() could run to its end); they can only be ended with MPI_Abort.
+    bool others_waiting() const { return others_waiting_; }
 
 private:
     unsigned count_ = 1, rank_ = 0;
+    bool others_waiting_ = false;
 };
 
 }  // namespace meshstream::tools
