@@ -499,7 +499,7 @@ int main(int argc, char** argv) {
     app.add_flag("--shuffle", opt.shuffle, "write the triangles in random order (out of core)");
     app.add_flag("--holes", opt.holes, "punch 40 holes into the surface, like occlusions in a scan");
     app.add_flag("--color", opt.color,
-                 "an 8-bit RGB colour per corner, a function of its position: smooth bands and one sharp border\n"
+                 "an 8-bit RGB colour per corner from its position: smooth bands, a sharp border\n"
                  "For formats that hold vertex colours (PLY, OBJ, Draco, glTF)");
     app.add_option("--to", opt.to,
                    "output format, instead of the extension's (e.g. ply)\nOne of: " + io::format_names(true))
