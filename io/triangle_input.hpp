@@ -49,6 +49,7 @@ public:
     const std::string& name() const { return name_; }
     const Format& format() const { return *input_.format; }
     ByteSource& source() { return *input_.source; }
+    bool has_source() const { return input_.source != nullptr; }  // false for a bare reader
     Reader& reader() { return *input_.reader; }
     // Releases the reader and its source (their buffers and tables) once the loop is done;
     // count(), name() and the drop counts stay; header() and the rest must not be called.

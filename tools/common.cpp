@@ -16,6 +16,7 @@
 #include <fstream>
 #include <iterator>
 #include <limits>
+#include <thread>
 
 namespace meshstream::tools {
 
@@ -282,6 +283,15 @@ io::ChannelKinds kept_channel_kinds(const std::string& drop_list) {
     if (std::string error = parse_drop_list(drop_list, kinds); !error.empty())
         throw CLI::ValidationError("--drop", error);
     return kinds;
+}
+
+unsigned every_core() { return std::max(1u, std::thread::hardware_concurrency()); }
+
+void add_threads_option(CLI::App* cmd, unsigned& threads, const std::string& what) {
+    cmd->add_option("--threads", threads,
+                    what + " (default: every core, " + std::to_string(every_core()) + " here; 1: none)")
+        ->type_name("N")
+        ->check(CLI::Range(1u, 1024u));
 }
 
 void add_drop_flag(CLI::App* cmd, ReadFlags& flags) {

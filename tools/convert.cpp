@@ -1,6 +1,10 @@
 // `meshstream convert IN OUT`: streams triangles between any two registered formats, one chunk
-// at a time. Memory: one chunk plus whatever the two formats need (see docs/formats.md).
+// at a time. With --threads 2 or more the input is read on a thread of its own and the output
+// written on another (io/pipeline.hpp), the same bytes out. Memory: one chunk (seven with
+// threads: the reader's three, the writer's three and its own) plus whatever the two formats
+// need (see docs/formats.md).
 #include "io/error.hpp"
+#include "io/pipeline.hpp"
 #include "tools/commands.hpp"
 #include "tools/common.hpp"
 #include "tools/help.hpp"
@@ -10,6 +14,7 @@
 #include <chrono>
 #include <cstdio>
 #include <memory>
+#include <optional>
 
 namespace meshstream::tools {
 namespace {
@@ -18,6 +23,7 @@ struct ConvertOptions {
     std::string input, output;
     bool clean = false;
     bool json = false;
+    unsigned threads = every_core();
     ReadFlags read;
     WriteFlags write;
 };
@@ -48,9 +54,30 @@ void run_convert(const ConvertOptions& opt) {
     // The chunk carries only what the output keeps: the reader fills no more.
     io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, wo.channels);
     Progress progress("converting", header.triangle_count);
-    while (in.next(chunk)) {
-        out.write(chunk);
-        progress.update(in.count().read, in.source());
+    if (opt.threads < 2) {
+        while (in.next(chunk)) {
+            out.write(chunk);
+            progress.update(in.count().read, in.source());
+        }
+    } else {
+        // Reading (inflating, parsing) on one thread, writing (formatting, welding, encoding,
+        // deflating) on another; this thread passes the chunks on and draws the progress.
+        const std::optional<uint64_t> file_bytes = in.source().stored_size();
+        io::WriteBehind writer(out, chunk.capacity(), chunk.channels());
+        io::ReadAhead reader(in, chunk.capacity(), chunk.channels());
+        while (true) {
+            try {
+                if (!reader.next(chunk)) break;
+            } catch (...) {
+                // Without threads the writes before a read error come first: one of them may
+                // fail instead, and that error is the run's.
+                writer.close();
+                throw;
+            }
+            writer.write(chunk);
+            progress.update(reader.count().read, reader.stored_offset(), file_bytes);
+        }
+        writer.close();
     }
     // A reader may have added materials while reading (OBJ: names met after the first face).
     if (wo.channels.material) out.writer->update_materials(in.header().materials);
@@ -93,6 +120,7 @@ void add_convert(CLI::App& app) {
     add_clean_flag(cmd, opt->clean);
     add_drop_flag(cmd, opt->read);
     add_json_flag(cmd, opt->json);
+    add_threads_option(cmd, opt->threads, "read and write on threads of their own");
     add_read_flags(cmd, opt->read);
     describe_memory_for_writing(cmd);
     cmd->footer(

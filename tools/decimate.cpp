@@ -43,8 +43,6 @@ using compare::CompareOptions;
 using compare::CompareResult;
 using compare::file_source;
 
-unsigned every_core() { return std::max(1u, std::thread::hardware_concurrency()); }
-
 struct DecimateOptions {
     std::string input, output;
     std::optional<double> ratio;

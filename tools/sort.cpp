@@ -2,9 +2,11 @@
 // the stream decimator (sort/external_sort.hpp does the sorting; docs/sorting.md explains the
 // method and the memory bound). This file chooses the axis, splits --memory between the
 // reader/writer and the sorter, drives the progress bar and records the axis in the output.
-// Reading and writing run on their own threads (a ChunkPipe each), overlapping parsing and
-// file I/O with the sorting on the main thread.
+// With --threads 2 or more, reading runs on a thread of its own during run generation and
+// writing during the merge (io/pipeline.hpp), overlapping parsing, inflating, formatting and
+// deflating with the sorting on the command's thread; the output is the same.
 #include "io/error.hpp"
+#include "io/pipeline.hpp"
 #include "sort/external_sort.hpp"
 #include "tools/commands.hpp"
 #include "tools/common.hpp"
@@ -15,16 +17,10 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
-#include <condition_variable>
 #include <cstdio>
-#include <deque>
-#include <exception>
 #include <memory>
-#include <mutex>
-#include <thread>
 #include <vector>
 
 namespace meshstream::tools {
@@ -36,103 +32,12 @@ struct SortOptions {
     bool stats = false;
     bool clean = false;
     bool json = false;
+    unsigned threads = every_core();
     ReadFlags read;
     WriteFlags write;
 };
 
 const char* const kAxisNames[] = {"x", "y", "z"};
-
-// Chunks circulating between the two threads of a ChunkPipe: one being filled, one being
-// consumed, two in flight to absorb jitter. Part of the sorter's memory share.
-constexpr size_t kPipeSlots = 4;
-
-// A bounded, ordered hand-over of chunks from one producer thread to one consumer thread:
-// kPipeSlots chunks, allocated once, move between a free list and a full list. An error on
-// either side is recorded with fail() and rethrown on the other side at its next call.
-class ChunkPipe {
-public:
-    ChunkPipe(size_t capacity, io::Channels channels) {
-        for (size_t i = 0; i < kPipeSlots; ++i) {
-            storage_.push_back(std::make_unique<io::TriangleChunk>(capacity, channels));
-            free_.push_back(storage_.back().get());
-        }
-    }
-
-    // Producer: an empty chunk to fill; null once stop() was called. Rethrows a failure.
-    io::TriangleChunk* get_free() { return take(free_); }
-    // Producer: hands a filled chunk over (in order).
-    void put_full(io::TriangleChunk* chunk) { give(full_, chunk); }
-    // Producer: the stream ended normally; get_full() returns null after the last chunk.
-    void close() {
-        std::lock_guard lock(mutex_);
-        closed_ = true;
-        changed_.notify_all();
-    }
-    // Consumer: the next filled chunk, or null at the end or once stop() was called.
-    // Rethrows a failure.
-    io::TriangleChunk* get_full() { return take(full_); }
-    // Consumer: returns a consumed chunk for refilling.
-    void put_free(io::TriangleChunk* chunk) { give(free_, chunk); }
-
-    // Either side: records the first error (rethrown to the other side) and wakes it.
-    void fail(std::exception_ptr error) {
-        std::lock_guard lock(mutex_);
-        if (!error_) error_ = error;
-        changed_.notify_all();
-    }
-    // Makes both sides' get_*() return null (the owner unwinds and joins the worker).
-    void stop() {
-        std::lock_guard lock(mutex_);
-        stopped_ = true;
-        changed_.notify_all();
-    }
-
-private:
-    io::TriangleChunk* take(std::deque<io::TriangleChunk*>& list) {
-        std::unique_lock lock(mutex_);
-        const bool full_side = &list == &full_;
-        changed_.wait(lock, [&] { return !list.empty() || stopped_ || error_ || (full_side && closed_); });
-        if (stopped_) return nullptr;
-        if (error_) std::rethrow_exception(error_);
-        if (list.empty()) return nullptr;  // closed and drained
-        io::TriangleChunk* chunk = list.front();
-        list.pop_front();
-        return chunk;
-    }
-    void give(std::deque<io::TriangleChunk*>& list, io::TriangleChunk* chunk) {
-        std::lock_guard lock(mutex_);
-        list.push_back(chunk);
-        changed_.notify_all();
-    }
-
-    std::vector<std::unique_ptr<io::TriangleChunk>> storage_;
-    std::mutex mutex_;
-    std::condition_variable changed_;
-    std::deque<io::TriangleChunk*> free_, full_;
-    bool closed_ = false, stopped_ = false;
-    std::exception_ptr error_;
-};
-
-// Runs `body` on a thread that is stopped (pipe.stop()) and joined when this goes out of
-// scope, so an exception on the main thread never leaves the worker running. `body` must
-// catch its own exceptions (into pipe.fail()). A worker blocked in a read (a quiet stdin)
-// is joined once that read returns; SIGINT ends the process at once as before.
-class PipeWorker {
-public:
-    template <class F>
-    PipeWorker(ChunkPipe& pipe, F&& body) : pipe_(pipe), thread_(std::forward<F>(body)) {}
-    ~PipeWorker() {
-        pipe_.stop();
-        join();
-    }
-    void join() {
-        if (thread_.joinable()) thread_.join();
-    }
-
-private:
-    ChunkPipe& pipe_;
-    std::thread thread_;
-};
 
 double seconds_since(std::chrono::steady_clock::time_point t) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
@@ -215,10 +120,11 @@ void run_sort(const SortOptions& opt) {
     so.channels = io::writable_channels(out_format, wanted, opt.write.options(opt.read, out_format));
     const std::string dropped = io::describe_missing(wanted, so.channels);
     const size_t record_bytes = sort::ExternalSorter::record_bytes_for(so.channels);
-    // The pipe's chunks are part of the sorter's share: each at most 1/64 of the budget.
+    // The pipeline's chunks are part of the sorter's share: each at most 1/64 of the budget
+    // (counted whether or not threads are used).
     const size_t chunk_capacity =
         std::clamp<size_t>(budget / 64 / (record_bytes + 36), 256, io::TriangleChunk::kDefaultCapacity);
-    const uint64_t pipe_bytes = kPipeSlots * chunk_capacity * (record_bytes + 36);
+    const uint64_t pipe_bytes = io::kPipelineChunks * chunk_capacity * (record_bytes + 36);
     if (budget - budget / 4 <= pipe_bytes) {
         // The least budget b with b - b/4 > pipe_bytes (the pipe's size is fixed at such small
         // budgets: its chunks are at their minimum), in whole KiB.
@@ -242,30 +148,21 @@ void run_sort(const SortOptions& opt) {
     };
     sort::ExternalSorter sorter(so);
     {
-        // Input thread: reads, parses and filters chunks; this thread adds them to the runs
-        // (and sorts and spills each full run).
-        ChunkPipe pipe(chunk_capacity, so.channels);
-        // Counted on the reader's thread, shown on this one: triangles, and bytes of the file.
-        std::atomic<uint64_t> read{0}, bytes_read{0};
+        // With threads, the input is read, parsed and filtered on a thread of its own; this
+        // thread adds the chunks to the runs (and sorts and spills each full run).
+        io::TriangleChunk chunk(chunk_capacity, so.channels);
         const std::optional<uint64_t> file_bytes = in.source().stored_size();
-        PipeWorker reader(pipe, [&] {
-            try {
-                while (io::TriangleChunk* chunk = pipe.get_free()) {
-                    if (!in.next(*chunk)) break;
-                    read.store(in.count().read, std::memory_order_relaxed);
-                    bytes_read.store(in.source().stored_offset(), std::memory_order_relaxed);
-                    pipe.put_full(chunk);
-                }
-                pipe.close();
-            } catch (...) {
-                pipe.fail(std::current_exception());
+        if (opt.threads < 2) {
+            while (in.next(chunk)) {
+                sorter.add(chunk);
+                progress.update(in.count().read, in.source().stored_offset(), file_bytes);
             }
-        });
-        while (io::TriangleChunk* chunk = pipe.get_full()) {
-            sorter.add(*chunk);
-            pipe.put_free(chunk);
-            progress.update(read.load(std::memory_order_relaxed), bytes_read.load(std::memory_order_relaxed),
-                            file_bytes);
+        } else {
+            io::ReadAhead reader(in, chunk_capacity, so.channels);
+            while (reader.next(chunk)) {
+                sorter.add(chunk);
+                progress.update(reader.count().read, reader.stored_offset(), file_bytes);
+            }
         }
     }
     // What the reader noted by the end of the input (a last line without a line end), before
@@ -292,28 +189,24 @@ void run_sort(const SortOptions& opt) {
     const int passes = sorter.stats().merge_passes;
     progress.phase(passes == 0 ? "writing" : "merge " + std::to_string(passes) + "/" + std::to_string(passes), total);
     {
-        // Output thread: formats and writes chunks; this thread merges (or gathers) them.
-        ChunkPipe pipe(chunk_capacity, so.channels);
-        PipeWorker writer(pipe, [&] {
-            try {
-                while (io::TriangleChunk* chunk = pipe.get_full()) {
-                    out.write(*chunk);
-                    pipe.put_free(chunk);
-                }
-            } catch (...) {
-                pipe.fail(std::current_exception());
-            }
-        });
+        // With threads, the output is formatted and written on a thread of its own; this thread
+        // merges (or gathers) the chunks.
+        io::TriangleChunk chunk(chunk_capacity, so.channels);
         uint64_t done = 0;
-        while (true) {
-            io::TriangleChunk* chunk = pipe.get_free();  // rethrows the writer's error
-            if (!sorter.next(*chunk)) break;
-            pipe.put_full(chunk);
-            progress.update(done += chunk->size());
+        if (opt.threads < 2) {
+            while (sorter.next(chunk)) {
+                out.write(chunk);
+                progress.update(done += chunk.size());
+            }
+        } else {
+            io::WriteBehind writer(out, chunk_capacity, so.channels);
+            while (sorter.next(chunk)) {
+                const size_t n = chunk.size();
+                writer.write(chunk);
+                progress.update(done += n);
+            }
+            writer.close();
         }
-        pipe.close();
-        writer.join();
-        pipe.get_free();  // rethrows an error of the last writes
     }
     out.finish();
     progress.done();
@@ -382,6 +275,7 @@ void add_sort(CLI::App& app) {
     add_write_flags(cmd, opt->write);
     add_clean_flag(cmd, opt->clean);
     add_json_flag(cmd, opt->json);
+    add_threads_option(cmd, opt->threads, "read and write on threads of their own");
     cmd->add_flag("--stats", opt->stats, "print runs, merge passes, temporary disk, time and peak RSS on stderr");
     add_drop_flag(cmd, opt->read);
     cmd->get_option("--drop")->group(kMoreOptions);
