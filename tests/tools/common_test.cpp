@@ -2,7 +2,13 @@
 // tested through the binary in cli_*_test.cpp).
 #include "tools/common.hpp"
 
+#include "test_util.hpp"
+
 #include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <string>
 
 namespace meshstream::tools {
 namespace {
@@ -62,6 +68,11 @@ TEST(WholeMeshMemory, IsHalfTheAvailableMemoryWithinAFloorAndACeiling) {
 // An explicit --memory is the writer's budget whatever the output; without it only a writer
 // that holds the whole mesh gets the larger default.
 TEST(WholeMeshMemory, AppliesToWholeMeshWritersWithoutMemoryOnly) {
+    // A fixed meminfo: /proc/meminfo's MemAvailable moves between two reads on a busy machine.
+    test::TempDir dir;
+    const std::string meminfo = (dir.path() / "meminfo").string();
+    std::ofstream(meminfo) << "MemAvailable:    8000000 kB\n";
+    ASSERT_EQ(::setenv("MESHSTREAM_MEMINFO", meminfo.c_str(), 1), 0);
     ReadFlags read;
     WriteFlags write;
     const io::Format& glb = *io::find_format("glb");
@@ -72,6 +83,8 @@ TEST(WholeMeshMemory, AppliesToWholeMeshWritersWithoutMemoryOnly) {
     read.memory = "64M";
     EXPECT_EQ(write.options(read, glb).memory_budget_bytes, uint64_t{64} << 20);
     EXPECT_EQ(write.options(read, stl).memory_budget_bytes, uint64_t{64} << 20);
+    EXPECT_EQ(whole_mesh_memory(), 8000000 * uint64_t{1024} / 2);
+    ::unsetenv("MESHSTREAM_MEMINFO");
 }
 
 }  // namespace
