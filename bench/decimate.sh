@@ -32,6 +32,8 @@ COMPARE=${COMPARE:-1}
 DECIMATE_ARGS=${DECIMATE_ARGS:-}
 
 die() { echo "bench/decimate.sh: $*" >&2; exit 1; }
+# shellcheck source=bench/lib.sh
+source "$src/bench/lib.sh"  # measure, load
 [ -x /usr/bin/time ] || die "GNU time is missing: apt-get install time"
 command -v python3 >/dev/null || die "python3 is missing"
 mkdir -p "$BENCH_DIR"
@@ -62,21 +64,7 @@ results=$BENCH_DIR/results.tsv
 : >"$results"
 
 # time_run LABEL CMD...: runs CMD under GNU time; appends "seconds<TAB>rss_kb" lines to $BENCH_DIR/runs.txt
-measure() {
-  local log=$BENCH_DIR/time.log
-  if ! /usr/bin/time -v -o "$log" "$@" >"$BENCH_DIR/cmd.out" 2>"$BENCH_DIR/cmd.err"; then
-    cat "$BENCH_DIR/cmd.err" >&2
-    die "failed: $*"
-  fi
-  python3 - "$log" <<'EOF'
-import re, sys
-text = open(sys.argv[1]).read()
-wall = re.search(r"Elapsed \(wall clock\) time .*: (\S+)", text).group(1).split(":")
-seconds = sum(float(x) * 60 ** i for i, x in enumerate(reversed(wall)))
-rss = int(re.search(r"Maximum resident set size \(kbytes\): (\d+)", text).group(1))
-print(f"{seconds}\t{rss}")
-EOF
-}
+MEASURE_DIR=$BENCH_DIR
 
 median_of_runs() {  # CMD...: prints "median_seconds<TAB>median_rss_kb"
   local lines=()
@@ -84,7 +72,7 @@ median_of_runs() {  # CMD...: prints "median_seconds<TAB>median_rss_kb"
   printf '%s\n' "${lines[@]}" | python3 -c '
 import sys, statistics
 rows = [l.split("\t") for l in sys.stdin.read().split("\n") if l]
-print(f"{statistics.median(float(r[0]) for r in rows)}\t{int(statistics.median(int(r[1]) for r in rows))}")'
+print(f"{statistics.median(float(r[0]) for r in rows)}\t{int(statistics.median(int(r[2]) for r in rows))}")'
 }
 
 error_of() {  # INPUT OUTPUT: prints "rms_pct<TAB>max_pct<TAB>rms<TAB>max"

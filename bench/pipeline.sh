@@ -33,6 +33,8 @@ ALL_CASES="stl-to-ply-ascii ply-ascii-to-stl stl-to-ply-gz ply-gz-to-stl stl-to-
 CASES=${CASES:-$ALL_CASES}
 
 die() { echo "bench/pipeline.sh: $*" >&2; exit 1; }
+# shellcheck source=bench/lib.sh
+source "$src/bench/lib.sh"  # measure, load
 [ -x /usr/bin/time ] || die "GNU time is missing: apt-get install time"
 command -v python3 >/dev/null || die "python3 is missing"
 mkdir -p "$BENCH_DIR"
@@ -81,29 +83,11 @@ args_of() {  # CASE THREADS: the command line's arguments after `meshstream -q`
 }
 output_of() { args_of "$1" "$2" | awk '{print $NF}'; }
 
-load() { cut -d' ' -f1-3 /proc/loadavg; }
 load_before=$(load)
 runs_file=$d/pipeline_runs.tsv
 : >"$runs_file"
 
-# measure CMD...: runs CMD under GNU time; prints "wall_s<TAB>cpu_s<TAB>rss_kb"
-measure() {
-  local log=$d/time.log
-  if ! /usr/bin/time -v -o "$log" "$@" >"$d/cmd.out" 2>"$d/cmd.err"; then
-    cat "$d/cmd.err" >&2
-    die "failed: $*"
-  fi
-  python3 - "$log" <<'EOF'
-import re, sys
-text = open(sys.argv[1]).read()
-wall = re.search(r"Elapsed \(wall clock\) time .*: (\S+)", text).group(1).split(":")
-seconds = sum(float(x) * 60 ** i for i, x in enumerate(reversed(wall)))
-cpu = float(re.search(r"User time \(seconds\): (\S+)", text).group(1)) + \
-      float(re.search(r"System time \(seconds\): (\S+)", text).group(1))
-rss = int(re.search(r"Maximum resident set size \(kbytes\): (\d+)", text).group(1))
-print(f"{seconds}\t{cpu}\t{rss}")
-EOF
-}
+MEASURE_DIR=$d
 
 for c in $CASES; do
   # Alternated run by run, so that a change in the machine's load reaches every setting alike.

@@ -40,6 +40,8 @@ RMS=${RMS:-1}
 DECIMATE_ARGS=${DECIMATE_ARGS:-}
 
 die() { echo "bench/threads.sh: $*" >&2; exit 1; }
+# shellcheck source=bench/lib.sh
+source "$src/bench/lib.sh"  # measure, load
 [ -x /usr/bin/time ] || die "GNU time is missing: apt-get install time"
 command -v python3 >/dev/null || die "python3 is missing"
 mkdir -p "$BENCH_DIR"
@@ -64,27 +66,9 @@ fi
 
 results=$BENCH_DIR/threads.tsv
 : >"$results"
-load() { cut -d' ' -f1-3 /proc/loadavg; }
 load_before=$(load)
 
-# measure CMD...: runs CMD under GNU time; prints "wall_s<TAB>cpu_s<TAB>rss_kb"
-measure() {
-  local log=$BENCH_DIR/time.log
-  if ! /usr/bin/time -v -o "$log" "$@" >"$BENCH_DIR/cmd.out" 2>"$BENCH_DIR/cmd.err"; then
-    cat "$BENCH_DIR/cmd.err" >&2
-    die "failed: $*"
-  fi
-  python3 - "$log" <<'EOF'
-import re, sys
-text = open(sys.argv[1]).read()
-wall = re.search(r"Elapsed \(wall clock\) time .*: (\S+)", text).group(1).split(":")
-seconds = sum(float(x) * 60 ** i for i, x in enumerate(reversed(wall)))
-cpu = float(re.search(r"User time \(seconds\): (\S+)", text).group(1)) + \
-      float(re.search(r"System time \(seconds\): (\S+)", text).group(1))
-rss = int(re.search(r"Maximum resident set size \(kbytes\): (\d+)", text).group(1))
-print(f"{seconds}\t{cpu}\t{rss}")
-EOF
-}
+MEASURE_DIR=$BENCH_DIR
 
 rms_of() {  # INPUT OUTPUT: prints the symmetric RMS error in % of the bbox diagonal
   "$ms" -q compare --json "$1" "$2" >"$BENCH_DIR/compare.json" || die "compare failed: $1 $2"
