@@ -33,9 +33,9 @@ using namespace meshstream;
 
 // Runs `mpirun -n RANKS meshstream-mpi ARGS` through /bin/sh, stdout to /dev/null unless ARGS
 // redirects it, stderr captured. Root may run it (the CI machine's user). `rank0` runs first in
-// rank 0's shell (a ulimit for it alone; the ranks then talk over TCP, whose setup writes no
-// file as shared memory's does). A job that does not end within two minutes is killed (exit
-// 124): a rank waiting for ever fails the test.
+// rank 0's shell (a ulimit for it alone; the ranks then talk over TCP on the loopback
+// interface, whose setup writes no file as shared memory's does). A job that does not end
+// within two minutes is killed (exit 124): a rank waiting for ever fails the test.
 CliRun run_mpi(int ranks, const std::string& args, const std::string& rank0 = "") {
     char err_path[] = "/tmp/meshstream_mpi_err-XXXXXX";
     const int fd = ::mkstemp(err_path);
@@ -49,8 +49,8 @@ CliRun run_mpi(int ranks, const std::string& args, const std::string& rank0 = ""
     if (rank0.empty())
         cmd += std::string(MESHSTREAM_MPI_BINARY) + " " + args;
     else
-        cmd += "--mca btl self,tcp sh -c 'if [ \"$OMPI_COMM_WORLD_RANK\" = 0 ]; then " + rank0 + "; fi; exec " +
-               MESHSTREAM_MPI_BINARY + " \"$@\"' sh " + args;
+        cmd += "--mca btl self,tcp --mca btl_tcp_if_include lo sh -c 'if [ \"$OMPI_COMM_WORLD_RANK\" = 0 ]; then " +
+               rank0 + "; fi; exec " + MESHSTREAM_MPI_BINARY + " \"$@\"' sh " + args;
     const int status = std::system((cmd + " 2> " + err_path).c_str());
     CliRun r{WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status), slurp(err_path)};
     ::unlink(err_path);
