@@ -4,6 +4,7 @@
 // simplifier (hasTriangleFlip) and Garland & Heckbert's implementation.
 #include "decimate/collapse.hpp"
 
+#include "decimate/attribute_store.hpp"
 #include "decimate/phase_timers.hpp"
 
 #include <algorithm>
@@ -142,12 +143,62 @@ bool moves_keep_faces_valid(const HalfEdgeBuffer& buffer, uint32_t v, const doub
     return true;
 }
 
+bool seam_allows(const HalfEdgeBuffer& buffer, uint32_t h) {
+    const AttributeStore* attributes = buffer.attributes();
+    return attributes == nullptr || attributes->seam_allows(buffer, h);
+}
+
+Quadric merged_quadric(const HalfEdgeBuffer& buffer, uint32_t p, uint32_t q) {
+    const Quadric sum = buffer.quadric(p) + buffer.quadric(q);
+    const AttributeStore* attributes = buffer.attributes();
+    if (attributes == nullptr || !attributes->weighted()) return sum;
+    const int m = attributes->size();
+    double a[AttributeQuadric::size(kMaxAttributeComponents)];
+    std::copy_n(attributes->quadric(p), AttributeQuadric::size(m), a);
+    AttributeQuadric::add(a, attributes->quadric(q), m);
+    return attributes->combined(sum, a);
+}
+
+namespace {
+
+// The error of h = p→q when q keeps its position and values (written, or a seam vertex): the
+// geometric error at q plus p's attribute error at q with the values q shows on h's face.
+double fixed_error(const HalfEdgeBuffer& buffer, const AttributeStore& attributes, uint32_t h) {
+    const uint32_t p = buffer.corner_vertex(h), q = buffer.corner_vertex(next_in_face(h));
+    const Quadric sum = buffer.quadric(p) + buffer.quadric(q);
+    double x[3];
+    buffer.position(q, x);
+    const double w = sum.a00 + sum.a11 + sum.a22;
+    return std::max(0.0, sum.error(x)) + w * AttributeQuadric::error(attributes.quadric(p), attributes.size(),
+                                                                     attributes.omega(), x,
+                                                                     attributes.shown(buffer, next_in_face(h)));
+}
+
+bool values_fixed(const HalfEdgeBuffer& buffer, uint32_t q) {
+    const AttributeStore* attributes = buffer.attributes();
+    return attributes != nullptr && attributes->weighted() && (buffer.vertex(q).flags & (kSeam | kFrozen)) != 0;
+}
+
+}  // namespace
+
+double collapse_error(const HalfEdgeBuffer& buffer, uint32_t h) {
+    const uint32_t p = buffer.corner_vertex(h), q = buffer.corner_vertex(next_in_face(h));
+    if (values_fixed(buffer, q)) return fixed_error(buffer, *buffer.attributes(), h);
+    double x[3];
+    buffer.position(q, x);
+    return merged_quadric(buffer, p, q).error(x);
+}
+
 CollapsePlacement collapse_placement(const HalfEdgeBuffer& buffer, uint32_t h) {
     const PhaseTimer timer(Phase::kRate);
     const uint32_t p = buffer.corner_vertex(h), q = buffer.corner_vertex(next_in_face(h));
-    const Quadric sum = buffer.quadric(p) + buffer.quadric(q);
     CollapsePlacement out;
     buffer.position(q, out.target);
+    if (values_fixed(buffer, q)) {  // q does not move either (collapse_target_free)
+        out.error = fixed_error(buffer, *buffer.attributes(), h);
+        return out;
+    }
+    const Quadric sum = merged_quadric(buffer, p, q);
     out.error = sum.error(out.target);
     if (!collapse_target_free(buffer, h)) return out;
     // Takes y when its error is below the best so far (round-off can put the rounded optimum
@@ -306,6 +357,7 @@ void apply_collapse(HalfEdgeBuffer& buffer, uint32_t h) {
         }
     };
 
+    if (AttributeStore* attributes = buffer.attributes()) attributes->merge(buffer, h);
     const uint32_t h1 = next_in_face(h), h2 = prev_in_face(h);
     const uint32_t o1 = buffer.twin(h1), o2 = buffer.twin(h2);
     drop_open(h);

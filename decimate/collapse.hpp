@@ -27,16 +27,19 @@ inline constexpr uint32_t kMaxMovedFaces = 32;
 // Beyond the paper: a true-boundary p (a hole, off P_in and P_out, one open fan) may also
 // collapse along its outgoing boundary edge (twin kOpenEdge), as in Garland & Heckbert; its
 // quadric holds the boundary planes added when it left P_in, which keep the hole's outline.
+// With channels (attribute_store.hpp): p is no seam vertex, and a seam vertex q takes the collapse
+// only where its corners on the edge's two faces agree (seam_allows).
+bool seam_allows(const HalfEdgeBuffer& buffer, uint32_t h);
 inline bool collapse_eligible(const HalfEdgeBuffer& buffer, uint32_t h) {
     const Vertex& p = buffer.vertex(buffer.corner_vertex(h));
-    if ((p.flags & (kInHash | kFrozen | kNonManifold | kManyFans)) != 0) return false;
+    if ((p.flags & (kInHash | kFrozen | kNonManifold | kManyFans | kSeam)) != 0) return false;
     if (p.open_edges == 0) {
         if (!is_half_edge(buffer.twin(h))) return false;
     } else if (p.open_edges != 2 || buffer.twin(h) != kOpenEdge) {
         return false;
     }
     const Vertex& q = buffer.vertex(buffer.corner_vertex(next_in_face(h)));
-    return (q.flags & (kInHash | kNonManifold)) == 0;
+    return (q.flags & (kInHash | kNonManifold)) == 0 && ((q.flags & kSeam) == 0 || seam_allows(buffer, h));
 }
 
 // True when the target q of an eligible h = p→q may move (beyond the paper, as Garland &
@@ -45,16 +48,18 @@ inline bool collapse_eligible(const HalfEdgeBuffer& buffer, uint32_t h) {
 // kMaxMovedFaces faces.
 inline bool collapse_target_free(const HalfEdgeBuffer& buffer, uint32_t h) {
     const Vertex& q = buffer.vertex(buffer.corner_vertex(next_in_face(h)));
-    return (q.flags & (kInHash | kFrozen | kNonManifold)) == 0 && q.open_edges == 0 && q.face_count <= kMaxMovedFaces;
+    return (q.flags & (kInHash | kFrozen | kNonManifold | kSeam)) == 0 && q.open_edges == 0 &&
+           q.face_count <= kMaxMovedFaces;
 }
 
-// The quadric error of collapsing h = p→q without moving q: (Q_p + Q_q) evaluated at q.
-inline double collapse_error(const HalfEdgeBuffer& buffer, uint32_t h) {
-    const uint32_t p = buffer.corner_vertex(h), q = buffer.corner_vertex(next_in_face(h));
-    double x[3];
-    buffer.position(q, x);
-    return (buffer.quadric(p) + buffer.quadric(q)).error(x);
-}
+// The quadric a merge of p and q minimizes: Q_p + Q_q, plus, when the buffer carries weighted
+// channels, the attribute error minimized over the merged vertex's values (attributes.hpp).
+Quadric merged_quadric(const HalfEdgeBuffer& buffer, uint32_t p, uint32_t q);
+
+// The quadric error of collapsing h = p→q without moving q: merged_quadric evaluated at q; when
+// q's values are fixed (written or a seam vertex), the attribute error of p's quadric at q's
+// position and the values q shows on h's face.
+double collapse_error(const HalfEdgeBuffer& buffer, uint32_t h);
 
 // Where an eligible collapse h = p→q puts the merged vertex, and its error. When q is free
 // (collapse_target_free): the minimum of Q_p + Q_q (rounded to stored float coordinates), or,

@@ -16,11 +16,14 @@ void rate_edge(HalfEdgeBuffer& buffer, CollapseQueue& queue, uint32_t h) {
     const uint32_t p = buffer.corner_vertex(h), q = buffer.corner_vertex(next_in_face(h));
     const Vertex& vp = buffer.vertex(p);
     const Vertex& vq = buffer.vertex(q);
-    constexpr uint16_t kNoSource = kInHash | kFrozen | kNonManifold | kManyFans, kNoTarget = kInHash | kNonManifold;
+    constexpr uint16_t kNoSource = kInHash | kFrozen | kNonManifold | kManyFans | kSeam;
+    constexpr uint16_t kNoTarget = kInHash | kNonManifold;
     const bool twin_real = is_half_edge(t);
     const bool forward = (vp.flags & kNoSource) == 0 && (vq.flags & kNoTarget) == 0 &&
-                         (vp.open_edges == 0 ? twin_real : vp.open_edges == 2 && t == kOpenEdge);
-    const bool backward = twin_real && (vq.flags & kNoSource) == 0 && (vp.flags & kNoTarget) == 0 && vq.open_edges == 0;
+                         (vp.open_edges == 0 ? twin_real : vp.open_edges == 2 && t == kOpenEdge) &&
+                         ((vq.flags & kSeam) == 0 || seam_allows(buffer, h));
+    const bool backward = twin_real && (vq.flags & kNoSource) == 0 && (vp.flags & kNoTarget) == 0 &&
+                          vq.open_edges == 0 && ((vp.flags & kSeam) == 0 || seam_allows(buffer, t));
     if (!forward && !backward) {
         CollapseQueue::forget(buffer, h);
         return;
@@ -28,7 +31,7 @@ void rate_edge(HalfEdgeBuffer& buffer, CollapseQueue& queue, uint32_t h) {
     if (forward && backward && vp.face_count <= kMaxMovedFaces && vq.face_count <= kMaxMovedFaces) {
         // Both ends free (collapse_target_free either way): the same merge at the minimum of
         // Q_p + Q_q. Rated at the exact minimum; collapse_placement() rounds it to floats.
-        const Quadric sum = buffer.quadric(p) + buffer.quadric(q);
+        const Quadric sum = merged_quadric(buffer, p, q);
         double x[3];
         queue.push(buffer, h, false, sum.minimum(x) ? sum.error_at_minimum(x) : collapse_placement(buffer, h).error);
         return;

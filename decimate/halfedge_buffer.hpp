@@ -72,6 +72,7 @@ inline constexpr uint16_t kHasPartner = 32;  // partner_position() holds a colla
 inline constexpr uint16_t kPending = 64;     // listed for take_pending()
 inline constexpr uint16_t kBlocked = 128;    // a collapse at it was refused (collapse.hpp)
 inline constexpr uint16_t kManyFans = 256;   // its faces are not one fan (two fans touch here)
+inline constexpr uint16_t kSeam = 512;       // its corners disagree in attributes (attribute_store.hpp)
 
 struct Vertex {
     float pos[3];           // input position, moved by collapses and once when written (§4.4)
@@ -117,6 +118,8 @@ struct alignas(64) Face {
     uint8_t alive;
 };
 static_assert(sizeof(Face) == 64);
+
+class AttributeStore;
 
 class HalfEdgeBuffer {
 public:
@@ -303,6 +306,10 @@ public:
     }
     uint32_t& mark(uint32_t v) { return slots_[v].mark; }
 
+    // The channels carried beside the buffer (attribute_store.hpp), or null for positions only.
+    AttributeStore* attributes() const { return attributes_; }
+    void set_attributes(AttributeStore* store) { attributes_ = store; }
+
     // Running counts for Stats.
     uint64_t vertices_merged() const { return vertices_merged_; }
     uint64_t nonmanifold_edges() const { return nonmanifold_edges_; }
@@ -394,6 +401,7 @@ private:
     size_t stub_mask_, stub_count_ = 0;
 
     uint64_t vertices_merged_ = 0, nonmanifold_edges_ = 0, boundary_edges_ = 0;
+    AttributeStore* attributes_ = nullptr;
 };
 
 }  // namespace meshstream::decimate

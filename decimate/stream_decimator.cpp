@@ -12,6 +12,7 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace meshstream::decimate {
 namespace {
@@ -48,21 +49,25 @@ double choose_ratio(const Options& options, std::optional<uint64_t> input_count)
 
 }  // namespace
 
-StreamDecimator::StreamDecimator(const Options& options, std::optional<uint64_t> input_triangle_count)
-    : StreamDecimator(options, io::InputCount{input_triangle_count}, nullptr) {}
+StreamDecimator::StreamDecimator(const Options& options, std::optional<uint64_t> input_triangle_count,
+                                 const AttributeLayout& attributes)
+    : StreamDecimator(options, io::InputCount{input_triangle_count}, nullptr, attributes) {}
 
-StreamDecimator::StreamDecimator(const Options& options, const io::InputCount& input)
-    : StreamDecimator(options, io::InputCount{input.promised}, &input) {}
+StreamDecimator::StreamDecimator(const Options& options, const io::InputCount& input, const AttributeLayout& attributes)
+    : StreamDecimator(options, io::InputCount{input.promised}, &input, attributes) {}
 
-StreamDecimator::StreamDecimator(const Options& options, io::InputCount own, const io::InputCount* input)
+StreamDecimator::StreamDecimator(const Options& options, io::InputCount own, const io::InputCount* input,
+                                 const AttributeLayout& attributes)
     : options_(checked(options, own.promised)),
       own_count_(own),
       input_(input != nullptr ? input : &own_count_),
       ratio_(choose_ratio(options, own.promised)),
       buffer_(options.buffer_triangles, options.weld_eps),
+      attributes_(attributes.any() ? std::make_unique<AttributeStore>(attributes, options.buffer_triangles) : nullptr),
       queue_(options.buffer_triangles),
       rng_(options.seed),
-      output_(options.output_chunk_triangles) {
+      output_(options.output_chunk_triangles, attributes_ ? &attributes_->layout() : nullptr) {
+    buffer_.set_attributes(attributes_.get());
     stats_.buffer_capacity = options.buffer_triangles;
     if (options.sorted_axis) {
         sweep_capacity_ = 3 * options.buffer_triangles + 3;
@@ -75,8 +80,9 @@ uint64_t StreamDecimator::expected_output(double ratio, uint64_t input_triangle_
     return final_triangle_count(ratio, input_triangle_count);
 }
 
-size_t StreamDecimator::reserved_bytes(size_t buffer_triangles) {
-    return HalfEdgeBuffer::reserved_bytes(buffer_triangles) + CollapseQueue::reserved_bytes(buffer_triangles);
+size_t StreamDecimator::reserved_bytes(size_t buffer_triangles, const AttributeLayout& attributes) {
+    return HalfEdgeBuffer::reserved_bytes(buffer_triangles) + CollapseQueue::reserved_bytes(buffer_triangles) +
+           (attributes.any() ? AttributeStore::reserved_bytes(attributes, buffer_triangles) : 0);
 }
 
 void StreamDecimator::push(const io::TriangleChunk& in, const Emit& out) { push(in, 1.0, out); }
@@ -89,6 +95,8 @@ void StreamDecimator::push(const io::TriangleChunk& in, double weight, const Emi
     // NaN/inf corners can be neither welded nor finalized (the commands drop them first).
     if (!std::all_of(xyz.begin(), xyz.end(), [](float v) { return std::isfinite(v); }))
         throw std::invalid_argument("StreamDecimator::push needs finite coordinates");
+    if (attributes_ && !attributes_->layout().carried_by(in.channels()))
+        throw std::invalid_argument("StreamDecimator::push needs the chunk to carry the decimator's channels");
     // Welding reads a random hash slot and then a random vertex per corner; prefetching them
     // a few triangles ahead overlaps those misses (hints only: results do not change). Each
     // corner is hashed once, kept in a small ring until the triangle is read.
@@ -106,12 +114,32 @@ void StreamDecimator::push(const io::TriangleChunk& in, double weight, const Emi
             buffer_.prefetch_triangle(hashes, 0);
         }
         if (i + kVerticesAhead < n) buffer_.prefetch_triangle(ring[(i + kVerticesAhead) % kRing], 1);
-        read_triangle(&xyz[9 * i], ring[i % kRing], out);
+        read_triangle(in, i, ring[i % kRing], out);
     }
 }
 
-void StreamDecimator::read_triangle(const float tri[9], const uint64_t hashes[3], const Emit& out) {
+void StreamDecimator::read_triangle(const io::TriangleChunk& in, size_t i, const uint64_t hashes[3], const Emit& out) {
+    const float* tri = &in.xyz()[9 * i];
     if (buffer_.full() || buffer_.free_vertex_count() < 3) make_room(out);
+    // The triangle's channels, as the attribute store keeps them.
+    float corners[3 * kMaxAttributeComponents];
+    double face_scalars[64];
+    uint32_t material = 0;
+    const size_t face_scalar_count = attributes_ ? attributes_->layout().face_scalar_count() : 0;
+    std::vector<double> many_face_scalars;
+    double* fs = face_scalars;
+    if (attributes_) {
+        const AttributeLayout& layout = attributes_->layout();
+        const int m = layout.size();
+        for (int k = 0; k < 3; ++k) layout.gather(in, i, k, corners + k * m);
+        attributes_->sanitize(corners, 3 * size_t(m));
+        if (const uint32_t* mat = in.material_at(i)) material = *mat;
+        if (face_scalar_count > 64) {
+            many_face_scalars.resize(face_scalar_count);
+            fs = many_face_scalars.data();
+        }
+        for (size_t c = 0; c < face_scalar_count; ++c) fs[c] = *in.face_scalar_at(i, c);
+    }
     if (options_.sorted_axis) track_sweep(tri);
     const HalfEdgeBuffer::Added added = [&] {
         const PhaseTimer timer(Phase::kRead);
@@ -130,10 +158,17 @@ void StreamDecimator::read_triangle(const float tri[9], const uint64_t hashes[3]
             ++stats_.weld_dropped;
             return;
         }
-        pass_through(buffer_, added.vertex, next_id_, output_, out);
+        if (attributes_) {
+            const int m = attributes_->size();
+            const PassedChannels passed{{corners, corners + m, corners + 2 * m}, material, fs};
+            pass_through(buffer_, added.vertex, next_id_, output_, out, &passed);
+        } else {
+            pass_through(buffer_, added.vertex, next_id_, output_, out);
+        }
         ++stats_.degenerate_passed;
         return;
     }
+    if (attributes_) attributes_->add_face(buffer_, added.face, corners, material, fs);
     stats_.peak_buffer_triangles = std::max(stats_.peak_buffer_triangles, buffer_.face_count());
     if (options_.sorted_axis) {
         // New P_in vertices join the sweep queue in reading order, which on sorted input is
@@ -374,6 +409,10 @@ void StreamDecimator::collect_stats() {
     stats_.vertices_merged = buffer_.vertices_merged();
     stats_.nonmanifold_edges = buffer_.nonmanifold_edges();
     stats_.boundary_edges = buffer_.boundary_edges();
+    if (attributes_) {
+        stats_.seam_vertices = attributes_->seam_vertices();
+        stats_.attribute_values_zeroed = attributes_->non_finite_values();
+    }
 }
 
 }  // namespace meshstream::decimate

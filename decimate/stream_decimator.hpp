@@ -10,6 +10,7 @@
 // and counted instead of failing.
 #pragma once
 
+#include "decimate/attribute_store.hpp"
 #include "decimate/collapse_queue.hpp"
 #include "decimate/halfedge_buffer.hpp"
 #include "decimate/random.hpp"
@@ -80,8 +81,10 @@ struct Stats {
     int sweep_direction = 0;       // sorted input: +1 ascending, −1 descending, 0 not yet seen
     uint64_t sort_violations = 0;  // triangles reaching behind the sweep (sweep then stops)
     uint64_t orphans_evicted = 0;
-    uint64_t vertices_moved = 0;          // moved to their quadric optimum when written
-    bool no_valid_collapse_left = false;  // the end's scan of every half-edge found none valid
+    uint64_t vertices_moved = 0;           // moved to their quadric optimum when written
+    uint64_t seam_vertices = 0;            // vertices whose corners disagree (kept in place)
+    uint64_t attribute_values_zeroed = 0;  // non-finite channel values read as 0
+    bool no_valid_collapse_left = false;   // the end's scan of every half-edge found none valid
 };
 
 class StreamDecimator {
@@ -89,16 +92,21 @@ public:
     // `input_triangle_count` is the reader's count when known; Options::target needs it.
     // Options outside their ranges throw std::invalid_argument. Allocates every buffer once;
     // reserved_bytes() tells how much (about 580 bytes reserved per buffer triangle).
-    StreamDecimator(const Options& options, std::optional<uint64_t> input_triangle_count);
+    //
+    // With `attributes` carrying channels (AttributeLayout::any()), the decimator reads them from
+    // every chunk (which must have them), rates collapses by geometric plus attribute error,
+    // keeps seams (attributes.hpp) and emits them; else it reads and emits positions only.
+    StreamDecimator(const Options& options, std::optional<uint64_t> input_triangle_count,
+                    const AttributeLayout& attributes = {});
     // The same for input that passes a read loop (io::TriangleInput) which may drop triangles
     // on the way: `input` (observed, must outlive this) says what its header promised and how
     // many were dropped so far. With Options::target the ratio becomes target / (promised −
     // dropped so far), so the output lands on the target when the dropped ones come early or
     // spread through the input; ones that all come late leave it short (the mesh before them
     // was decimated for more input).
-    StreamDecimator(const Options& options, const io::InputCount& input);
+    StreamDecimator(const Options& options, const io::InputCount& input, const AttributeLayout& attributes = {});
 
-    // Reads every triangle of `in` (positions only; other channels are ignored), decimating
+    // Reads every triangle of `in` (positions, and the attribute layout's channels), decimating
     // and writing to `out` as the schedule demands. Every coordinate must be finite, else it
     // throws std::invalid_argument before reading any: NaN/inf corners can be neither welded
     // nor finalized (the commands drop them first with tools::TriangleFilter).
@@ -126,13 +134,14 @@ public:
     static uint64_t expected_output(double ratio, uint64_t input_triangle_count);
     // The address space a decimator with a buffer of `buffer_triangles` reserves (the buffer,
     // hash tables and collapse queue); see docs/decimation.md for what becomes resident.
-    static size_t reserved_bytes(size_t buffer_triangles);
+    static size_t reserved_bytes(size_t buffer_triangles, const AttributeLayout& attributes = {});
     // The ratio in use (target / input count with Options::target, less what was dropped).
     double ratio() const { return ratio_; }
 
 private:
-    StreamDecimator(const Options& options, io::InputCount own, const io::InputCount* input);
-    void read_triangle(const float tri[9], const uint64_t hashes[3], const Emit& out);
+    StreamDecimator(const Options& options, io::InputCount own, const io::InputCount* input,
+                    const AttributeLayout& attributes);
+    void read_triangle(const io::TriangleChunk& in, size_t i, const uint64_t hashes[3], const Emit& out);
     void make_room(const Emit& out);
     void write_one(const Emit& out, bool allow_forced);
     void sweep();
@@ -147,6 +156,7 @@ private:
     const io::InputCount* input_;  // own_count_ or the caller's read loop's
     double ratio_;
     HalfEdgeBuffer buffer_;
+    std::unique_ptr<AttributeStore> attributes_;  // null for positions only
     CollapseQueue queue_;
     Rng rng_;
     TriangleOutput output_;

@@ -1,13 +1,28 @@
 // Multiple-choice writing and write-time vertex placement (Wu & Kobbelt 2003, §4.4).
 #include "decimate/writing.hpp"
 
+#include "decimate/attribute_store.hpp"
 #include "decimate/collapse.hpp"
 
 #include <algorithm>
 
 namespace meshstream::decimate {
 
-TriangleOutput::TriangleOutput(size_t chunk_triangles) : chunk_(chunk_triangles, io::Channels::ids_only()) {}
+TriangleOutput::TriangleOutput(size_t chunk_triangles, const AttributeLayout* layout)
+    : chunk_(chunk_triangles, layout ? layout->channels() : io::Channels::ids_only()), layout_(layout) {}
+
+void TriangleOutput::emit(const float xyz[9], const uint64_t ids[3], const Emit& out, const float* const corners[3],
+                          uint32_t material, const double* face_scalars) {
+    const size_t i = chunk_.size();
+    float* slot = chunk_.push_slot();
+    std::copy(xyz, xyz + 9, slot);
+    std::copy(ids, ids + 3, chunk_.id_at(i));
+    for (int k = 0; k < 3; ++k) layout_->scatter(corners[k], chunk_, i, k);
+    if (uint32_t* m = chunk_.material_at(i)) *m = material;
+    for (size_t c = 0; c < layout_->face_scalar_count(); ++c) *chunk_.face_scalar_at(i, c) = face_scalars[c];
+    ++triangle_count_;
+    if (chunk_.full()) flush(out);
+}
 
 void TriangleOutput::emit(const float xyz[9], const uint64_t ids[3], const Emit& out) {
     float* slot = chunk_.push_slot();
@@ -30,11 +45,15 @@ uint32_t pick_write(HalfEdgeBuffer& buffer) { return buffer.oldest_interior_face
 
 bool place_vertex(HalfEdgeBuffer& buffer, uint32_t v) {
     const Vertex& x = buffer.vertex(v);
-    if ((x.flags & (kInHash | kNonManifold | kFrozen)) != 0 || x.open_edges != 0) return false;
+    if ((x.flags & (kInHash | kNonManifold | kFrozen | kSeam)) != 0 || x.open_edges != 0) return false;
     // Nothing collapsed into v: every plane of its quadric passes through v, so its own
     // position is the minimum, and a solve would only move it by round-off.
     if ((x.flags & kHasPartner) == 0) return false;
-    const Quadric& q = buffer.quadric(v);
+    // With weighted channels, the minimum of geometric and attribute error (attributes.hpp).
+    const AttributeStore* attributes = buffer.attributes();
+    const Quadric q = attributes != nullptr && attributes->weighted()
+                          ? attributes->combined(buffer.quadric(v), attributes->quadric(v))
+                          : buffer.quadric(v);
     double old[3], best[3];
     buffer.position(v, old);
     if (!q.minimum(best)) {
@@ -84,10 +103,12 @@ int write_face(HalfEdgeBuffer& buffer, uint32_t f, uint64_t& next_id, TriangleOu
     uint64_t ids[3];
     uint32_t v[3];
     int moved = 0;
+    AttributeStore* attributes = buffer.attributes();
     for (int k = 0; k < 3; ++k) {
         v[k] = buffer.corner_vertex(half_edge(f, k));
         if ((buffer.vertex(v[k]).flags & kFrozen) == 0) {
             moved += place_vertex(buffer, v[k]) ? 1 : 0;
+            if (attributes) attributes->settle(buffer, v[k]);
             buffer.freeze(v[k], next_id++);
         }
     }
@@ -98,7 +119,13 @@ int write_face(HalfEdgeBuffer& buffer, uint32_t f, uint64_t& next_id, TriangleOu
         xyz[3 * k + 2] = x.pos[2];
         ids[k] = x.id;
     }
-    output.emit(xyz, ids, out);
+    if (attributes) {
+        const float* corners[3];
+        for (uint32_t k = 0; k < 3; ++k) corners[k] = attributes->shown(buffer, half_edge(f, k));
+        output.emit(xyz, ids, out, corners, attributes->material(f), attributes->face_scalars(f));
+    } else {
+        output.emit(xyz, ids, out);
+    }
     for (int k = 0; k < 3; ++k) {
         const uint32_t h = half_edge(f, k);
         const uint32_t t = buffer.twin(h);
@@ -119,18 +146,24 @@ int write_face(HalfEdgeBuffer& buffer, uint32_t f, uint64_t& next_id, TriangleOu
 }
 
 void pass_through(HalfEdgeBuffer& buffer, const uint32_t vertex[3], uint64_t& next_id, TriangleOutput& output,
-                  const Emit& out) {
+                  const Emit& out, const PassedChannels* channels) {
     float xyz[9];
     uint64_t ids[3];
+    AttributeStore* attributes = buffer.attributes();
     for (int k = 0; k < 3; ++k) {
         const Vertex& x = buffer.vertex(vertex[k]);
+        if (attributes && channels)
+            attributes->ensure_vertex(buffer, vertex[k], channels->corners[k], channels->material);
         if ((x.flags & kFrozen) == 0) buffer.freeze(vertex[k], next_id++);
         xyz[3 * k] = x.pos[0];
         xyz[3 * k + 1] = x.pos[1];
         xyz[3 * k + 2] = x.pos[2];
         ids[k] = x.id;
     }
-    output.emit(xyz, ids, out);
+    if (channels)
+        output.emit(xyz, ids, out, channels->corners, channels->material, channels->face_scalars);
+    else
+        output.emit(xyz, ids, out);
 }
 
 }  // namespace meshstream::decimate

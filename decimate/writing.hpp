@@ -3,6 +3,7 @@
 // frozen, with a stable output id, so neighbouring triangles written later share it.
 #pragma once
 
+#include "decimate/attributes.hpp"
 #include "decimate/halfedge_buffer.hpp"
 #include "io/chunk.hpp"
 
@@ -11,21 +12,26 @@
 
 namespace meshstream::decimate {
 
-// Receives each full chunk of output triangles (positions + vertex_id channel); the chunk is
-// reused after the call returns.
+// Receives each full chunk of output triangles (positions + vertex_id channel, plus the carried
+// channels with an attribute store); the chunk is reused after the call returns.
 using Emit = std::function<void(const io::TriangleChunk&)>;
 
 // Collects written triangles into a fixed chunk and hands it to an Emit when full.
 class TriangleOutput {
 public:
-    explicit TriangleOutput(size_t chunk_triangles);
+    // With `layout` (which must outlive this), chunks carry its channels too.
+    explicit TriangleOutput(size_t chunk_triangles, const AttributeLayout* layout = nullptr);
     void emit(const float xyz[9], const uint64_t ids[3], const Emit& out);
+    // The same with the channels: each corner's m values, the face's material and face scalars.
+    void emit(const float xyz[9], const uint64_t ids[3], const Emit& out, const float* const corners[3],
+              uint32_t material, const double* face_scalars);
     // Hands over the partial chunk, if any.
     void flush(const Emit& out);
     uint64_t triangle_count() const { return triangle_count_; }
 
 private:
     io::TriangleChunk chunk_;
+    const AttributeLayout* layout_;
     uint64_t triangle_count_ = 0;
 };
 
@@ -53,7 +59,14 @@ int write_face(HalfEdgeBuffer& buffer, uint32_t f, uint64_t& next_id, TriangleOu
 
 // Passes a triangle whose corners welded together (degenerate) straight through: its
 // vertices are frozen where they are (they are on P_in) and it is emitted as read.
+// A passed triangle's own channels (with an attribute store): each corner's m values, material,
+// face scalars.
+struct PassedChannels {
+    const float* corners[3];
+    uint32_t material;
+    const double* face_scalars;
+};
 void pass_through(HalfEdgeBuffer& buffer, const uint32_t vertex[3], uint64_t& next_id, TriangleOutput& output,
-                  const Emit& out);
+                  const Emit& out, const PassedChannels* channels = nullptr);
 
 }  // namespace meshstream::decimate

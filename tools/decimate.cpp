@@ -53,6 +53,7 @@ struct DecimateOptions {
     std::optional<int> sorted_axis;
     std::string sort = "auto";  // --sort auto|always|never
     unsigned threads = every_core();
+    std::string weights;  // --weights normal=W,color=W,uv=W,NAME=W
     bool report = false;
     bool json = false;
     ReadFlags read;
@@ -90,6 +91,72 @@ double weld_epsilon(const DecimateOptions& opt, const std::string& input_name) {
         diag2 += d * d;
     }
     return std::isfinite(diag2) ? value / 100 * std::sqrt(diag2) : 0;  // no finite corner: nothing to weld
+}
+
+// --weights: "normal=0.5,color=1,uv=2,intensity=1" (colour also as colour/colors, normal as
+// normals, uv as uvs; any other name is a vertex scalar's).
+decimate::AttributeWeights parse_weights(const std::string& text) {
+    decimate::AttributeWeights w;
+    if (text.empty()) return w;
+    size_t start = 0;
+    while (start <= text.size()) {
+        const size_t end = std::min(text.find(',', start), text.size());
+        const std::string item = text.substr(start, end - start);
+        const size_t eq = item.find('=');
+        if (eq == std::string::npos || eq == 0)
+            throw CLI::ValidationError("--weights",
+                                       "expected NAME=WEIGHT items separated by commas, found '" + item + "'");
+        const std::string name = item.substr(0, eq), number = item.substr(eq + 1);
+        double value = 0;
+        size_t used = 0;
+        try {
+            value = std::stod(number, &used);
+        } catch (const std::exception&) {
+            used = 0;
+        }
+        if (used == 0 || used != number.size() || !(value >= 0) || !std::isfinite(value))
+            throw CLI::ValidationError("--weights", name + ": expected a number >= 0, found '" + number + "'");
+        if (name == "normal" || name == "normals")
+            w.normal = value;
+        else if (name == "color" || name == "colour" || name == "colors" || name == "colours")
+            w.color = value;
+        else if (name == "uv" || name == "uvs")
+            w.uv = value;
+        else
+            w.scalars.emplace_back(name, value);
+        start = end + 1;
+    }
+    return w;
+}
+
+// What the decimator carries from input to output: the channels read (less --drop's) that the
+// output format keeps, as an attribute layout; and what is dropped for the output's sake.
+struct Carried {
+    io::Channels channels;  // what the reader fills and the writer gets (no vertex ids)
+    decimate::AttributeLayout layout;
+    std::string dropped;  // in words; empty when nothing is
+};
+
+Carried carried_channels(const DecimateOptions& opt, const io::MeshHeader& header, const io::Format& out_format,
+                         const io::WriteOptions& wo, const std::string& input_name) {
+    Carried c;
+    // What --drop leaves (the reader may read less: nothing, for an output that keeps nothing).
+    io::Channels wanted = opt.read.options().channels.of(header.channels);
+    wanted.vertex_id = false;
+    c.channels = io::writable_channels(out_format, wanted, wo);
+    c.channels.vertex_id = false;
+    c.dropped = io::describe_missing(wanted, c.channels);
+    try {
+        c.layout = decimate::AttributeLayout(c.channels, parse_weights(opt.weights));
+    } catch (const std::invalid_argument& e) {
+        throw UsageError(input_name + ": --weights: " + e.what());
+    }
+    if (c.layout.size() > decimate::kMaxAttributeComponents)
+        throw UsageError(input_name + ": " + std::to_string(c.layout.size()) +
+                         " normal, colour, texture and scalar values per corner, more than the " +
+                         std::to_string(decimate::kMaxAttributeComponents) +
+                         " decimate carries: leave some out with --drop extra (or uvs)");
+    return c;
 }
 
 // What a decimation pass reads: fills a chunk, false at the end.
@@ -241,14 +308,14 @@ CountPass count_usable_triangles(const DecimateOptions& opt, const io::ReadOptio
     return pass;
 }
 
-std::unique_ptr<decimate::StreamDecimator> make_decimator(const decimate::Options& options,
-                                                          const io::InputCount& count) {
+std::unique_ptr<decimate::StreamDecimator> make_decimator(const decimate::Options& options, const io::InputCount& count,
+                                                          const decimate::AttributeLayout& attributes = {}) {
     try {  // on the heap only to catch a refused reservation here
-        return std::make_unique<decimate::StreamDecimator>(options, count);
+        return std::make_unique<decimate::StreamDecimator>(options, count, attributes);
     } catch (const std::bad_alloc&) {
         throw std::runtime_error(
             "--buffer " + std::to_string(options.buffer_triangles) + " reserves " +
-            human_bytes(double(decimate::StreamDecimator::reserved_bytes(options.buffer_triangles))) +
+            human_bytes(double(decimate::StreamDecimator::reserved_bytes(options.buffer_triangles, attributes))) +
             " of memory (about 580 bytes a triangle), which this system refused: give a smaller --buffer (the "
             "default 400000 reserves " +
             human_bytes(double(decimate::StreamDecimator::reserved_bytes(400000))) + ")");
@@ -257,10 +324,11 @@ std::unique_ptr<decimate::StreamDecimator> make_decimator(const decimate::Option
 
 // Pushes what `next` gives through `decimator`, calling `show_progress` after each chunk;
 // returns false when `stop`, asked after each chunk, said to stop, true at the end of the input.
-bool decimate_pass(const ChunkSource& next, decimate::StreamDecimator& decimator, const decimate::Emit& emit,
-                   const std::function<void()>& show_progress, const std::function<bool()>& stop) {
-    // The decimator rates and writes positions only: no other channel is read.
-    io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, io::Channels{});
+bool decimate_pass(const ChunkSource& next, const io::Channels& channels, decimate::StreamDecimator& decimator,
+                   const decimate::Emit& emit, const std::function<void()>& show_progress,
+                   const std::function<bool()>& stop) {
+    // The chunk carries what the decimator does: the reader fills no more.
+    io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, channels);
     while (next(chunk)) {
         decimator.push(chunk, emit);
         show_progress();
@@ -280,9 +348,10 @@ struct SortedInput {
 };
 
 std::unique_ptr<sort::ExternalSorter> make_sorter(int axis, uint64_t budget, const std::string& tmpdir,
-                                                  Progress& progress) {
+                                                  Progress& progress, const io::Channels& channels = {}) {
     sort::SorterOptions so;
     so.axis = axis;
+    so.channels = channels;
     so.memory_budget_bytes = budget;
     so.tmpdir = tmpdir;
     so.on_merge_progress = [&progress](int pass, int pass_count, uint64_t merged) {
@@ -295,13 +364,13 @@ std::unique_ptr<sort::ExternalSorter> make_sorter(int axis, uint64_t budget, con
 // Sorts a file input: its bounding box first (the longest axis), then its triangles, read
 // again through the read loop.
 SortedInput sort_file(const DecimateOptions& opt, uint64_t sort_budget, const io::ReadOptions& ro,
-                      const std::string& tmpdir, Progress& progress) {
+                      const std::string& tmpdir, Progress& progress, const io::Channels& channels) {
     SortedInput s;
     s.axis = longest_axis(input_bounds(opt.input, opt.read.from, ro));
     io::TriangleInput in = open_triangle_input(opt.input, opt.read, ro, Command::kDecimate);
-    s.sorter = make_sorter(s.axis, sort_budget, tmpdir, progress);
+    s.sorter = make_sorter(s.axis, sort_budget, tmpdir, progress, channels);
     progress.phase("sorting: reading", in.header().triangle_count);
-    io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, io::Channels{});
+    io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, channels);
     while (in.next(chunk)) {
         s.sorter->add(chunk);
         progress.update(in.count().read, in.source());
@@ -371,12 +440,22 @@ nlohmann::ordered_json report_error(const DecimateOptions& opt, const DecimateFa
     return {{"bbox_diagonal", r.diagonal}, {"hausdorff", r.hausdorff()}, {"mean", r.mean()}, {"rms", r.rms()}};
 }
 
-// The read loop decimate reads through: the decimator keeps positions only, so the reader stores
-// no attribute (a coloured PLY then costs what a plain one does), while the header still lists
-// what is dropped.
-io::ReadOptions decimate_read_options(const DecimateOptions& opt) {
+// The read loop decimate reads through: the channels --drop leaves, when the output format can
+// keep any (decimate carries them); else none, so that the reader stores no attribute (a
+// coloured PLY decimated to STL costs what a plain one does), while the header still lists what
+// is dropped. An MPI rank (`positions_only`) decimates positions: channels keep to one process.
+io::ReadOptions decimate_read_options(const DecimateOptions& opt, const io::Format* out_format = nullptr,
+                                      const io::WriteOptions* wo = nullptr) {
     io::ReadOptions read = opt.read.options();
-    read.channels = io::ChannelKinds::none();
+    io::Channels every;
+    every.normal = true;
+    every.color = io::ColorFormat{io::ScalarType::kFloat32, true};
+    every.uv_sets = 1;
+    every.vertex_scalars = {io::ScalarChannel{"s"}};
+    every.material = true;
+    every.face_scalars = {io::ScalarChannel{"f"}};
+    if (out_format == nullptr || !io::writable_channels(*out_format, every, *wo).has_attributes())
+        read.channels = io::ChannelKinds::none();
     return read;
 }
 
@@ -444,7 +523,8 @@ void run_decimate(const DecimateOptions& opt, RangeProcesses* processes) {
             throw UsageError(name + ": --report needs to re-read both files; it does not work with '-' or a pipe");
         }
     }
-    const io::ReadOptions read = decimate_read_options(opt);
+    io::WriteOptions wo = opt.write.options(opt.read, out_format);
+    const io::ReadOptions read = decimate_read_options(opt, &out_format, &wo);
     io::TriangleInput in = open_triangle_input(opt.input, opt.read, read, Command::kDecimate);
     std::optional<CountPass> counted;
     if (opt.target && !in.header().triangle_count && is_regular_file(opt.input)) {
@@ -461,6 +541,10 @@ void run_decimate(const DecimateOptions& opt, RangeProcesses* processes) {
     const RunFile input_file{opt.input, std::string(in.format().name), in.source().gzip()};
     const std::optional<uint64_t> input_count = counted ? counted->count.promised : header.triangle_count;
     const decimate::Options options = decimation_options(opt, header, input_name, in.format().name, input_count);
+    const Carried carried = carried_channels(opt, header, out_format, wo, input_name);
+    const bool with_channels = carried.layout.any();
+    wo.channels = carried.channels;
+    if (carried.channels.material) wo.materials = header.materials;
 
     // --threads (or meshstream-mpi's processes): a file cut into ranges of triangles
     // (decimate_threads.hpp) by the count its header states or estimates, else by one counted in
@@ -484,6 +568,12 @@ void run_decimate(const DecimateOptions& opt, RangeProcesses* processes) {
     }
     // The ranges' outputs wait in --tmpdir: where nothing can be written, one thread decimates.
     std::string one_thread_why;
+    // Ranges, their spools and MPI's messages carry positions only.
+    if (ranges > 1 && with_channels) {
+        ranges = 1;
+        one_thread_why = "ranges carry positions only, and decimate keeps this input's " +
+                         io::describe_missing(carried.channels, io::Channels{});
+    }
     if (ranges > 1) {
         try {
             io::TempFile probe(opt.read.tmpdir, "meshstream-range");
@@ -493,7 +583,6 @@ void run_decimate(const DecimateOptions& opt, RangeProcesses* processes) {
         }
     }
 
-    io::WriteOptions wo = opt.write.options(opt.read, out_format);
     // The output count, for whole-mesh writers to refuse a --memory too small before the work
     // (and to say how much the output needs when it passes the budget): from the header's
     // count, a PLY's faces (each at least one triangle) or the count of the first pass.
@@ -508,8 +597,14 @@ void run_decimate(const DecimateOptions& opt, RangeProcesses* processes) {
 
     // --sort: what may happen. Input known to be sorted (its flag, --sorted-axis) is decimated
     // as it comes in auto: sorting again cannot help it, a larger buffer can.
-    const bool may_restart = opt.sort == "auto" && !options.sorted_axis;
     const bool read_once = !is_regular_file(opt.input);
+    // A stream is spooled to be sorted as positions only: with channels it is decimated as read.
+    const bool spool_loses = read_once && with_channels;
+    if (sort_first && spool_loses)
+        throw UsageError("<stdin>: --sort always spools a stream as positions only, and decimate keeps its " +
+                         io::describe_missing(carried.channels, io::Channels{}) +
+                         ": give the input as a file, or sort first (meshstream sort IN SORTED.mstream)");
+    const bool may_restart = opt.sort == "auto" && !options.sorted_axis && !spool_loses;
     const uint64_t budget = opt.read.options().memory_budget_bytes;
     io::ReadOptions sort_ro = read;  // the reader's share while sorting
     sort_ro.memory_budget_bytes = budget / 4;
@@ -565,7 +660,7 @@ void run_decimate(const DecimateOptions& opt, RangeProcesses* processes) {
         }
     } else if (!sort_first) {
         sharing.share(std::nullopt);  // the other processes have nothing to do
-        decimator = make_decimator(options, decimator_count(in.count()));
+        decimator = make_decimator(options, decimator_count(in.count()), carried.layout);
         const auto attempt = std::chrono::steady_clock::now();
         const ChunkSource next = [&](io::TriangleChunk& chunk) {
             if (!in.next(chunk)) return false;
@@ -573,7 +668,7 @@ void run_decimate(const DecimateOptions& opt, RangeProcesses* processes) {
             return true;
         };
         const bool whole = decimate_pass(
-            next, *decimator, emit, [&] { progress.update(in.count().read, in.source()); },
+            next, carried.channels, *decimator, emit, [&] { progress.update(in.count().read, in.source()); },
             [&] {
                 return may_restart && decimator->stats().forced_writes > 0 && !gate.released() &&
                        (!spool || spool->ok());
@@ -589,6 +684,11 @@ void run_decimate(const DecimateOptions& opt, RangeProcesses* processes) {
                                   : "its output to " + out->sink->name() + " was already under way (" +
                                         human_count(double(gate.held_triangles())) +
                                         " triangles held back first; write to a file, or sort first)";
+        } else if (spool_loses && opt.sort == "auto" && !options.sorted_axis && decimator->stats().forced_writes > 0) {
+            outcome.kind = SortOutcome::Kind::kCouldNot;
+            outcome.why_not = "a stream is spooled as positions only, and decimate keeps its " +
+                              io::describe_missing(carried.channels, io::Channels{}) +
+                              " (give the input as a file, or sort first)";
         }
     }
     if (sort_first || outcome.kind == SortOutcome::Kind::kSorted) {
@@ -610,7 +710,7 @@ void run_decimate(const DecimateOptions& opt, RangeProcesses* processes) {
         const auto sorting = std::chrono::steady_clock::now();
         try {
             sorted = spool ? sort_spooled(in, *spool, sort_budget, opt.read.tmpdir, progress)
-                           : sort_file(opt, sort_budget, sort_ro, opt.read.tmpdir, progress);
+                           : sort_file(opt, sort_budget, sort_ro, opt.read.tmpdir, progress, carried.channels);
         } catch (const io::Error& e) {
             // A sort auto chose may fail (a full --tmpdir) where decimating as read would not:
             // the file is then decimated as it is. A spooled stdin is gone with the spool.
@@ -626,7 +726,7 @@ void run_decimate(const DecimateOptions& opt, RangeProcesses* processes) {
             outcome.temp_bytes = sorted->temp_bytes;
             used.sorted_axis = sorted->axis;
             used.sorted_by_minimum = true;
-            decimator = make_decimator(used, decimator_count(sorted->count));
+            decimator = make_decimator(used, decimator_count(sorted->count), carried.layout);
             progress.phase("decimating the sorted input", sorted->count.passed());
             uint64_t done = 0;
             const ChunkSource next = [&](io::TriangleChunk& chunk) {
@@ -634,18 +734,20 @@ void run_decimate(const DecimateOptions& opt, RangeProcesses* processes) {
                 done += chunk.size();
                 return true;
             };
-            decimate_pass(next, *decimator, emit, [&] { progress.update(done); }, {});
+            decimate_pass(next, carried.channels, *decimator, emit, [&] { progress.update(done); }, {});
         } else {
             in = open_triangle_input(opt.input, opt.read, read, Command::kDecimate);
-            decimator = make_decimator(options, decimator_count(in.count()));
+            decimator = make_decimator(options, decimator_count(in.count()), carried.layout);
             progress.phase("decimating", input_count);
-            decimate_pass([&](io::TriangleChunk& chunk) { return in.next(chunk); }, *decimator, emit,
+            decimate_pass([&](io::TriangleChunk& chunk) { return in.next(chunk); }, carried.channels, *decimator, emit,
                           [&] { progress.update(in.count().read, in.source()); }, {});
         }
     }
     progress.phase("finishing", std::nullopt);
     if (decimator) decimator->finish(emit);
     gate.release();
+    // A reader may have added materials while reading (OBJ: names met after the first face).
+    if (carried.channels.material) out->writer->update_materials((sorted ? sorted->end_header : in.header()).materials);
     progress.done();
     out->finish();
     const double seconds = seconds_since(start);
@@ -677,8 +779,9 @@ void run_decimate(const DecimateOptions& opt, RangeProcesses* processes) {
     if (!opt.json && !global().quiet) print_decimate_summary(facts, opt.output, seconds);
 
     Warnings warnings;
-    if (const std::string dropped = io::describe_missing(header.channels, io::Channels{}); !dropped.empty())
-        warnings.note("channels_dropped", dropped + " dropped: decimate keeps positions only");
+    // --drop's channels were not read: their loss was asked for, so it goes unsaid.
+    if (!carried.dropped.empty())
+        warnings.note("channels_dropped", dropped_channels_text(carried.dropped, *out->format, carried.channels));
     note_unused_write_flags(opt.write, *out->format, opt.output, warnings);
     for (const std::string& note : out->writer->notes()) warnings.note("output_note", note);
     note_dropped_triangles(sorted     ? sorted->dropped
@@ -691,8 +794,10 @@ void run_decimate(const DecimateOptions& opt, RangeProcesses* processes) {
                        input_name, warnings);
     note_decimate_warnings(facts, warnings);
     if (!one_thread_why.empty())
-        warnings.note("threads_unavailable",
-                      "decimated by one thread: the ranges' outputs cannot be spooled (" + one_thread_why + ")");
+        warnings.note(
+            "threads_unavailable",
+            "decimated by one thread: " +
+                (with_channels ? one_thread_why : "the ranges' outputs cannot be spooled (" + one_thread_why + ")"));
     warnings.print();
 
     RunReport report;
@@ -744,6 +849,14 @@ void add_decimate(CLI::App& app, RangeProcesses* processes) {
                     "first; never: decimate as read")
         ->type_name("WHEN")
         ->check(CLI::IsMember({"auto", "always", "never"}));
+    cmd->add_option("--weights", opt->weights,
+                    "weights of the attribute errors: normal, color, uv, or a vertex scalar's name\n"
+                    "Default: 1 for normals, colours and texture coordinates, none for scalars. "
+                    "Collapses are rated by geometric plus attribute error. A weight multiplies the values (colours "
+                    "in 0..1), so the error grows with its square; 0 rates by geometry alone (values are still "
+                    "interpolated); e.g. --weights color=W,normal=W")
+        ->type_name("NAME=W,...")
+        ->group(kMoreOptions);
     cmd->add_flag("--report", opt->report,
                   "measure the output's error against the input at the end\n"
                   "Hausdorff, mean and RMS distance, as compare does");
@@ -760,6 +873,7 @@ void add_decimate(CLI::App& app, RangeProcesses* processes) {
     add_json_flag(cmd, opt->json);
     add_write_flags(cmd, opt->write);
     add_read_flags(cmd, opt->read);
+    add_drop_flag(cmd, opt->read);
     describe_memory_for_writing(cmd);
     cmd->get_option("--tmpdir")->group("Options");
     strict_refuses_dropped_triangles(cmd);

@@ -74,6 +74,9 @@ void note_decimate_warnings(const DecimateFacts& f, Warnings& warnings) {
                 "may show as cracks); " +
                 (axis_conflict ? std::string("leave out --sorted-axis to use the file's own axis")
                                : std::string("run `meshstream sort` on it first")));
+    if (s.attribute_values_zeroed > 0)
+        warnings.add("attribute_values_zeroed", "non-finite normal, colour, texture or scalar values read as 0",
+                     s.attribute_values_zeroed);
     if (s.nonmanifold_edges > 0)
         warnings.add("nonmanifold_edges_frozen",
                      "non-manifold, duplicate or mis-oriented edges frozen and passed through", s.nonmanifold_edges);
@@ -129,7 +132,8 @@ void note_decimate_warnings(const DecimateFacts& f, Warnings& warnings) {
         warnings.note("target_missed",
                       missed +
                           " (no allowed collapse is left: each would fold a face over or change the topology, "
-                          "or move a vertex that must stay, as on a non-manifold edge)");
+                          "or move a vertex that must stay, as on a non-manifold edge" +
+                          (s.seam_vertices > 0 ? std::string(" or an attribute seam") : std::string()) + ")");
     else if (s.triangles_in > 0 && s.triangles_out > s.target_triangles && s.nonmanifold_edges > 0)
         warnings.note("target_missed",
                       missed + " (the " + std::to_string(s.nonmanifold_edges) +
@@ -179,6 +183,7 @@ nlohmann::ordered_json decimate_details_json(const DecimateFacts& f) {
     j["buffer"] = s.buffer_capacity;
     j["peak_buffer_fill"] = s.peak_buffer_triangles;
     j["collapses"] = s.collapses;
+    j["seam_vertices"] = s.seam_vertices;
     j["forced_writes"] = s.forced_writes;
     j["skipped_triangles"] = f.skipped;
     j["sorted_axis"] =

@@ -592,3 +592,218 @@ TEST(StreamDecimator, RangesKeepTheirSeamsAndTheSeamPassJoinsThem) {
     EXPECT_EQ(two.misoriented_edges, 0u);
     EXPECT_LE(two.boundary_edges, one.boundary_edges + one.boundary_edges / 5);
 }
+
+// ---- Channels (decimate/attributes.hpp): what the decimator carries besides positions.
+
+namespace {
+
+// A flat n × n grid over [0,1]² (z = 0), two triangles a cell, each corner's single uv set and
+// colour given by functions of the corner's position and of the triangle's cell.
+struct ChannelMesh {
+    meshstream::io::Channels channels;
+    std::vector<float> xyz, uv, rgba;  // per triangle: 9, 6, 12
+};
+
+template <class Uv, class Rgb>
+ChannelMesh channel_grid(int n, Uv uv_of, Rgb rgb_of) {
+    ChannelMesh m;
+    m.channels.uv_sets = 1;
+    m.channels.color = meshstream::io::ColorFormat{meshstream::io::ScalarType::kFloat32, false};
+    auto corner = [&](int i, int j, int ci, int cj) {
+        const float x = float(i) / float(n), y = float(j) / float(n);
+        m.xyz.insert(m.xyz.end(), {x, y, 0.0f});
+        const std::array<float, 2> t = uv_of(x, y, ci, cj);
+        m.uv.insert(m.uv.end(), t.begin(), t.end());
+        const std::array<float, 3> c = rgb_of(x, y);
+        m.rgba.insert(m.rgba.end(), {c[0], c[1], c[2], 1.0f});
+    };
+    for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i) {
+            for (const auto& [di, dj] : {std::pair{0, 0}, {1, 0}, {1, 1}}) corner(i + di, j + dj, i, j);
+            for (const auto& [di, dj] : {std::pair{0, 0}, {1, 1}, {0, 1}}) corner(i + di, j + dj, i, j);
+        }
+    return m;
+}
+
+struct ChannelResult {
+    std::vector<float> xyz, uv, rgba;
+    Stats stats;
+};
+
+ChannelResult run_with_channels(const ChannelMesh& m, const Options& options, const AttributeWeights& weights) {
+    const size_t n = m.xyz.size() / 9;
+    StreamDecimator decimator(options, std::optional<uint64_t>(n), AttributeLayout(m.channels, weights));
+    ChannelResult r;
+    const Emit emit = [&](const meshstream::io::TriangleChunk& chunk) {
+        r.xyz.insert(r.xyz.end(), chunk.xyz().begin(), chunk.xyz().end());
+        for (size_t i = 0; i < chunk.size(); ++i) {
+            r.uv.insert(r.uv.end(), chunk.uv_at(i, 0), chunk.uv_at(i, 0) + 6);
+            r.rgba.insert(r.rgba.end(), chunk.color_at(i), chunk.color_at(i) + 12);
+        }
+    };
+    meshstream::io::TriangleChunk chunk(1000, m.channels);
+    for (size_t i = 0; i < n; ++i) {
+        std::copy_n(&m.xyz[9 * i], 9, chunk.push_slot());
+        std::copy_n(&m.uv[6 * i], 6, chunk.uv_at(chunk.size() - 1, 0));
+        std::copy_n(&m.rgba[12 * i], 12, chunk.color_at(chunk.size() - 1));
+        if (chunk.full()) {
+            decimator.push(chunk, emit);
+            chunk.clear();
+        }
+    }
+    if (!chunk.empty()) decimator.push(chunk, emit);
+    decimator.finish(emit);
+    r.stats = decimator.stats();
+    return r;
+}
+
+std::array<float, 2> uv_is_xy(float x, float y, int, int) { return {x, y}; }
+std::array<float, 3> ramp(float x, float y) { return {0.1f + 0.8f * x, 0.9f - 0.5f * y, 0.3f + 0.2f * x + 0.3f * y}; }
+
+}  // namespace
+
+TEST(StreamDecimatorChannels, LinearFieldsComeOutExactWhereverVerticesMove) {
+    const ChannelMesh m = channel_grid(40, uv_is_xy, ramp);
+    Options options;
+    options.ratio = 0.1;
+    options.buffer_triangles = 1000;  // decimated in a stream, not in one piece
+    const ChannelResult r = run_with_channels(m, options, {});
+    ASSERT_EQ(r.xyz.size() / 9, StreamDecimator::expected_output(0.1, m.xyz.size() / 9));
+    EXPECT_GT(r.stats.vertices_moved + r.stats.collapses, 0u);
+    for (size_t c = 0; c < r.xyz.size() / 3; ++c) {
+        const float x = r.xyz[3 * c], y = r.xyz[3 * c + 1];
+        const std::array<float, 3> expect = ramp(x, y);
+        for (int k = 0; k < 3; ++k) ASSERT_NEAR(r.rgba[4 * c + k], expect[k], 2e-4) << "corner " << c;
+        ASSERT_NEAR(r.uv[2 * c], x, 2e-4);
+        ASSERT_NEAR(r.uv[2 * c + 1], y, 2e-4);
+        ASSERT_EQ(r.rgba[4 * c + 3], 1.0f);
+    }
+}
+
+TEST(StreamDecimatorChannels, NoTriangleSpansAUvSeamAndSeamVerticesStay) {
+    // Cells right of x = 0.5 belong to another texture chart (u + 10): the column of vertices at
+    // x = 0.5 is a seam.
+    const int n = 32;
+    const ChannelMesh m = channel_grid(
+        n,
+        [&](float x, float y, int ci, int) {
+            return std::array<float, 2>{x + (ci >= n / 2 ? 10.0f : 0.0f), y};
+        },
+        ramp);
+    Options options;
+    options.ratio = 0.25;
+    options.buffer_triangles = 800;
+    // The seam holds by rule, whatever the weights: here the uv error weighs nothing.
+    AttributeWeights no_uv_error;
+    no_uv_error.uv = 0;
+    const ChannelResult r = run_with_channels(m, options, no_uv_error);
+    EXPECT_EQ(r.xyz.size() / 9, StreamDecimator::expected_output(0.25, m.xyz.size() / 9));
+    EXPECT_EQ(r.stats.seam_vertices, uint64_t(n + 1));
+    std::set<float> seam_ys;
+    for (size_t t = 0; t < r.xyz.size() / 9; ++t) {
+        int chart[3];
+        for (int k = 0; k < 3; ++k) {
+            const size_t c = 3 * t + size_t(k);
+            const float offset = r.uv[2 * c] - r.xyz[3 * c];
+            ASSERT_TRUE(std::fabs(offset) < 1e-3 || std::fabs(offset - 10) < 1e-3) << offset;
+            chart[k] = offset > 5;
+            if (r.xyz[3 * c] == 0.5f) seam_ys.insert(r.xyz[3 * c + 1]);
+        }
+        EXPECT_TRUE(chart[0] == chart[1] && chart[1] == chart[2]) << "triangle " << t << " spans the seam";
+    }
+    EXPECT_EQ(seam_ys.size(), size_t(n + 1));  // every seam vertex kept
+}
+
+namespace {
+
+// RMS over the input grid's vertices of the colour difference between the input's colour there
+// and the output's interpolated colour at the same (x, y) (flat meshes: found in 2D).
+double colour_rms(const ChannelMesh& in, const ChannelResult& out) {
+    double sum = 0;
+    size_t count = 0;
+    for (size_t c = 0; c < in.xyz.size() / 3; c += 1) {
+        const double px = in.xyz[3 * c], py = in.xyz[3 * c + 1];
+        for (size_t t = 0; t < out.xyz.size() / 9; ++t) {
+            const float* a = &out.xyz[9 * t];
+            const double x0 = a[0], y0 = a[1], x1 = a[3], y1 = a[4], x2 = a[6], y2 = a[7];
+            const double d = (y1 - y2) * (x0 - x2) + (x2 - x1) * (y0 - y2);
+            if (d == 0) continue;
+            const double l0 = ((y1 - y2) * (px - x2) + (x2 - x1) * (py - y2)) / d;
+            const double l1 = ((y2 - y0) * (px - x2) + (x0 - x2) * (py - y2)) / d;
+            const double l2 = 1 - l0 - l1;
+            if (l0 < -1e-6 || l1 < -1e-6 || l2 < -1e-6) continue;
+            for (int k = 0; k < 3; ++k) {
+                const double v =
+                    l0 * out.rgba[12 * t + k] + l1 * out.rgba[12 * t + 4 + k] + l2 * out.rgba[12 * t + 8 + k];
+                sum += (v - in.rgba[4 * c + size_t(k)]) * (v - in.rgba[4 * c + size_t(k)]);
+            }
+            ++count;
+            break;
+        }
+    }
+    return std::sqrt(sum / double(std::max<size_t>(count, 1)));
+}
+
+}  // namespace
+
+TEST(StreamDecimatorChannels, ColourErrorKeepsASharpBorderThatGeometryAloneSmears) {
+    // A flat grid (no geometric error anywhere), red left of x = 0.5 and blue right of it.
+    auto border = [](float x, float) {
+        return x < 0.5f ? std::array<float, 3>{1, 0, 0} : std::array<float, 3>{0, 0, 1};
+    };
+    const ChannelMesh m = channel_grid(32, uv_is_xy, border);
+    Options options;
+    options.ratio = 0.1;
+    options.buffer_triangles = 1000;
+    AttributeWeights geometry_only;
+    geometry_only.color = 0;
+    geometry_only.uv = 0;
+    const double weighted = colour_rms(m, run_with_channels(m, options, {}));
+    const double unweighted = colour_rms(m, run_with_channels(m, options, geometry_only));
+    EXPECT_LT(weighted, 0.5 * unweighted) << weighted << " vs " << unweighted;
+}
+
+TEST(StreamDecimatorChannels, UnweightedChannelsLeaveTheGeometryAsPositionsOnly) {
+    // Weights 0 and no seams: the same collapses as a positions-only run, so the same triangles.
+    const ChannelMesh m = channel_grid(30, uv_is_xy, ramp);
+    Options options;
+    options.ratio = 0.2;
+    options.buffer_triangles = 600;
+    AttributeWeights none;
+    none.color = 0;
+    none.uv = 0;
+    const ChannelResult with = run_with_channels(m, options, none);
+    const Decimated without = run_decimator(m.xyz, options, 1000);
+    EXPECT_EQ(with.xyz, without.xyz);
+}
+
+TEST(StreamDecimatorChannels, DegenerateTrianglesPassThroughWithTheirValues) {
+    ChannelMesh m = channel_grid(4, uv_is_xy, ramp);
+    // One more triangle with a repeated corner and colours of its own.
+    const float tri[9] = {2, 2, 0, 2, 2, 0, 3, 2, 0};
+    m.xyz.insert(m.xyz.end(), tri, tri + 9);
+    m.uv.insert(m.uv.end(), {0.5f, 0.5f, 0.5f, 0.5f, 0.25f, 0.75f});
+    m.rgba.insert(m.rgba.end(), {0.2f, 0.4f, 0.6f, 1, 0.2f, 0.4f, 0.6f, 1, 0.8f, 0.6f, 0.4f, 1});
+    Options options;
+    options.ratio = 1.0;
+    const ChannelResult r = run_with_channels(m, options, {});
+    ASSERT_EQ(r.stats.degenerate_passed, 1u);
+    bool found = false;
+    for (size_t t = 0; t < r.xyz.size() / 9; ++t)
+        if (r.xyz[9 * t] == 2 && r.xyz[9 * t + 6] == 3) {
+            found = true;
+            EXPECT_FLOAT_EQ(r.rgba[12 * t + 8], 0.8f);
+            EXPECT_FLOAT_EQ(r.uv[6 * t + 5], 0.75f);
+        }
+    EXPECT_TRUE(found);
+}
+
+TEST(StreamDecimatorChannels, RefusesChunksWithoutItsChannels) {
+    const ChannelMesh m = channel_grid(2, uv_is_xy, ramp);
+    Options options;
+    StreamDecimator decimator(options, std::optional<uint64_t>(8), AttributeLayout(m.channels, {}));
+    meshstream::io::TriangleChunk positions(8);
+    const float tri[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    positions.push(tri);
+    EXPECT_THROW(decimator.push(positions, [](const meshstream::io::TriangleChunk&) {}), std::invalid_argument);
+}

@@ -142,8 +142,7 @@ TEST(CliConvert, DroppedVertexColoursAreSaid) {
     cli_test::CliRun ply = run("convert " + coloured + " " + dir / "c.ply");
     EXPECT_EQ(ply.code, 0) << ply.err;
     EXPECT_EQ(ply.err.find("colours"), std::string::npos) << ply.err;
-    // sort carries the channels the output keeps, and names the others; decimate keeps
-    // positions only and says so.
+    // sort and decimate carry the channels the output keeps, and name the others.
     cli_test::CliRun sorted = run("sort " + coloured + " " + dir / "s.ply");
     EXPECT_EQ(sorted.code, 0) << sorted.err;
     EXPECT_EQ(sorted.err.find("colours"), std::string::npos) << sorted.err;
@@ -154,8 +153,12 @@ TEST(CliConvert, DroppedVertexColoursAreSaid) {
         << sorted_stl.err;
     cli_test::CliRun decimated = run("decimate " + coloured + " " + dir / "d.ply -r 0.5");
     EXPECT_EQ(decimated.code, 0) << decimated.err;
-    EXPECT_NE(decimated.err.find("warning: colours dropped: decimate keeps positions only"), std::string::npos)
-        << decimated.err;
+    EXPECT_EQ(decimated.err.find("colours"), std::string::npos) << decimated.err;
+    EXPECT_NE(cli_test::slurp(dir / "d.ply").find("property uchar red\nproperty uchar green\nproperty uchar blue\n"),
+              std::string::npos);
+    cli_test::CliRun decimated_stl = run("decimate " + coloured + " " + dir / "d.stl -r 0.5");
+    EXPECT_NE(decimated_stl.err.find("warning: colours dropped: stl output carries positions only"), std::string::npos)
+        << decimated_stl.err;
 }
 
 TEST(CliConvert, AsciiStlNormalsHaveNoNegativeZeros) {
@@ -391,11 +394,11 @@ TEST(CliProgress, PercentFromTheFilesBytesAndClearedAtTheEnd) {
 TEST(CliProgress, QuietKeepsWarnings) {
     TempDir dir;
     const std::string coloured = std::string(MESHSTREAM_FIXTURES_DIR) + "/ply/cactus_vcolor.binary_le.ply";
-    const cli_test::CliRun loud = run("decimate -r 0.5 " + coloured + " " + dir / "d.ply");
+    const cli_test::CliRun loud = run("decimate -r 0.5 " + coloured + " " + dir / "d.stl");
     EXPECT_NE(loud.err.find("triangles in 1236, out 618"), std::string::npos) << loud.err;
     for (const std::string q : {"-q decimate", "decimate -q"}) {
-        const cli_test::CliRun quiet = run(q + " -r 0.5 " + coloured + " " + dir / "d.ply");
+        const cli_test::CliRun quiet = run(q + " -r 0.5 " + coloured + " " + dir / "d.stl");
         EXPECT_EQ(quiet.code, 0);
-        EXPECT_EQ(quiet.err, "meshstream: warning: colours dropped: decimate keeps positions only\n");
+        EXPECT_EQ(quiet.err, "meshstream: warning: colours dropped: stl output carries positions only\n");
     }
 }

@@ -51,7 +51,7 @@ TEST(RunReportJson, EveryWritingCommandPrintsOneObject) {
     };
     const Case cases[] = {{"convert", "", "c.stl", "stl", 1236},
                           {"sort", "--axis z", "s.stl.gz", "stl", 1236},
-                          {"decimate", "-r 0.5", "d.ply", "ply", 618}};
+                          {"decimate", "-r 0.5", "d.stl", "stl", 618}};
     for (const Case& c : cases) {
         SCOPED_TRACE(c.command);
         const std::string out = dir / c.output, json = dir / (c.command + ".json");

@@ -1,0 +1,103 @@
+// The channels of the in-core mesh (decimate/attributes.hpp): beside each vertex record of the
+// half-edge buffer, its attribute quadric and its value; beside each face record, its corners'
+// values, its material and its face scalars. Allocated once with the buffer, only when the stream
+// has channels to carry: a positions-only stream has none of it and pays nothing.
+//
+// A vertex's value is the value of all its corners unless it is a seam vertex (kSeam: its corners
+// disagree, or its faces have different materials), whose corners keep their own values. A
+// vertex that absorbed collapses gets, when written, the value that minimizes its attribute
+// quadric at its final position.
+//
+// Memory: per vertex slot (3·N + 3 of them for a buffer of N triangles) 8 · (11 + 4·m) bytes of
+// quadric, 12·m of value and value range, and 8 of bookkeeping; per face slot 12·m bytes of corner values, 4 of
+// material and 8 per face scalar. As with the buffer's own pools, only the touched part becomes
+// resident (about N/2 vertices and N faces).
+#pragma once
+
+#include "decimate/attributes.hpp"
+#include "decimate/halfedge_buffer.hpp"
+
+#include <cstdint>
+
+namespace meshstream::decimate {
+
+// The most components a corner's vector may have.
+inline constexpr int kMaxAttributeComponents = 32;
+
+class AttributeStore {
+public:
+    // Throws std::invalid_argument when the layout has more than kMaxAttributeComponents.
+    AttributeStore(const AttributeLayout& layout, size_t triangle_capacity);
+    static size_t reserved_bytes(const AttributeLayout& layout, size_t triangle_capacity);
+
+    const AttributeLayout& layout() const { return layout_; }
+    int size() const { return m_; }
+    const double* omega() const { return layout_.omega().data(); }
+    // True when collapses are rated with attribute error (some channel weighs).
+    bool weighted() const { return layout_.weighted(); }
+
+    // READ: face f of `buffer` was just added with corner values `corners` (3·m floats, corner
+    // k at k·m), `material` and `face_scalars` (face_scalar_count() doubles). Sets up new
+    // vertices, marks seam vertices (kSeam) and adds the face's attribute quadric to its three.
+    void add_face(HalfEdgeBuffer& buffer, uint32_t f, const float* corners, uint32_t material,
+                  const double* face_scalars);
+    // The values of a vertex that has not been seen yet (a triangle passed through).
+    void ensure_vertex(HalfEdgeBuffer& buffer, uint32_t v, const float* value, uint32_t material);
+
+    double* quadric(uint32_t v) { return &quadrics_[v * stride_]; }
+    const double* quadric(uint32_t v) const { return &quadrics_[v * stride_]; }
+    float* vertex_value(uint32_t v) { return &values_[3 * size_t(v) * m_]; }
+    const float* vertex_value(uint32_t v) const { return &values_[3 * size_t(v) * m_]; }
+    // The smallest and largest input values of the vertices merged into v.
+    float* range_lo(uint32_t v) { return &values_[(3 * size_t(v) + 1) * m_]; }
+    float* range_hi(uint32_t v) { return &values_[(3 * size_t(v) + 2) * m_]; }
+    // Corner c (half-edge index 4·f + k) of an in-core face.
+    float* corner_value(uint32_t c) { return &corners_[(3 * size_t(face_of(c)) + corner_of(c)) * m_]; }
+    const float* corner_value(uint32_t c) const { return &corners_[(3 * size_t(face_of(c)) + corner_of(c)) * m_]; }
+    // The value corner c shows: its own at a seam vertex, else its vertex's.
+    const float* shown(const HalfEdgeBuffer& buffer, uint32_t c) const {
+        const uint32_t v = buffer.corner_vertex(c);
+        return (buffer.vertex(v).flags & kSeam) ? corner_value(c) : vertex_value(v);
+    }
+    uint32_t material(uint32_t f) const { return materials_.get() ? materials_[f] : 0; }
+    const double* face_scalars(uint32_t f) const { return &face_scalars_[f * face_scalar_count_]; }
+
+    // A collapse p→q of half-edge h is about to happen: p's corners take the value q shows on
+    // h's face (when q is a seam vertex), and q's quadric gains p's.
+    void merge(HalfEdgeBuffer& buffer, uint32_t h);
+    // True when a collapse into q along h keeps the seams: q is no seam vertex, or its corners
+    // on the two faces of the edge agree (else the seam runs along the edge).
+    bool seam_allows(const HalfEdgeBuffer& buffer, uint32_t h) const;
+    // Vertex v is being written at its final position: a vertex that absorbed collapses takes
+    // the values minimizing its attribute quadric there, each kept within the range of the input
+    // values of the vertices merged into it.
+    void settle(HalfEdgeBuffer& buffer, uint32_t v);
+
+    // The quadric (in the position) a collapse into a vertex of merged geometric quadric `g`
+    // and merged attribute quadric `a` minimizes: g + W·reduced(a), W = trace of g.
+    Quadric combined(const Quadric& g, const double* a) const;
+
+    // Vertices marked kSeam so far.
+    uint64_t seam_vertices() const { return seam_vertices_; }
+    // Non-finite input values replaced by 0 so far.
+    uint64_t non_finite_values() const { return non_finite_; }
+    // Replaces non-finite values of a corner vector by 0, counting them.
+    void sanitize(float* values, size_t n);
+
+private:
+    void init_vertex(HalfEdgeBuffer& buffer, uint32_t v, const float* value, uint32_t material);
+
+    AttributeLayout layout_;
+    int m_;
+    size_t stride_, face_scalar_count_;
+    RawArray<double> quadrics_;
+    RawArray<float> values_;
+    RawArray<uint32_t> generation_;  // the vertex generation the slot's values belong to
+    RawArray<uint32_t> vertex_material_;
+    RawArray<float> corners_;
+    RawArray<uint32_t> materials_;
+    RawArray<double> face_scalars_;
+    uint64_t non_finite_ = 0, seam_vertices_ = 0;
+};
+
+}  // namespace meshstream::decimate
