@@ -1,17 +1,24 @@
 // The channels of the in-core mesh (decimate/attributes.hpp): beside each vertex record of the
-// half-edge buffer, its attribute quadric and its value; beside each face record, its corners'
-// values, its material and its face scalars. Allocated once with the buffer, only when the stream
-// has channels to carry: a positions-only stream has none of it and pays nothing.
+// half-edge buffer, its attribute quadric and its value; beside each face record, its material and
+// face scalars, and the values of its corners at seam vertices. Allocated once with the buffer,
+// only when the stream has channels to carry: a positions-only stream has none of it and pays
+// nothing.
 //
 // A vertex's value is the value of all its corners unless it is a seam vertex (kSeam: its corners
 // disagree, or its faces have different materials), whose corners keep their own values. A
 // vertex that absorbed collapses gets, when written, the value that minimizes its attribute
-// quadric at its final position.
+// quadric at its final position, within the range of the input values merged into it.
 //
-// Memory: per vertex slot (3·N + 3 of them for a buffer of N triangles) 8 · (11 + 4·m) bytes of
-// quadric, 12·m of value and value range, and 8 of bookkeeping; per face slot 12·m bytes of corner values, 4 of
-// material and 8 per face scalar. As with the buffer's own pools, only the touched part becomes
-// resident (about N/2 vertices and N faces).
+// Memory: per vertex slot (3·N + 3 of them for a buffer of N triangles) one record of 14 + 5·m
+// floats rounded up to whole cache lines (128 bytes for an RGB colour, m = 3): the attribute
+// quadric in float (11 + 4·m), relative to the vertex's input position (3: near the vertex a
+// value's interpolation is about the value itself, which float holds to 1e-7 of it; relative to
+// the buffer's origin it would be the gradient extrapolated across the mesh), and its value (m);
+// beside it the range of the input values merged into it (2·m floats) and, when the stream has
+// materials, 4 bytes of material. Per face slot 12·m bytes of corner values (written only at seam
+// vertices), 4 of material and 8 per face scalar when the stream has them. As with the buffer's
+// own pools, only the touched part becomes resident (about N/2 vertices; corner values only
+// round seams).
 #pragma once
 
 #include "decimate/attributes.hpp"
@@ -44,14 +51,26 @@ public:
     // The values of a vertex that has not been seen yet (a triangle passed through).
     void ensure_vertex(HalfEdgeBuffer& buffer, uint32_t v, const float* value, uint32_t material);
 
-    double* quadric(uint32_t v) { return &quadrics_[v * stride_]; }
-    const double* quadric(uint32_t v) const { return &quadrics_[v * stride_]; }
-    float* vertex_value(uint32_t v) { return &values_[3 * size_t(v) * m_]; }
-    const float* vertex_value(uint32_t v) const { return &values_[3 * size_t(v) * m_]; }
+    // The attribute error minimized over the values (AttributeQuadric::reduced) of v's quadric,
+    // and of p's and q's summed, as quadrics in the position relative to the buffer's origin.
+    Quadric reduced(const HalfEdgeBuffer& buffer, uint32_t v) const;
+    Quadric merged_reduced(const HalfEdgeBuffer& buffer, uint32_t p, uint32_t q) const;
+    // The attribute error of v's quadric at x (relative to the buffer's origin) with the values
+    // fixed at `values`.
+    double error(const HalfEdgeBuffer& buffer, uint32_t v, const double x[3], const float* values) const;
+    double quadric_area(uint32_t v) const { return record(v)[10]; }
+    // A cache hint for v's record (no effect on results).
+    void prefetch(uint32_t v) const {
+        const char* r = reinterpret_cast<const char*>(record(v));
+        for (size_t b = 0; b < 4 * stride_; b += 64) __builtin_prefetch(r + b);
+    }
+    float* vertex_value(uint32_t v) { return record(v) + value_offset_; }
+    const float* vertex_value(uint32_t v) const { return record(v) + value_offset_; }
     // The smallest and largest input values of the vertices merged into v.
-    float* range_lo(uint32_t v) { return &values_[(3 * size_t(v) + 1) * m_]; }
-    float* range_hi(uint32_t v) { return &values_[(3 * size_t(v) + 2) * m_]; }
-    // Corner c (half-edge index 4·f + k) of an in-core face.
+    float* range_lo(uint32_t v) { return &ranges_[2 * size_t(v) * m_]; }
+    float* range_hi(uint32_t v) { return &ranges_[(2 * size_t(v) + 1) * m_]; }
+    // Corner c (half-edge index 4·f + k) of an in-core face; valid where its vertex is a seam
+    // vertex.
     float* corner_value(uint32_t c) { return &corners_[(3 * size_t(face_of(c)) + corner_of(c)) * m_]; }
     const float* corner_value(uint32_t c) const { return &corners_[(3 * size_t(face_of(c)) + corner_of(c)) * m_]; }
     // The value corner c shows: its own at a seam vertex, else its vertex's.
@@ -59,11 +78,11 @@ public:
         const uint32_t v = buffer.corner_vertex(c);
         return (buffer.vertex(v).flags & kSeam) ? corner_value(c) : vertex_value(v);
     }
-    uint32_t material(uint32_t f) const { return materials_.get() ? materials_[f] : 0; }
+    uint32_t material(uint32_t f) const { return materials_ ? materials_[f] : 0; }
     const double* face_scalars(uint32_t f) const { return &face_scalars_[f * face_scalar_count_]; }
 
     // A collapse p→q of half-edge h is about to happen: p's corners take the value q shows on
-    // h's face (when q is a seam vertex), and q's quadric gains p's.
+    // h's face (when q is a seam vertex), and q's quadric and range gain p's.
     void merge(HalfEdgeBuffer& buffer, uint32_t h);
     // True when a collapse into q along h keeps the seams: q is no seam vertex, or its corners
     // on the two faces of the edge agree (else the seam runs along the edge).
@@ -71,11 +90,11 @@ public:
     // Vertex v is being written at its final position: a vertex that absorbed collapses takes
     // the values minimizing its attribute quadric there, each kept within the range of the input
     // values of the vertices merged into it.
-    void settle(HalfEdgeBuffer& buffer, uint32_t v);
+    void settle(const HalfEdgeBuffer& buffer, uint32_t v);
 
     // The quadric (in the position) a collapse into a vertex of merged geometric quadric `g`
-    // and merged attribute quadric `a` minimizes: g + W·reduced(a), W = trace of g.
-    Quadric combined(const Quadric& g, const double* a) const;
+    // and reduced attribute quadric `r` minimizes: g + W·r, W = trace of g.
+    static Quadric combined(const Quadric& g, const Quadric& r);
 
     // Vertices marked kSeam so far.
     uint64_t seam_vertices() const { return seam_vertices_; }
@@ -86,14 +105,25 @@ public:
 
 private:
     void init_vertex(HalfEdgeBuffer& buffer, uint32_t v, const float* value, uint32_t material);
+    void make_seam(HalfEdgeBuffer& buffer, uint32_t v);
+    float* record(uint32_t v) { return &records_[v * stride_]; }
+    const float* record(uint32_t v) const { return &records_[v * stride_]; }
+    // The reference point of v's quadric, relative to the buffer's origin.
+    void reference(const HalfEdgeBuffer& buffer, uint32_t v, double r[3]) const;
+    // Adds `q` (relative to the point `at`, itself relative to the buffer's origin) to v's quadric.
+    void add_quadric(const HalfEdgeBuffer& buffer, uint32_t v, const double* q, const double at[3]);
+    // v's record's quadric as doubles, relative to v's reference point.
+    void local_quadric(uint32_t v, double* out) const {
+        const float* q = record(v);
+        for (size_t i = 0, n = AttributeQuadric::size(m_); i < n; ++i) out[i] = q[i];
+    }
 
     AttributeLayout layout_;
     int m_;
-    size_t stride_, face_scalar_count_;
-    RawArray<double> quadrics_;
-    RawArray<float> values_;
-    RawArray<uint32_t> generation_;  // the vertex generation the slot's values belong to
-    RawArray<uint32_t> vertex_material_;
+    size_t stride_, value_offset_, face_scalar_count_;
+    RawArray<float> records_;
+    RawArray<float> ranges_;
+    RawArray<uint32_t> vertex_material_;  // only with materials
     RawArray<float> corners_;
     RawArray<uint32_t> materials_;
     RawArray<double> face_scalars_;

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
 
 namespace meshstream::decimate {
@@ -106,9 +107,7 @@ void AttributeQuadric::from_triangle(double* q, const double p0[3], const double
         t1[i] = (d22 * e1[i] - d12 * e2[i]) / denom;
         t2[i] = (d11 * e2[i] - d12 * e1[i]) / denom;
     }
-    Quadric& a = *reinterpret_cast<Quadric*>(q);
-    static_assert(sizeof(Quadric) == 10 * sizeof(double));
-    q[10] = area;
+    Quadric a;
     for (int j = 0; j < m; ++j) {
         const double v0 = a0[j], v1 = double(a1[j]) - v0, v2 = double(a2[j]) - v0;
         const double g[3] = {t1[0] * v1 + t2[0] * v2, t1[1] * v1 + t2[1] * v2, t1[2] * v1 + t2[2] * v2};
@@ -130,6 +129,8 @@ void AttributeQuadric::from_triangle(double* q, const double p0[3], const double
         gj[2] = area * g[2];
         gj[3] = area * d;
     }
+    AttributeQuadric::set_part(q, a);
+    q[10] = area;
 }
 
 void AttributeQuadric::add(double* q, const double* r, int m) {
@@ -138,7 +139,7 @@ void AttributeQuadric::add(double* q, const double* r, int m) {
 }
 
 Quadric AttributeQuadric::reduced(const double* q, int m, const double* omega) {
-    Quadric out = *reinterpret_cast<const Quadric*>(q);
+    Quadric out = AttributeQuadric::part(q);
     const double area = q[10];
     if (!(area > 0)) return out;
     // Minimized over value s_j: Σ A (g·x + d − s)² = (that at s = 0) − (G·x + D)² / ΣA.
@@ -161,7 +162,8 @@ Quadric AttributeQuadric::reduced(const double* q, int m, const double* omega) {
 }
 
 double AttributeQuadric::error(const double* q, int m, const double* omega, const double x[3], const float* values) {
-    double e = reinterpret_cast<const Quadric*>(q)->error(x);
+    Quadric a = AttributeQuadric::part(q);
+    double e = a.error(x);
     const double area = q[10];
     for (int j = 0; j < m; ++j) {
         if (omega[j] == 0) continue;

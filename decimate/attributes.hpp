@@ -103,6 +103,17 @@ struct AttributeQuadric {
     static void values(const double* q, int m, const double x[3], const float* fallback, float* out);
     // Σ A: the weight the attribute error carries.
     static double area(const double* q) { return q[10]; }
+    // The Quadric in the first 10 numbers, and back.
+    static Quadric part(const double* q) {
+        Quadric a;
+        a.a00 = q[0], a.a01 = q[1], a.a02 = q[2], a.a11 = q[3], a.a12 = q[4], a.a22 = q[5];
+        a.b0 = q[6], a.b1 = q[7], a.b2 = q[8], a.c = q[9];
+        return a;
+    }
+    static void set_part(double* q, const Quadric& a) {
+        q[0] = a.a00, q[1] = a.a01, q[2] = a.a02, q[3] = a.a11, q[4] = a.a12, q[5] = a.a22;
+        q[6] = a.b0, q[7] = a.b1, q[8] = a.b2, q[9] = a.c;
+    }
 };
 
 }  // namespace meshstream::decimate

@@ -152,11 +152,7 @@ Quadric merged_quadric(const HalfEdgeBuffer& buffer, uint32_t p, uint32_t q) {
     const Quadric sum = buffer.quadric(p) + buffer.quadric(q);
     const AttributeStore* attributes = buffer.attributes();
     if (attributes == nullptr || !attributes->weighted()) return sum;
-    const int m = attributes->size();
-    double a[AttributeQuadric::size(kMaxAttributeComponents)];
-    std::copy_n(attributes->quadric(p), AttributeQuadric::size(m), a);
-    AttributeQuadric::add(a, attributes->quadric(q), m);
-    return attributes->combined(sum, a);
+    return AttributeStore::combined(sum, attributes->merged_reduced(buffer, p, q));
 }
 
 namespace {
@@ -169,9 +165,7 @@ double fixed_error(const HalfEdgeBuffer& buffer, const AttributeStore& attribute
     double x[3];
     buffer.position(q, x);
     const double w = sum.a00 + sum.a11 + sum.a22;
-    return std::max(0.0, sum.error(x)) + w * AttributeQuadric::error(attributes.quadric(p), attributes.size(),
-                                                                     attributes.omega(), x,
-                                                                     attributes.shown(buffer, next_in_face(h)));
+    return std::max(0.0, sum.error(x)) + w * attributes.error(buffer, p, x, attributes.shown(buffer, next_in_face(h)));
 }
 
 bool values_fixed(const HalfEdgeBuffer& buffer, uint32_t q) {

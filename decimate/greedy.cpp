@@ -2,6 +2,7 @@
 // choice of Wu & Kobbelt 2003, §4.3), with the end-of-input scans.
 #include "decimate/greedy.hpp"
 
+#include "decimate/attribute_store.hpp"
 #include "decimate/phase_timers.hpp"
 
 #include <algorithm>
@@ -49,6 +50,11 @@ namespace {
 // Rates the edges of v; with `skip_pending`, not those whose other end is still listed for
 // take_pending() (it rates them when its turn comes: each edge once).
 void rate_edges_around(HalfEdgeBuffer& buffer, CollapseQueue& queue, uint32_t v, bool skip_pending) {
+    // With channels every rating reads both ends' attribute records, far apart in their pool:
+    // asked for all at once, their cache misses overlap (a hint only).
+    if (const AttributeStore* attributes = buffer.attributes())
+        for (uint32_t c = buffer.vertex(v).first_corner; c != kNoIndex; c = buffer.next_corner(c))
+            attributes->prefetch(buffer.corner_vertex(next_in_face(c)));
     for (uint32_t c = buffer.vertex(v).first_corner; c != kNoIndex; c = buffer.next_corner(c)) {
         const uint32_t to = buffer.corner_vertex(next_in_face(c));
         if (!skip_pending || (buffer.vertex(to).flags & kPending) == 0) rate_edge(buffer, queue, c);  // v→next

@@ -68,11 +68,12 @@ inline constexpr uint16_t kFrozen = 2;       // written (on P_out): position fin
 inline constexpr uint16_t kNonManifold = 4;  // touches a non-manifold edge: never collapsed
 inline constexpr uint16_t kWeldMerged = 8;   // absorbed another input position (--weld)
 inline constexpr uint16_t kAlive = 16;
-inline constexpr uint16_t kHasPartner = 32;  // partner_position() holds a collapsed edge's far end
-inline constexpr uint16_t kPending = 64;     // listed for take_pending()
-inline constexpr uint16_t kBlocked = 128;    // a collapse at it was refused (collapse.hpp)
-inline constexpr uint16_t kManyFans = 256;   // its faces are not one fan (two fans touch here)
-inline constexpr uint16_t kSeam = 512;       // its corners disagree in attributes (attribute_store.hpp)
+inline constexpr uint16_t kHasPartner = 32;   // partner_position() holds a collapsed edge's far end
+inline constexpr uint16_t kPending = 64;      // listed for take_pending()
+inline constexpr uint16_t kBlocked = 128;     // a collapse at it was refused (collapse.hpp)
+inline constexpr uint16_t kManyFans = 256;    // its faces are not one fan (two fans touch here)
+inline constexpr uint16_t kSeam = 512;        // its corners disagree in attributes (attribute_store.hpp)
+inline constexpr uint16_t kHasValues = 1024;  // its attribute record is set up (attribute_store.hpp)
 
 struct Vertex {
     float pos[3];           // input position, moved by collapses and once when written (§4.4)

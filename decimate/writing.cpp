@@ -51,9 +51,9 @@ bool place_vertex(HalfEdgeBuffer& buffer, uint32_t v) {
     if ((x.flags & kHasPartner) == 0) return false;
     // With weighted channels, the minimum of geometric and attribute error (attributes.hpp).
     const AttributeStore* attributes = buffer.attributes();
-    const Quadric q = attributes != nullptr && attributes->weighted()
-                          ? attributes->combined(buffer.quadric(v), attributes->quadric(v))
-                          : buffer.quadric(v);
+    Quadric q = buffer.quadric(v);
+    if (attributes != nullptr && attributes->weighted())
+        q = AttributeStore::combined(q, attributes->reduced(buffer, v));
     double old[3], best[3];
     buffer.position(v, old);
     if (!q.minimum(best)) {

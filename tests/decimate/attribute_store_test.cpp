@@ -118,7 +118,7 @@ TEST(AttributeStore, ACollapseIntoASeamVertexTakesItsValueOnThatSide) {
     const uint32_t corner = a.vertex[1], seam = a.vertex[2];  // (1,0) and (1,1)
     ASSERT_EQ(s.buffer.vertex(corner).flags & kSeam, 0);
     ASSERT_NE(s.buffer.vertex(seam).flags & kSeam, 0);
-    const double area_before = AttributeQuadric::area(s.store.quadric(seam));
+    const double area_before = s.store.quadric_area(seam);
     // (1,0) → (1,1) along the open edge of face a: one side only, allowed.
     const uint32_t h = half_edge(a.face, 1);
     EXPECT_TRUE(s.store.seam_allows(s.buffer, h));
@@ -126,8 +126,8 @@ TEST(AttributeStore, ACollapseIntoASeamVertexTakesItsValueOnThatSide) {
     const float* moved = s.store.corner_value(half_edge(a.face, 1));
     EXPECT_EQ(moved[0], 1.0f);  // (1,1)'s value on this chart, not (7,7)
     EXPECT_EQ(moved[1], 1.0f);
-    EXPECT_NEAR(AttributeQuadric::area(s.store.quadric(seam)),
-                area_before + AttributeQuadric::area(s.store.quadric(corner)), 1e-12);
+    EXPECT_NEAR(s.store.quadric_area(seam),
+                area_before + s.store.quadric_area(corner), 1e-12);
 }
 
 TEST(AttributeStore, NoCollapseAlongASeamEdgeIntoASeamVertex) {
