@@ -443,9 +443,9 @@ nlohmann::ordered_json report_error(const DecimateOptions& opt, const DecimateFa
 // The read loop decimate reads through: the channels --drop leaves, when the output format can
 // keep any (decimate carries them); else none, so that the reader stores no attribute (a
 // coloured PLY decimated to STL costs what a plain one does), while the header still lists what
-// is dropped. An MPI rank (`positions_only`) decimates positions: channels keep to one process.
-io::ReadOptions decimate_read_options(const DecimateOptions& opt, const io::Format* out_format = nullptr,
-                                      const io::WriteOptions* wo = nullptr) {
+// is dropped.
+io::ReadOptions decimate_read_options(const DecimateOptions& opt, const io::Format& out_format,
+                                      const io::WriteOptions& wo) {
     io::ReadOptions read = opt.read.options();
     io::Channels every;
     every.normal = true;
@@ -454,8 +454,7 @@ io::ReadOptions decimate_read_options(const DecimateOptions& opt, const io::Form
     every.vertex_scalars = {io::ScalarChannel{"s"}};
     every.material = true;
     every.face_scalars = {io::ScalarChannel{"f"}};
-    if (out_format == nullptr || !io::writable_channels(*out_format, every, *wo).has_attributes())
-        read.channels = io::ChannelKinds::none();
+    if (!io::writable_channels(out_format, every, wo).has_attributes()) read.channels = io::ChannelKinds::none();
     return read;
 }
 
@@ -464,18 +463,27 @@ io::ReadOptions decimate_read_options(const DecimateOptions& opt, const io::Form
 void decimate_one_range(const DecimateOptions& opt, RangeProcesses& processes) {
     const std::optional<RangePlan> plan = processes.receive_plan();
     if (!plan || processes.rank() >= plan->ranges) return;
-    const io::ReadOptions read = decimate_read_options(opt);
+    // The channels carried, found as process 0 found them (same file, same options).
+    const io::Format& out_format = resolve_output_format(opt.output, opt.write);
+    const io::WriteOptions wo = opt.write.options(opt.read, out_format);
+    const io::ReadOptions read = decimate_read_options(opt, out_format, wo);
+    const Carried carried = [&] {
+        io::TriangleInput in = open_triangle_input(opt.input, opt.read, read, Command::kDecimate);
+        return carried_channels(opt, in.header(), out_format, wo, in.name());
+    }();
     RangesJob job;
     job.open = [&] { return open_triangle_input(opt.input, opt.read, read, Command::kDecimate); };
-    job.make_decimator = [](const decimate::Options& o) {
+    job.channels = carried.channels;
+    job.make_decimator = [&carried](const decimate::Options& o) {
         static const io::InputCount kNoCount;  // a range takes a ratio
-        return make_decimator(o, kNoCount);
+        return make_decimator(o, kNoCount, carried.layout);
     };
     job.options = plan->options;
     job.cut_triangles = plan->cut_triangles;
     job.ranges = plan->ranges;
     job.stop_at_forced_write = plan->stop_at_forced_write;
-    processes.send([&](RangeSink& sink, std::atomic<bool>& stop) { run_range(job, processes.rank() - 1, sink, stop); });
+    processes.send(carried.channels,
+                   [&](RangeSink& sink, std::atomic<bool>& stop) { run_range(job, processes.rank() - 1, sink, stop); });
 }
 
 // meshstream-mpi, process 0: the other processes wait for the plan, so they are told once,
@@ -524,7 +532,7 @@ void run_decimate(const DecimateOptions& opt, RangeProcesses* processes) {
         }
     }
     io::WriteOptions wo = opt.write.options(opt.read, out_format);
-    const io::ReadOptions read = decimate_read_options(opt, &out_format, &wo);
+    const io::ReadOptions read = decimate_read_options(opt, out_format, wo);
     io::TriangleInput in = open_triangle_input(opt.input, opt.read, read, Command::kDecimate);
     std::optional<CountPass> counted;
     if (opt.target && !in.header().triangle_count && is_regular_file(opt.input)) {
@@ -568,12 +576,6 @@ void run_decimate(const DecimateOptions& opt, RangeProcesses* processes) {
     }
     // The ranges' outputs wait in --tmpdir: where nothing can be written, one thread decimates.
     std::string one_thread_why;
-    // Ranges, their spools and MPI's messages carry positions only.
-    if (ranges > 1 && with_channels) {
-        ranges = 1;
-        one_thread_why = "ranges carry positions only, and decimate keeps this input's " +
-                         io::describe_missing(carried.channels, io::Channels{});
-    }
     if (ranges > 1) {
         try {
             io::TempFile probe(opt.read.tmpdir, "meshstream-range");
@@ -630,11 +632,12 @@ void run_decimate(const DecimateOptions& opt, RangeProcesses* processes) {
         const auto attempt = std::chrono::steady_clock::now();
         RangesJob job;
         job.open = [&] { return open_triangle_input(opt.input, opt.read, read, Command::kDecimate); };
-        job.make_decimator = [](const decimate::Options& o) {
+        job.make_decimator = [&carried](const decimate::Options& o) {
             static const io::InputCount kNoCount;  // a range and the seam pass take a ratio
-            return make_decimator(o, kNoCount);
+            return make_decimator(o, kNoCount, carried.layout);
         };
         job.tmpdir = opt.read.tmpdir;
+        job.channels = carried.channels;
         job.options = options;
         job.options.target.reset();
         if (options.target) job.options.ratio = std::min(1.0, double(*options.target) / double(*cut_count));
@@ -647,8 +650,8 @@ void run_decimate(const DecimateOptions& opt, RangeProcesses* processes) {
         if (processes) {
             // Range k but the last by process k+1; the last, and the seam pass, here.
             job.remote_ranges = ranges - 1;
-            job.receive_remote = [processes](std::span<RangeSink* const> sinks, std::atomic<bool>& stop) {
-                processes->receive(sinks, stop);
+            job.receive_remote = [processes, &carried](std::span<RangeSink* const> sinks, std::atomic<bool>& stop) {
+                processes->receive(sinks, stop, carried.channels);
             };
             sharing.share(RangePlan{job.options, job.cut_triangles, job.ranges, job.stop_at_forced_write});
         }
@@ -794,10 +797,8 @@ void run_decimate(const DecimateOptions& opt, RangeProcesses* processes) {
                        input_name, warnings);
     note_decimate_warnings(facts, warnings);
     if (!one_thread_why.empty())
-        warnings.note(
-            "threads_unavailable",
-            "decimated by one thread: " +
-                (with_channels ? one_thread_why : "the ranges' outputs cannot be spooled (" + one_thread_why + ")"));
+        warnings.note("threads_unavailable",
+                      "decimated by one thread: the ranges' outputs cannot be spooled (" + one_thread_why + ")");
     warnings.print();
 
     RunReport report;

@@ -23,21 +23,54 @@
 #include <vector>
 
 namespace meshstream::tools {
+
+TriangleRecords::TriangleRecords(const io::Channels& channels)
+    : corner_(channels), face_(channels), bytes_(36 + 3 * corner_.bytes() + face_.bytes()) {}
+
+void TriangleRecords::encode(const io::TriangleChunk& chunk, std::vector<char>& out) const {
+    const size_t at = out.size(), n = chunk.size();
+    out.resize(at + n * bytes_);
+    auto* dst = reinterpret_cast<std::byte*>(out.data() + at);
+    const float* xyz = chunk.xyz().data();
+    for (size_t i = 0; i < n; ++i, dst += bytes_) {
+        std::memcpy(dst, xyz + 9 * i, 36);
+        std::byte* p = dst + 36;
+        for (int k = 0; k < 3; ++k, p += corner_.bytes()) corner_.pack(chunk, i, k, p);
+        face_.pack(chunk, i, p);
+    }
+}
+
+void TriangleRecords::decode(const char* src, size_t triangles, io::TriangleChunk& chunk) const {
+    chunk.clear();
+    const auto* from = reinterpret_cast<const std::byte*>(src);
+    for (size_t i = 0; i < triangles; ++i, from += bytes_) {
+        float* xyz = chunk.push_slot();
+        std::memcpy(xyz, from, 36);
+        const std::byte* p = from + 36;
+        for (int k = 0; k < 3; ++k, p += corner_.bytes()) corner_.unpack(p, chunk, i, k);
+        face_.unpack(p, chunk, i);
+    }
+}
+
 namespace {
 
-// One range's output on its way to the seam pass: positions in a temporary file, and for each
-// chunk its piece, triangle count and the input triangles each of them stands for. Appended to by
-// the range's thread (or the thread receiving a remote range), read by the seam pass's.
+// One range's output on its way to the seam pass: its triangles' records (TriangleRecords) in a
+// temporary file, and for each chunk its piece, triangle count and the input triangles each of
+// them stands for. Appended to by the range's thread (or the thread receiving a remote range),
+// read by the seam pass's.
 class RangeSpool final : public RangeSink {
 public:
-    explicit RangeSpool(const std::string& tmpdir) : file_(tmpdir, "meshstream-range") {}
+    RangeSpool(const std::string& tmpdir, const io::Channels& channels)
+        : file_(tmpdir, "meshstream-range"), records_(channels) {}
 
     void append(const io::TriangleChunk& chunk, double weight, Piece piece) override {
-        file_.write(chunk.xyz().data(), chunk.xyz().size_bytes());
+        encoded_.clear();
+        records_.encode(chunk, encoded_);
+        file_.write(encoded_.data(), encoded_.size());
         file_.flush();  // the seam pass reads the file directly (pread), not this object's buffer
         const std::lock_guard lock(mutex_);
         chunks_.push_back({written_, chunk.size(), weight, piece});
-        written_ += chunk.xyz().size_bytes();
+        written_ += encoded_.size();
         changed_.notify_all();
     }
     void progress(uint64_t decimated) override { decimated_ = decimated; }
@@ -70,9 +103,9 @@ public:
             }
             c = chunks_[i++];
         }
-        chunk.clear();
-        const size_t bytes = c.triangles * 36;
-        auto* dst = reinterpret_cast<char*>(chunk.xyz_storage());
+        const size_t bytes = c.triangles * records_.bytes();
+        read_.resize(bytes);
+        char* dst = read_.data();
         for (size_t got = 0; got < bytes;) {
             const ssize_t r = ::pread(file_.fd(), dst + got, bytes - got, off_t(c.offset + got));
             if (r < 0 && errno == EINTR) continue;
@@ -81,7 +114,7 @@ public:
                                                   (r < 0 ? std::strerror(errno) : "file shorter than written"));
             got += size_t(r);
         }
-        chunk.resize(c.triangles);
+        records_.decode(read_.data(), c.triangles, chunk);
         weight = c.weight;
         return true;
     }
@@ -113,6 +146,9 @@ private:
         Piece piece = Piece::kInterior;
     };
     io::TempFile file_;
+    TriangleRecords records_;
+    std::vector<char> encoded_;  // the range's thread's
+    std::vector<char> read_;     // the seam pass's
     std::mutex mutex_;
     std::condition_variable changed_;
     std::vector<Chunk> chunks_;
@@ -163,8 +199,8 @@ void run_range(const RangesJob& job, unsigned k, RangeSink& sink, std::atomic<bo
         // their span along the axis tells the sweep which vertices an earlier range may share.
         const int axis = options.sorted_axis.value_or(-1);
         double span_lo = std::numeric_limits<double>::infinity(), span_hi = -span_lo;
-        io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, io::Channels{});
-        io::TriangleChunk part(io::TriangleChunk::kDefaultCapacity, io::Channels{});
+        io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, job.channels);
+        io::TriangleChunk part(io::TriangleChunk::kDefaultCapacity, job.channels);
         uint64_t passed = 0;  // passed triangles of the read loop seen so far
         size_t first = 0;     // the range begins at this triangle of `chunk`
         bool straddles = false;
@@ -250,7 +286,7 @@ RangesResult decimate_in_ranges(const RangesJob& job, const decimate::Emit& emit
     std::vector<std::unique_ptr<Range>> ranges;
     for (unsigned k = 0; k < job.ranges; ++k) {
         auto range = std::make_unique<Range>();
-        range->spool = std::make_unique<RangeSpool>(job.tmpdir);
+        range->spool = std::make_unique<RangeSpool>(job.tmpdir, job.channels);
         ranges.push_back(std::move(range));
     }
     // The seam pass: the ranges' outputs carry no sort order, and their welded positions meet
@@ -300,7 +336,7 @@ RangesResult decimate_in_ranges(const RangesJob& job, const decimate::Emit& emit
         for (const auto& r : ranges) n += r->spool->decimated();
         progress(n);
     };
-    io::TriangleChunk chunk(job.options.output_chunk_triangles, io::Channels{});
+    io::TriangleChunk chunk(job.options.output_chunk_triangles, job.channels);
     double weight = 1;
     if (job.seams_after_ranges)
         for (const auto& r : ranges) r->spool->wait_closed(stop, tick);
@@ -358,6 +394,8 @@ RangesResult decimate_in_ranges(const RangesJob& job, const decimate::Emit& emit
         t.sort_violations += x.sort_violations;
         t.orphans_evicted += x.orphans_evicted;
         t.vertices_moved += x.vertices_moved;
+        t.seam_vertices += x.seam_vertices;  // met by a range (and again by the seam pass at a cut)
+        t.attribute_values_zeroed += x.attribute_values_zeroed;
     }
     result.seams = s;
     const Range& last = *ranges.back();

@@ -14,7 +14,8 @@
 // Each range re-opens the input and reads its way to its range (no format has to seek): the
 // reading before a range is the serial part besides the seam pass. Memory: N decimators of
 // --buffer triangles, N readers, the seam pass's decimator of a quarter of --buffer; the ranges'
-// outputs wait on disk (36 bytes a triangle), not in memory.
+// outputs wait on disk (36 bytes a triangle, plus the channels carried: TriangleRecords), not in
+// memory.
 #pragma once
 
 #include "decimate/stream_decimator.hpp"
@@ -30,6 +31,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <vector>
 
 namespace meshstream::tools {
 
@@ -52,6 +54,24 @@ size_t seam_buffer(size_t buffer);
 // (along the seam with the range after). Read in this order, each seam's two strips meet in the
 // seam pass at once, and they are joined before the buffer has to hold anything else.
 enum class Piece : uint8_t { kFirstSeam, kInterior, kLastSeam };
+
+// A chunk's triangles as fixed-size records: the positions (36 bytes), then each corner's channels
+// (io::CornerLayout, in the source's types) and the triangle's (io::FaceLayout); vertex ids are
+// not kept (the seam pass welds by position). What ranges spool and send.
+class TriangleRecords {
+public:
+    explicit TriangleRecords(const io::Channels& channels);
+    size_t bytes() const { return bytes_; }  // per triangle
+    // Appends the records of every triangle of `chunk` (which has at least the channels).
+    void encode(const io::TriangleChunk& chunk, std::vector<char>& out) const;
+    // Fills `chunk` (the channels, capacity ≥ triangles) with `triangles` records from `src`.
+    void decode(const char* src, size_t triangles, io::TriangleChunk& chunk) const;
+
+private:
+    io::CornerLayout corner_;
+    io::FaceLayout face_;
+    size_t bytes_;
+};
 
 // How a range ended (besides an exception).
 struct RangeOutcome {
@@ -78,7 +98,10 @@ struct RangesJob {
     std::function<io::TriangleInput()> open;
     // Makes a decimator (the command's, which says what a refused --buffer reservation costs).
     std::function<std::unique_ptr<decimate::StreamDecimator>(const decimate::Options&)> make_decimator;
-    std::string tmpdir;              // for the ranges' spools
+    std::string tmpdir;  // for the ranges' spools
+    // The channels carried besides positions (the decimators' attribute layout's): read, spooled
+    // and sent with each triangle.
+    io::Channels channels;
     decimate::Options options;       // the decimator's: ratio (not target), buffer, seed, weld, sorted axis
     std::optional<uint64_t> target;  // --target: the seam pass lands on it (else round(ratio · input))
     uint64_t cut_triangles = 0;      // the count the ranges are cut from (the last takes the rest)
@@ -119,11 +142,13 @@ public:
     virtual void share_plan(const std::optional<RangePlan>& plan) = 0;
     // Every other process, once: the plan process 0 shared.
     virtual std::optional<RangePlan> receive_plan() = 0;
-    // Process 0: RangesJob::receive_remote for the ranges of processes 1 .. sinks.size().
-    virtual void receive(std::span<RangeSink* const> sinks, std::atomic<bool>& stop) = 0;
+    // Process 0: RangesJob::receive_remote for the ranges of processes 1 .. sinks.size(), whose
+    // triangles carry `channels` (RangesJob::channels).
+    virtual void receive(std::span<RangeSink* const> sinks, std::atomic<bool>& stop, const io::Channels& channels) = 0;
     // Every other process: the sink that sends its range to process 0; sets `stop` once process
     // 0 asks the range to stop. Returns once process 0 has received everything it sent.
-    virtual void send(const std::function<void(RangeSink&, std::atomic<bool>& stop)>& run_range) = 0;
+    virtual void send(const io::Channels& channels,
+                      const std::function<void(RangeSink&, std::atomic<bool>& stop)>& run_range) = 0;
 };
 
 struct RangesResult {

@@ -1,10 +1,10 @@
 // The messages of a job spread over MPI ranks: see mpi_processes.hpp.
 //
 // Rank r > 0 sends rank 0, in this order: kChunk messages (a ChunkHeader, then the chunk's
-// positions, 36 bytes a triangle) and kProgress messages (the range's triangles decimated so far),
-// then one kClose (a CloseHeader, then the exception's message when it failed). Rank 0 may send it
-// kStop at any time (its range is to stop between chunks), and sends every rank it received from
-// one kDone once it has everything: a rank leaves only then, with no message of it in flight.
+// triangles as TriangleRecords: 36 bytes of positions each, and the channels carried) and kProgress messages (the
+// range's triangles decimated so far), then one kClose (a CloseHeader, then the exception's message when it failed).
+// Rank 0 may send it kStop at any time (its range is to stop between chunks), and sends every rank it received from one
+// kDone once it has everything: a rank leaves only then, with no message of it in flight.
 #include "tools/mpi_processes.hpp"
 
 #include <chrono>
@@ -98,12 +98,11 @@ std::string message_of(const std::exception_ptr& error) {
 // Rank r's sink: every call a message to rank 0. Between chunks it looks for rank 0's kStop.
 class SendingSink final : public RangeSink {
 public:
-    explicit SendingSink(std::atomic<bool>& stop) : stop_(stop) {}
+    SendingSink(std::atomic<bool>& stop, const io::Channels& channels) : stop_(stop), records_(channels) {}
     void append(const io::TriangleChunk& chunk, double weight, Piece piece) override {
         bytes_.clear();
         append_bytes(bytes_, ChunkHeader{weight, chunk.size(), piece});
-        const auto* xyz = reinterpret_cast<const char*>(chunk.xyz().data());
-        bytes_.insert(bytes_.end(), xyz, xyz + chunk.xyz().size_bytes());
+        records_.encode(chunk, bytes_);
         send_bytes(bytes_, 0, kChunk);
         look_for_stop();
     }
@@ -130,6 +129,7 @@ private:
         if (flag) stop_ = true;
     }
     std::atomic<bool>& stop_;
+    TriangleRecords records_;
     std::vector<char> bytes_;
 };
 
@@ -165,7 +165,8 @@ std::optional<RangePlan> MpiProcesses::receive_plan() {
     return message.plan;
 }
 
-void MpiProcesses::receive(std::span<RangeSink* const> sinks, std::atomic<bool>& stop) {
+void MpiProcesses::receive(std::span<RangeSink* const> sinks, std::atomic<bool>& stop, const io::Channels& channels) {
+    const TriangleRecords records(channels);
     std::vector<bool> open(sinks.size(), true);
     size_t still_open = sinks.size();
     bool stop_sent = false;
@@ -182,7 +183,7 @@ void MpiProcesses::receive(std::span<RangeSink* const> sinks, std::atomic<bool>&
             stop = true;
         }
     };
-    io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, io::Channels{});
+    io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, channels);
     while (still_open > 0) {
         if (stop && !stop_sent) {
             for (size_t i = 0; i < sinks.size(); ++i)
@@ -210,12 +211,10 @@ void MpiProcesses::receive(std::span<RangeSink* const> sinks, std::atomic<bool>&
         switch (status.MPI_TAG) {
             case kChunk: {
                 const auto header = read_bytes<ChunkHeader>(bytes);
-                if (bytes.size() != sizeof header + header.triangles * 36)
+                if (bytes.size() != sizeof header + header.triangles * records.bytes())
                     abort_job("rank " + std::to_string(from) + " sent a chunk of the wrong size");
-                if (chunk.capacity() < header.triangles) chunk = io::TriangleChunk(size_t(header.triangles), {});
-                chunk.clear();
-                std::memcpy(chunk.xyz_storage(), bytes.data() + sizeof header, size_t(header.triangles) * 36);
-                chunk.resize(size_t(header.triangles));
+                if (chunk.capacity() < header.triangles) chunk = io::TriangleChunk(size_t(header.triangles), channels);
+                records.decode(bytes.data() + sizeof header, size_t(header.triangles), chunk);
                 deliver([&] { sink.append(chunk, header.weight, header.piece); });
                 break;
             }
@@ -243,9 +242,10 @@ void MpiProcesses::receive(std::span<RangeSink* const> sinks, std::atomic<bool>&
     if (failure) std::rethrow_exception(failure);
 }
 
-void MpiProcesses::send(const std::function<void(RangeSink&, std::atomic<bool>& stop)>& run_range) {
+void MpiProcesses::send(const io::Channels& channels,
+                        const std::function<void(RangeSink&, std::atomic<bool>& stop)>& run_range) {
     std::atomic<bool> stop{false};
-    SendingSink sink(stop);
+    SendingSink sink(stop, channels);
     run_range(sink, stop);
     // Rank 0's kStop, if it sent one, and its kDone.
     for (;;) {

@@ -19,8 +19,9 @@ public:
     unsigned rank() const override { return rank_; }
     void share_plan(const std::optional<RangePlan>& plan) override;
     std::optional<RangePlan> receive_plan() override;
-    void receive(std::span<RangeSink* const> sinks, std::atomic<bool>& stop) override;
-    void send(const std::function<void(RangeSink&, std::atomic<bool>& stop)>& run_range) override;
+    void receive(std::span<RangeSink* const> sinks, std::atomic<bool>& stop, const io::Channels& channels) override;
+    void send(const io::Channels& channels,
+              const std::function<void(RangeSink&, std::atomic<bool>& stop)>& run_range) override;
     // Rank 0: other ranks were given ranges and have not been released (the job failed before
     // receive() could run to its end); they can only be ended with MPI_Abort.
     bool others_waiting() const { return others_waiting_; }

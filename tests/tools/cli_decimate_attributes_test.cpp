@@ -100,16 +100,23 @@ TEST(CliDecimateChannels, BadWeightsAreUsageErrors) {
     EXPECT_TRUE(read_back(dir / "out.ply").channels.color.has_value());
 }
 
-TEST(CliDecimateChannels, RangesDecimatePositionsOnlySoColoursGoOnOneThread) {
+TEST(CliDecimateChannels, RangesCarryTheColoursThroughTheirSpoolsAndTheSeamPass) {
     TempDir dir;
     const std::string in = coloured_mesh(dir, 60000);
-    CliRun r = run("decimate -r 0.1 --threads 2 --buffer 16384 " + in + " " + dir / "out.ply");
+    const Read before = read_back(in);
+    const std::string common = "decimate -r 0.1 --buffer 16384 --json " + in + " ";
+    CliRun r = run(common + "--threads 2 " + dir / "two.ply > " + dir / "two.json");
     ASSERT_EQ(r.code, 0) << r.err;
-    EXPECT_NE(r.err.find("warning: decimated by one thread: ranges carry positions only, and decimate keeps this "
-                         "input's colours"),
-              std::string::npos)
-        << r.err;
-    EXPECT_TRUE(read_back(dir / "out.ply").channels.color.has_value());
+    EXPECT_NE(cli_test::slurp(dir / "two.json").find("\"threads\":2"), std::string::npos);
+    EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
+    const Read after = read_back(dir / "two.ply");
+    ASSERT_TRUE(after.channels.color.has_value());
+    EXPECT_EQ(after.triangles, uint64_t(std::llround(0.1 * double(before.triangles))));
+    EXPECT_GE(after.colour_min, before.colour_min - 1.0 / 255);
+    EXPECT_LE(after.colour_max, before.colour_max + 1.0 / 255);
+    // The same run again: the same bytes.
+    ASSERT_EQ(run(common + "--threads 2 " + dir / "again.ply > /dev/null").code, 0);
+    EXPECT_EQ(cli_test::slurp(dir / "two.ply"), cli_test::slurp(dir / "again.ply"));
 }
 
 TEST(CliDecimateChannels, AStreamWithColoursIsNotSortedFirst) {

@@ -90,6 +90,20 @@ TEST(MpiDecimate, KRanksWriteWhatKThreadsWrite) {
     }
 }
 
+TEST(MpiDecimate, RanksSendTheColoursTheyCarry) {
+    TempDir dir;
+    const std::string coloured = dir / "coloured.ply";
+    ASSERT_EQ(std::system((std::string(MESHSTREAM_GEN_BINARY) + " -q --color -n 60000 " + coloured).c_str()), 0);
+    const std::string common = "decimate --buffer 16384 -r 0.1 " + coloured + " ";
+    const CliRun r = run_mpi(2, common + dir / "mpi.ply");
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
+    ASSERT_EQ(run("-q " + common + "--threads 2 " + dir / "threads.ply").code, 0);
+    const std::string mpi = slurp(dir / "mpi.ply");
+    EXPECT_NE(mpi.find("property uchar red"), std::string::npos);
+    EXPECT_EQ(mpi, slurp(dir / "threads.ply"));
+}
+
 TEST(MpiDecimate, JsonIsOneObjectFromRankZero) {
     TempDir dir;
     const CliRun r = run_mpi(
