@@ -1,7 +1,8 @@
 // Metro-style error between two meshes (Cignoni, Rocchini & Scopigno 1998), streaming the
 // larger one. See metro.hpp for the method and its memory bound. Spatial indices are BVHs
 // built by median split on the longest centroid axis (leaf 4 triangles / 8 samples); distances
-// use Ericson's closest point on a triangle (Real-Time Collision Detection, §5.1.5) in double.
+// use Ericson's closest point on a triangle (Real-Time Collision Detection, §5.1.5) in double,
+// whose barycentric coordinates also interpolate the attributes at that point.
 #include "compare/metro.hpp"
 
 #include "io/byte_stream.hpp"
@@ -46,26 +47,57 @@ double triangle_area(const float* t) {
     return 0.5 * std::sqrt(cx * cx + cy * cy + cz * cz);
 }
 
-// A uniformly distributed point on triangle t (Osada et al. 2002: sqrt of r1).
-void point_in_triangle(const float* t, Rng& rng, double p[3]) {
+// A uniformly distributed point on triangle t (Osada et al. 2002: sqrt of r1), and its
+// barycentric coordinates.
+void point_in_triangle(const float* t, Rng& rng, double p[3], double bary[3]) {
     double s = std::sqrt(rng.uniform()), r2 = rng.uniform();
     double wa = 1 - s, wb = s * (1 - r2), wc = s * r2;
     for (int a = 0; a < 3; ++a) p[a] = wa * t[a] + wb * t[3 + a] + wc * t[6 + a];
+    bary[0] = wa, bary[1] = wb, bary[2] = wc;
 }
 
 double dot3(const double* a, const double* b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
-double segment_dist2(const double p[3], const double a[3], const double b[3]) {
+// Squared distance from p to segment a-b, and in `t` where its closest point lies (0 at a, 1 at b).
+double segment_dist2(const double p[3], const double a[3], const double b[3], double& t) {
     double ab[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, ap[3] = {p[0] - a[0], p[1] - a[1], p[2] - a[2]};
-    double len2 = dot3(ab, ab), t = len2 > 0 ? std::clamp(dot3(ap, ab) / len2, 0.0, 1.0) : 0.0;
+    double len2 = dot3(ab, ab);
+    t = len2 > 0 ? std::clamp(dot3(ap, ab) / len2, 0.0, 1.0) : 0.0;
     double d[3] = {ap[0] - t * ab[0], ap[1] - t * ab[1], ap[2] - t * ab[2]};
     return dot3(d, d);
 }
 
-// Squared distance from p to triangle t (9 floats), Ericson §5.1.5 by Voronoi regions. A
-// degenerate triangle (zero area) falls back to its three edges, where the region divisions
-// would be 0/0.
-double point_triangle_dist2(const double p[3], const float* t) {
+// Sets bary to (u, v, w) when kBary (the callers that need no coordinates skip the stores).
+template <bool kBary>
+void set_bary(double* bary, double u, double v, double w) {
+    if constexpr (kBary) bary[0] = u, bary[1] = v, bary[2] = w;
+}
+
+// The nearest of a degenerate triangle's three edges (the first of equals, ab, bc, ca), with
+// the barycentric coordinates of its closest point when kBary.
+template <bool kBary>
+double edges_dist2(const double p[3], const double a[3], const double b[3], const double c[3], double* bary) {
+    double t_ab, t_bc, t_ac;
+    const double ab = segment_dist2(p, a, b, t_ab), bc = segment_dist2(p, b, c, t_bc),
+                 ac = segment_dist2(p, a, c, t_ac);
+    if (ab <= bc && ab <= ac) {
+        set_bary<kBary>(bary, 1 - t_ab, t_ab, 0);
+        return ab;
+    }
+    if (bc <= ac) {
+        set_bary<kBary>(bary, 0, 1 - t_bc, t_bc);
+        return bc;
+    }
+    set_bary<kBary>(bary, 1 - t_ac, 0, t_ac);
+    return ac;
+}
+
+// Squared distance from p to triangle t (9 floats), Ericson §5.1.5 by Voronoi regions, and
+// with kBary the barycentric coordinates of the closest point in bary[3] (else bary is not
+// used and may be null). A degenerate triangle (zero area) falls back to its three edges,
+// where the region divisions would be 0/0.
+template <bool kBary = false>
+double point_triangle_dist2(const double p[3], const float* t, double* bary = nullptr) {
     double a[3] = {t[0], t[1], t[2]}, b[3] = {t[3], t[4], t[5]}, c[3] = {t[6], t[7], t[8]};
     double ab[3], ac[3], ap[3], q[3];
     for (int k = 0; k < 3; ++k) {
@@ -77,42 +109,130 @@ double point_triangle_dist2(const double p[3], const float* t) {
         double d[3] = {p[0] - x[0], p[1] - x[1], p[2] - x[2]};
         return dot3(d, d);
     };
+    auto corner = [&](const double* x, int k) {
+        set_bary<kBary>(bary, k == 0, k == 1, k == 2);
+        return dist2_to(x);
+    };
     double d1 = dot3(ab, ap), d2 = dot3(ac, ap);
-    if (d1 <= 0 && d2 <= 0) return dist2_to(a);
+    if (d1 <= 0 && d2 <= 0) return corner(a, 0);
     double bp[3] = {p[0] - b[0], p[1] - b[1], p[2] - b[2]};
     double d3 = dot3(ab, bp), d4 = dot3(ac, bp);
-    if (d3 >= 0 && d4 <= d3) return dist2_to(b);
+    if (d3 >= 0 && d4 <= d3) return corner(b, 1);
     double vc = d1 * d4 - d3 * d2;
     if (vc <= 0 && d1 >= 0 && d3 <= 0) {
-        if (d1 - d3 <= 0) return std::min({segment_dist2(p, a, b), segment_dist2(p, b, c), segment_dist2(p, a, c)});
+        if (d1 - d3 <= 0) return edges_dist2<kBary>(p, a, b, c, bary);
         double v = d1 / (d1 - d3);
         for (int k = 0; k < 3; ++k) q[k] = a[k] + v * ab[k];
+        set_bary<kBary>(bary, 1 - v, v, 0);
         return dist2_to(q);
     }
     double cp[3] = {p[0] - c[0], p[1] - c[1], p[2] - c[2]};
     double d5 = dot3(ab, cp), d6 = dot3(ac, cp);
-    if (d6 >= 0 && d5 <= d6) return dist2_to(c);
+    if (d6 >= 0 && d5 <= d6) return corner(c, 2);
     double vb = d5 * d2 - d1 * d6;
     if (vb <= 0 && d2 >= 0 && d6 <= 0) {
-        if (d2 - d6 <= 0) return std::min({segment_dist2(p, a, b), segment_dist2(p, b, c), segment_dist2(p, a, c)});
+        if (d2 - d6 <= 0) return edges_dist2<kBary>(p, a, b, c, bary);
         double w = d2 / (d2 - d6);
         for (int k = 0; k < 3; ++k) q[k] = a[k] + w * ac[k];
+        set_bary<kBary>(bary, 1 - w, 0, w);
         return dist2_to(q);
     }
     double va = d3 * d6 - d5 * d4;
     if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
         double den = (d4 - d3) + (d5 - d6);
-        if (den <= 0) return std::min({segment_dist2(p, a, b), segment_dist2(p, b, c), segment_dist2(p, a, c)});
+        if (den <= 0) return edges_dist2<kBary>(p, a, b, c, bary);
         double w = (d4 - d3) / den;
         for (int k = 0; k < 3; ++k) q[k] = b[k] + w * (c[k] - b[k]);
+        set_bary<kBary>(bary, 0, 1 - w, w);
         return dist2_to(q);
     }
     double sum = va + vb + vc;
-    if (!(sum > 0)) return std::min({segment_dist2(p, a, b), segment_dist2(p, b, c), segment_dist2(p, a, c)});
+    if (!(sum > 0)) return edges_dist2<kBary>(p, a, b, c, bary);
     double v = vb / sum, w = vc / sum;
     for (int k = 0; k < 3; ++k) q[k] = a[k] + ab[k] * v + ac[k] * w;
+    set_bary<kBary>(bary, 1 - v - w, v, w);
     return dist2_to(q);
 }
+
+// ---- Attributes ----------------------------------------------------------------------------
+
+// The attribute values compare measures, packed per corner (and per sample) as floats:
+// colour RGB first when measured, then the normal's xyz.
+struct AttributeLayout {
+    bool color = false, normal = false;
+    int floats() const { return 3 * (int(color) + int(normal)); }
+    int normal_offset() const { return color ? 3 : 0; }
+};
+
+// Packs the three corners of chunk triangle i into out[3 × layout.floats()].
+void pack_corners(const AttributeLayout& layout, const io::TriangleChunk& chunk, size_t i, float* out) {
+    const int n = layout.floats();
+    const float* rgba = layout.color ? chunk.color_at(i) : nullptr;
+    const float* normal = layout.normal ? chunk.normal_at(i) : nullptr;
+    for (int k = 0; k < 3; ++k) {
+        float* corner = out + k * n;
+        if (rgba) std::memcpy(corner, rgba + 4 * k, 3 * sizeof(float));
+        if (normal) std::memcpy(corner + layout.normal_offset(), normal + 3 * k, 3 * sizeof(float));
+    }
+}
+
+// out[j] = the corners' values (3 × n floats) interpolated at barycentric coordinates `bary`.
+void interpolate(const float* corners, int n, const double bary[3], float* out) {
+    for (int j = 0; j < n; ++j)
+        out[j] = float(bary[0] * corners[j] + bary[1] * corners[n + j] + bary[2] * corners[2 * n + j]);
+}
+
+struct ErrorAccumulator {
+    uint64_t n = 0, skipped = 0;
+    double sum2 = 0, max = 0;
+    void add(double error) {
+        if (!std::isfinite(error)) {
+            ++skipped;
+            return;
+        }
+        ++n;
+        sum2 += error * error;
+        max = std::max(max, error);
+    }
+    AttributeStats stats() const {
+        AttributeStats s;
+        s.samples = n;
+        s.skipped = skipped;
+        s.max = max;
+        s.rms = n ? std::sqrt(sum2 / double(n)) : 0;
+        return s;
+    }
+};
+
+// One direction's colour and normal errors.
+struct AttributeAccumulator {
+    AttributeLayout layout;
+    ErrorAccumulator color, normal;
+
+    // A sample's value on its own surface against the value at its nearest point of the other.
+    void add(const float* own, const float* other) {
+        if (layout.color) {
+            double d2 = 0;
+            for (int j = 0; j < 3; ++j) {
+                const double d = double(own[j]) - other[j];
+                d2 += d * d;
+            }
+            color.add(std::sqrt(d2));
+        }
+        if (layout.normal) {
+            const float *a = own + layout.normal_offset(), *b = other + layout.normal_offset();
+            const double x[3] = {a[0], a[1], a[2]}, y[3] = {b[0], b[1], b[2]};
+            if (!(dot3(x, x) > 0) || !(dot3(y, y) > 0)) {
+                ++normal.skipped;  // no direction to compare (or NaN)
+            } else {
+                // atan2 of |x × y| and x · y: the angle of the normalised vectors, exact near 0°
+                // and 180°, where acos of the dot product loses half its digits.
+                const double c[3] = {x[1] * y[2] - x[2] * y[1], x[2] * y[0] - x[0] * y[2], x[0] * y[1] - x[1] * y[0]};
+                normal.add(std::atan2(std::sqrt(dot3(c, c)), dot3(x, y)) * (180.0 / 3.14159265358979323846));
+            }
+        }
+    }
+};
 
 // ---- BVH over boxes ------------------------------------------------------------------------
 
@@ -201,9 +321,11 @@ double box_dist2(const BvhNode& n, const double p[3]) {
     return d2;
 }
 
-// Nearest primitive to p: returns the smallest leaf_dist2(i) below `best2`, or best2.
+// Nearest primitive to p: returns the smallest leaf_dist2(i) below `best2`, or best2; and in
+// *winner (when not null) that primitive, left alone when none is below best2.
 template <class LeafFn>
-double bvh_nearest(const std::vector<BvhNode>& nodes, const double p[3], double best2, LeafFn leaf_dist2) {
+double bvh_nearest(const std::vector<BvhNode>& nodes, const double p[3], double best2, LeafFn leaf_dist2,
+                   uint32_t* winner = nullptr) {
     if (nodes.empty()) return best2;
     uint32_t stack[128];
     int top = 0;
@@ -212,7 +334,11 @@ double bvh_nearest(const std::vector<BvhNode>& nodes, const double p[3], double 
         const BvhNode& n = nodes[stack[--top]];
         if (box_dist2(n, p) >= best2) continue;
         if (n.count) {
-            for (uint32_t i = n.first; i < n.first + n.count; ++i) best2 = std::min(best2, leaf_dist2(i));
+            for (uint32_t i = n.first; i < n.first + n.count; ++i) {
+                const double d2 = leaf_dist2(i);
+                if (winner && d2 < best2) *winner = i;
+                best2 = std::min(best2, d2);  // a min, not a branch on d2: the hot loop of compare
+            }
             continue;
         }
         double dl = box_dist2(nodes[n.first], p), dr = box_dist2(nodes[n.first + 1], p);
@@ -228,9 +354,11 @@ double bvh_nearest(const std::vector<BvhNode>& nodes, const double p[3], double 
     return best2;
 }
 
-// Triangles held in memory, with their BVH.
+// Triangles held in memory, with their BVH and their corners' attribute values.
 struct TriangleIndex {
     std::vector<float> xyz;  // 9 floats per triangle, in BVH order
+    int values = 0;          // attribute floats per corner (AttributeLayout::floats())
+    std::vector<float> corner_values;  // 3 × values floats per triangle, in BVH order
     std::vector<BvhNode> nodes;
 
     void build() {
@@ -246,9 +374,22 @@ struct TriangleIndex {
             },
             4, order);
         permute(xyz, order, 9);
+        if (values) permute(corner_values, order, 3 * size_t(values));
     }
-    double nearest_dist2(const double p[3]) const {
-        return bvh_nearest(nodes, p, kInf, [&](uint32_t i) { return point_triangle_dist2(p, &xyz[9 * size_t{i}]); });
+    // The squared distance from p to the nearest triangle at or below best2 (else best2), and
+    // when `value` is not null and one is, the attribute values at its closest point in
+    // value[values].
+    double nearest_dist2(const double p[3], double best2 = kInf, float* value = nullptr) const {
+        uint32_t winner = 0;
+        const double d2 = bvh_nearest(
+            nodes, p, best2, [&](uint32_t i) { return point_triangle_dist2(p, &xyz[9 * size_t{i}]); },
+            value ? &winner : nullptr);
+        if (value && d2 < best2) {  // the winner's coordinates, once
+            double bary[3];
+            point_triangle_dist2<true>(p, &xyz[9 * size_t{winner}], bary);
+            interpolate(&corner_values[3 * size_t(values) * winner], values, bary, value);
+        }
+        return d2;
     }
 };
 
@@ -266,13 +407,30 @@ struct SampleIndex {
     // UTM coordinates, which showed as error in a mesh compared with itself.
     double origin[3] = {0, 0, 0};
     std::vector<float> xyz;     // 3 floats per sample relative to origin, in BVH order
+    // Attribute floats per sample (AttributeLayout::floats()), and the samples' values: their
+    // own, and at their nearest point of the streamed mesh so far (the point best2 measures).
+    // They stay in the order the samples were added (a permuted copy of them was compare's
+    // peak memory): sample i's are at record slot[i].
+    int values = 0;
+    std::vector<float> own, other;  // `values` floats per sample each
+    std::vector<uint32_t> slot;     // with values, after build()
     std::vector<double> best2;  // running minimum squared distance
     std::vector<BvhNode> nodes;
 
-    void add(const double p[3]) {
+    // Appends a sample at p with its own attribute values (`values` floats; may be null when
+    // values is 0).
+    void add(const double p[3], const float* own_values) {
         xyz.insert(xyz.end(), {float(p[0] - origin[0]), float(p[1] - origin[1]), float(p[2] - origin[2])});
+        if (values) own.insert(own.end(), own_values, own_values + values);
     }
-    void add_relative(const float* rel) { xyz.insert(xyz.end(), rel, rel + 3); }
+    // Appends sample i of `from` (before its build()), which has the same origin and values, as
+    // it stands.
+    void add_from(const SampleIndex& from, size_t i) {
+        xyz.insert(xyz.end(), &from.xyz[3 * i], &from.xyz[3 * i] + 3);
+        if (!values) return;
+        own.insert(own.end(), &from.own[values * i], &from.own[values * i] + values);
+        other.insert(other.end(), &from.other[values * i], &from.other[values * i] + values);
+    }
     void position(size_t i, double p[3]) const {
         for (int a = 0; a < 3; ++a) p[a] = double(xyz[3 * i + a]) + origin[a];
     }
@@ -298,26 +456,38 @@ struct SampleIndex {
         permute(xyz, order, 3);
         best2.resize(bound2.size());
         for (size_t i = 0; i < order.size(); ++i) best2[i] = bound2[order[i]];
+        if (values) slot = std::move(order);
     }
 
     // Lowers best2 of every sample that triangle t (absolute bounding box abs_lo..abs_hi) is
-    // closer to.
-    void update(const float* t, const float abs_lo[3], const float abs_hi[3]) {
-        lower_within(abs_lo, abs_hi,
-                     [&](const double p[3], double so_far) { return std::min(so_far, point_triangle_dist2(p, t)); });
+    // closer to, and sets its `other` values to those interpolated at its closest point of t
+    // from t's corners (3 × values floats; may be null when values is 0).
+    void update(const float* t, const float* corners, const float abs_lo[3], const float abs_hi[3]) {
+        if (!values) {
+            lower_within(abs_lo, abs_hi, [&](size_t, const double p[3], double so_far) {
+                return std::min(so_far, point_triangle_dist2(p, t));
+            });
+            return;
+        }
+        lower_within(abs_lo, abs_hi, [&](size_t i, const double p[3], double so_far) {
+            double bary[3];
+            const double d2 = point_triangle_dist2<true>(p, t, bary);
+            if (!(d2 < so_far)) return so_far;
+            interpolate(corners, values, bary, &other[values * size_t{slot[i]}]);
+            return d2;
+        });
     }
     // The same for every triangle of `chunk` (abs_lo..abs_hi bounds them all), through its BVH:
     // for samples far from the streamed surface, which a triangle at a time would meet once for
     // every triangle within reach.
     void update(const TriangleIndex& chunk, const float abs_lo[3], const float abs_hi[3]) {
-        lower_within(abs_lo, abs_hi, [&](const double p[3], double so_far) {
-            return bvh_nearest(chunk.nodes, p, so_far,
-                               [&](uint32_t k) { return point_triangle_dist2(p, &chunk.xyz[9 * size_t{k}]); });
+        lower_within(abs_lo, abs_hi, [&](size_t i, const double p[3], double so_far) {
+            return chunk.nearest_dist2(p, so_far, values ? &other[values * size_t{slot[i]}] : nullptr);
         });
     }
 
 private:
-    // Calls best2[i] = lower(p_i, best2[i]) for every sample i whose box reaches abs_lo..abs_hi
+    // Calls best2[i] = lower(i, p_i, best2[i]) for every sample i whose box reaches abs_lo..abs_hi
     // and that box is nearer than best2[i].
     template <class Lower>
     void lower_within(const float abs_lo[3], const float abs_hi[3], Lower lower) {
@@ -352,7 +522,7 @@ private:
                     box2 += d * d;
                 }
                 if (box2 >= best2[i]) continue;
-                best2[i] = lower(p, best2[i]);
+                best2[i] = lower(i, p, best2[i]);
             }
         }
     }
@@ -391,14 +561,20 @@ void grow_bounds(io::Bounds& b, const float* t, bool& first) {
         }
 }
 
-// Reads the whole of `source` through `fn(triangle_index, tri)` for finite triangles; fills
-// the summary's counts, area and bounds (edges when `edges` is given).
+// Reads the whole of `reader` through `fn(triangle_index, tri, corners)` for finite
+// triangles, `corners` being the triangle's corners' values in `layout` (3 × layout.floats();
+// null when the layout is empty); fills the summary's counts, area and bounds (edges when
+// `edges` is given).
 template <class Fn>
-void stream_mesh(const MeshSource& source, MeshSummary& summary, EdgeCounter* edges, const CompareOptions& options,
-                 std::string_view phase, Fn fn) {
-    std::unique_ptr<io::Reader> reader = source.open();
+void stream_mesh(std::unique_ptr<io::Reader> reader, const AttributeLayout& layout, MeshSummary& summary,
+                 EdgeCounter* edges, const CompareOptions& options, std::string_view phase, Fn fn) {
     std::optional<uint64_t> total = reader->triangle_count();
-    io::TriangleChunk chunk;
+    io::Channels wanted;
+    wanted.normal = layout.normal;
+    if (layout.color) wanted.color = reader->header().channels.color.value_or(io::ColorFormat{});
+    io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, wanted);
+    float corners[3 * 6];
+    const float* values = layout.floats() ? corners : nullptr;
     uint64_t index = 0, non_finite = 0;
     double area = 0;
     bool first = true;
@@ -414,10 +590,12 @@ void stream_mesh(const MeshSource& source, MeshSummary& summary, EdgeCounter* ed
             area += triangle_area(tri);
             grow_bounds(bounds, tri, first);
             if (edges) edges->add_triangle(tri);
-            fn(index, tri);
+            if (values) pack_corners(layout, chunk, t, corners);
+            fn(index, tri, values);
         }
         if (options.progress) options.progress(phase, index, total);
     }
+    summary.channels = reader->header().channels;
     summary.triangles = index;
     summary.non_finite_triangles = non_finite;
     summary.area = area;
@@ -445,22 +623,36 @@ private:
     io::Input in_;
 };
 
+// Triangles, and optionally their corners' normals (9 floats each) and colours (12), in memory.
+struct MemoryMesh {
+    std::vector<float> xyz, normals, colors;
+};
+
 class MemoryReader final : public io::Reader {
 public:
-    explicit MemoryReader(std::shared_ptr<const std::vector<float>> xyz) : xyz_(std::move(xyz)) {
-        header_.triangle_count = xyz_->size() / 9;
+    explicit MemoryReader(std::shared_ptr<const MemoryMesh> mesh) : mesh_(std::move(mesh)) {
+        header_.triangle_count = mesh_->xyz.size() / 9;
+        header_.channels.normal = !mesh_->normals.empty();
+        if (!mesh_->colors.empty()) header_.channels.color = io::ColorFormat{io::ScalarType::kFloat32, true};
     }
     bool next(io::TriangleChunk& chunk) override {
         chunk.clear();
-        size_t n = std::min(chunk.capacity(), xyz_->size() / 9 - pos_);
-        std::memcpy(chunk.xyz_storage(), xyz_->data() + 9 * pos_, n * 9 * sizeof(float));
+        size_t n = std::min(chunk.capacity(), mesh_->xyz.size() / 9 - pos_);
+        std::memcpy(chunk.xyz_storage(), mesh_->xyz.data() + 9 * pos_, n * 9 * sizeof(float));
+        // The chunk's other channels stay as they are, as a reader leaves channels it lacks.
+        for (size_t i = 0; i < n; ++i) {
+            if (float* normal = chunk.normal_at(i); normal && !mesh_->normals.empty())
+                std::memcpy(normal, &mesh_->normals[9 * (pos_ + i)], 9 * sizeof(float));
+            if (float* rgba = chunk.color_at(i); rgba && !mesh_->colors.empty())
+                std::memcpy(rgba, &mesh_->colors[12 * (pos_ + i)], 12 * sizeof(float));
+        }
         chunk.resize(n);
         pos_ += n;
         return n > 0;
     }
 
 private:
-    std::shared_ptr<const std::vector<float>> xyz_;
+    std::shared_ptr<const MemoryMesh> mesh_;
     size_t pos_ = 0;
 };
 
@@ -478,11 +670,14 @@ MeshSource file_source(const std::string& path, std::string_view from, const io:
     return s;
 }
 
-MeshSource memory_source(std::string name, std::vector<float> xyz) {
+MeshSource memory_source(std::string name, std::vector<float> xyz, std::vector<float> normals,
+                         std::vector<float> colors) {
     assert(xyz.size() % 9 == 0);
+    assert(normals.empty() || normals.size() == xyz.size());
+    assert(colors.empty() || 3 * colors.size() == 4 * xyz.size());
     MeshSource s;
     s.name = std::move(name);
-    auto data = std::make_shared<const std::vector<float>>(std::move(xyz));
+    auto data = std::make_shared<const MemoryMesh>(MemoryMesh{std::move(xyz), std::move(normals), std::move(colors)});
     s.open = [data]() -> std::unique_ptr<io::Reader> { return std::make_unique<MemoryReader>(data); };
     return s;
 }
@@ -504,6 +699,27 @@ double MeshSummary::diagonal() const {
 
 // ---- compare_meshes ----------------------------------------------------------------------
 
+AttributeStats AttributeErrors::symmetric(const AttributeStats& x, const AttributeStats& y) {
+    AttributeStats s;
+    s.samples = x.samples + y.samples;
+    s.skipped = x.skipped + y.skipped;
+    s.max = std::max(x.max, y.max);
+    s.rms = std::max(x.rms, y.rms);
+    return s;
+}
+
+namespace {
+
+// "colours and normals", "colours", "normals" or "neither colours nor normals".
+std::string describe_attributes(const io::Channels& c) {
+    if (c.color && c.normal) return "colours and normals";
+    if (c.color) return "colours";
+    if (c.normal) return "normals";
+    return "neither colours nor normals";
+}
+
+}  // namespace
+
 CompareResult compare_meshes(const MeshSource& a, const MeshSource& b, const CompareOptions& options) {
     // Which one to hold: the smaller by header count (or a PLY's face count) when both are
     // known, else B. A stream cannot be read twice (nor opened once just for its count), so it
@@ -511,13 +727,15 @@ CompareResult compare_meshes(const MeshSource& a, const MeshSource& b, const Com
     if (a.once && b.once)
         throw io::Error(b.name, "compare cannot stream both meshes (stdin or pipes): one of them is read twice");
     bool hold_a = a.once;
+    std::optional<io::Channels> channels_a, channels_b;  // from the headers, where opened for counts
     if (!a.once && !b.once) {
-        auto count = [](const MeshSource& m) {
+        auto count = [](const MeshSource& m, std::optional<io::Channels>& channels) {
             const std::unique_ptr<io::Reader> reader = m.open();
             const io::MeshHeader& h = reader->header();
+            channels = h.channels;
             return h.triangle_count ? h.triangle_count : h.triangle_estimate;
         };
-        const std::optional<uint64_t> count_a = count(a), count_b = count(b);
+        const std::optional<uint64_t> count_a = count(a, channels_a), count_b = count(b, channels_b);
         hold_a = count_a && count_b && *count_a < *count_b;
     }
     const MeshSource& held = hold_a ? a : b;
@@ -528,12 +746,39 @@ CompareResult compare_meshes(const MeshSource& a, const MeshSource& b, const Com
     held_summary.in_memory = true;
     streamed_summary.name = streamed.name;
 
-    // The held mesh: triangles, edges, and later its samples.
+    // The channels both have decide what the held mesh keeps, so they are known before a
+    // triangle is read: the held mesh's from its reader, the streamed one's from the count
+    // above or, when the held mesh is a stream, from opening it once more (it is a file).
+    std::unique_ptr<io::Reader> held_reader = held.open();
+    held_summary.channels = held_reader->header().channels;
+    AttributeLayout layout;
+    if (options.attributes) {
+        const std::optional<io::Channels>& known = hold_a ? channels_b : channels_a;
+        streamed_summary.channels = known ? *known : streamed.open()->header().channels;
+        layout.color = held_summary.channels.color && streamed_summary.channels.color;
+        layout.normal = held_summary.channels.normal && streamed_summary.channels.normal;
+        if (!layout.color && !layout.normal) {
+            const MeshSummary& sa = hold_a ? held_summary : streamed_summary;
+            const MeshSummary& sb = hold_a ? streamed_summary : held_summary;
+            throw NoSharedAttributes("no colours or normals in both meshes to compare: A (" + a.name + ") has " +
+                                     describe_attributes(sa.channels) + ", B (" + b.name + ") has " +
+                                     describe_attributes(sb.channels));
+        }
+    }
+    const int values = layout.floats();
+
+    // The held mesh: triangles, their corners' values, edges, and later its samples.
     TriangleIndex triangles;
+    triangles.values = values;
     {
         EdgeCounter edges(options.memory_budget_bytes, options.tmpdir);
-        stream_mesh(held, held_summary, &edges, options, "reading " + held.name,
-                    [&](uint64_t, const float* t) { triangles.xyz.insert(triangles.xyz.end(), t, t + 9); });
+        stream_mesh(std::move(held_reader), layout, held_summary, &edges, options, "reading " + held.name,
+                    [&](uint64_t, const float* t, const float* corners) {
+                        triangles.xyz.insert(triangles.xyz.end(), t, t + 9);
+                        if (values)
+                            triangles.corner_values.insert(triangles.corner_values.end(), corners,
+                                                           corners + 3 * values);
+                    });
         held_summary.edges = edges.finish();
     }
     if (triangles.xyz.empty()) throw io::Error(held.name, "holds no (finite) triangles; nothing to compare");
@@ -541,21 +786,29 @@ CompareResult compare_meshes(const MeshSource& a, const MeshSource& b, const Com
 
     // Pass 1 over the streamed mesh: counts, area, edges, and a reservoir of its vertices
     // (Vitter's algorithm R), whose distances to the held samples bound the true distances
-    // from above before pass 2.
-    std::vector<float> reservoir;
+    // from above before pass 2; with their values, which are then the held samples' values at
+    // those (upper-bound) nearest points.
+    std::vector<float> reservoir, reservoir_values;
     size_t reservoir_capacity = static_cast<size_t>(std::clamp<uint64_t>(held_samples, 1024, 10'000'000));
     {
         EdgeCounter edges(options.memory_budget_bytes, options.tmpdir);
         uint64_t seen = 0;
-        stream_mesh(streamed, streamed_summary, &edges, options, "pass 1: " + streamed.name,
-                    [&](uint64_t index, const float* t) {
+        stream_mesh(streamed.open(), layout, streamed_summary, &edges, options, "pass 1: " + streamed.name,
+                    [&](uint64_t index, const float* t, const float* corners) {
                         Rng rng = triangle_rng(options.seed, kSaltReservoir, index);
-                        const float* corner = t + 3 * (rng.next() % 3);
+                        const uint64_t k = rng.next() % 3;
+                        const float* corner = t + 3 * k;
+                        const float* value = values ? corners + k * values : nullptr;
                         if (seen < reservoir_capacity) {
                             reservoir.insert(reservoir.end(), corner, corner + 3);
+                            if (values) reservoir_values.insert(reservoir_values.end(), value, value + values);
                         } else {
                             uint64_t slot = rng.next() % (seen + 1);
-                            if (slot < reservoir_capacity) std::memcpy(&reservoir[3 * slot], corner, 3 * sizeof(float));
+                            if (slot < reservoir_capacity) {
+                                std::memcpy(&reservoir[3 * slot], corner, 3 * sizeof(float));
+                                if (values)
+                                    std::memcpy(&reservoir_values[values * slot], value, values * sizeof(float));
+                            }
                         }
                         ++seen;
                     });
@@ -566,18 +819,21 @@ CompareResult compare_meshes(const MeshSource& a, const MeshSource& b, const Com
 
     // Samples on the held mesh, with upper bounds from the reservoir.
     SampleIndex samples, far_samples;
+    samples.values = far_samples.values = values;
     std::copy(triangles.xyz.begin(), triangles.xyz.begin() + 3, samples.origin);
     {
         double density = held_summary.area > 0 ? double(held_samples) / held_summary.area : 0;
         size_t n_tri = triangles.xyz.size() / 9;
+        float own[6] = {};
         for (size_t i = 0; i < n_tri && density > 0; ++i) {
             const float* t = &triangles.xyz[9 * i];
             Rng rng = triangle_rng(options.seed, kSaltMemorySamples, i);
             uint64_t k = samples_for(triangle_area(t), density, rng);
             for (uint64_t j = 0; j < k; ++j) {
-                double p[3];
-                point_in_triangle(t, rng, p);
-                samples.add(p);
+                double p[3], bary[3];
+                point_in_triangle(t, rng, p, bary);
+                if (values) interpolate(&triangles.corner_values[3 * size_t(values) * i], values, bary, own);
+                samples.add(p, own);
             }
         }
         std::vector<uint32_t> order;
@@ -588,19 +844,29 @@ CompareResult compare_meshes(const MeshSource& a, const MeshSource& b, const Com
             },
             8, order);
         permute(reservoir, order, 3);
+        if (values) permute(reservoir_values, order, size_t(values));
         size_t n = samples.xyz.size() / 3;
         std::vector<double> bound2(n);
+        samples.other.resize(n * size_t(values));
         for (size_t i = 0; i < n; ++i) {
             double p[3];
             samples.position(i, p);
-            bound2[i] = bvh_nearest(points, p, kInf, [&](uint32_t r) {
-                double d[3] = {p[0] - reservoir[3 * size_t{r}], p[1] - reservoir[3 * size_t{r} + 1],
-                               p[2] - reservoir[3 * size_t{r} + 2]};
-                return dot3(d, d);
-            });
+            uint32_t nearest = 0;
+            bound2[i] = bvh_nearest(
+                points, p, kInf,
+                [&](uint32_t r) {
+                    double d[3] = {p[0] - reservoir[3 * size_t{r}], p[1] - reservoir[3 * size_t{r} + 1],
+                                   p[2] - reservoir[3 * size_t{r} + 2]};
+                    return dot3(d, d);
+                },
+                &nearest);
+            if (values)
+                std::memcpy(&samples.other[values * i], &reservoir_values[values * size_t{nearest}],
+                            values * sizeof(float));
             if (options.progress && i % 65536 == 0) options.progress("bounding samples", i, n);
         }
         reservoir = std::vector<float>();  // freed before pass 2 (`= {}` would keep it)
+        reservoir_values = std::vector<float>();
         // Samples farther from the streamed surface than a few of its triangles' size would each
         // meet every streamed triangle within reach, one at a time (a plane 0.25 above a grid of
         // 210 k triangles took 564 s): they meet chunks of triangles through a BVH instead.
@@ -610,12 +876,13 @@ CompareResult compare_meshes(const MeshSource& a, const MeshSource& b, const Com
         const double far2 = (kFarFactor * typical) * (kFarFactor * typical);
         if (std::any_of(bound2.begin(), bound2.end(), [&](double bound) { return bound > far2; })) {
             SampleIndex near;
+            near.values = values;
             std::copy(samples.origin, samples.origin + 3, near.origin);
             std::copy(samples.origin, samples.origin + 3, far_samples.origin);
             std::vector<double> near_bound2, far_bound2;
             for (size_t i = 0; i < n; ++i) {
                 const bool far = bound2[i] > far2;
-                (far ? far_samples : near).add_relative(&samples.xyz[3 * i]);
+                (far ? far_samples : near).add_from(samples, i);
                 (far ? far_bound2 : near_bound2).push_back(bound2[i]);
             }
             samples = std::move(near);
@@ -629,42 +896,55 @@ CompareResult compare_meshes(const MeshSource& a, const MeshSource& b, const Com
     // Pass 2: samples on the streamed mesh against the held triangles, and the held samples'
     // running minimum against each streamed triangle.
     StatsAccumulator streamed_stats;
+    AttributeAccumulator streamed_attributes{layout, {}, {}};
     {
         double density = streamed_summary.area > 0 ? double(streamed_samples) / streamed_summary.area : 0;
         MeshSummary check;
         TriangleIndex chunk;  // for the far samples
+        chunk.values = values;
         float chunk_lo[3], chunk_hi[3];
         auto flush = [&] {
             if (chunk.xyz.empty()) return;
             chunk.build();
             far_samples.update(chunk, chunk_lo, chunk_hi);
             chunk.xyz.clear();
+            chunk.corner_values.clear();
         };
-        stream_mesh(streamed, check, nullptr, options, "pass 2: " + streamed.name, [&](uint64_t index, const float* t) {
-            Rng rng = triangle_rng(options.seed, kSaltStreamSamples, index);
-            uint64_t k = density > 0 ? samples_for(triangle_area(t), density, rng) : 0;
-            for (uint64_t j = 0; j < k; ++j) {
-                double p[3];
-                point_in_triangle(t, rng, p);
-                streamed_stats.add(triangles.nearest_dist2(p));
-            }
-            float lo[3], hi[3];
-            for (int x = 0; x < 3; ++x) {
-                lo[x] = std::min({t[x], t[3 + x], t[6 + x]});
-                hi[x] = std::max({t[x], t[3 + x], t[6 + x]});
-            }
-            samples.update(t, lo, hi);
-            if (far_samples.xyz.empty()) return;
-            // Consecutive triangles of a mesh file are mostly near each other: a chunk's box
-            // stays small.
-            const bool first = chunk.xyz.empty();
-            for (int x = 0; x < 3; ++x) {
-                chunk_lo[x] = first ? lo[x] : std::min(chunk_lo[x], lo[x]);
-                chunk_hi[x] = first ? hi[x] : std::max(chunk_hi[x], hi[x]);
-            }
-            chunk.xyz.insert(chunk.xyz.end(), t, t + 9);
-            if (chunk.xyz.size() == 9 * kChunkTriangles) flush();
-        });
+        float own[6] = {}, other[6] = {};
+        stream_mesh(streamed.open(), layout, check, nullptr, options, "pass 2: " + streamed.name,
+                    [&](uint64_t index, const float* t, const float* corners) {
+                        Rng rng = triangle_rng(options.seed, kSaltStreamSamples, index);
+                        uint64_t k = density > 0 ? samples_for(triangle_area(t), density, rng) : 0;
+                        for (uint64_t j = 0; j < k; ++j) {
+                            double p[3], bary[3];
+                            point_in_triangle(t, rng, p, bary);
+                            if (!values) {
+                                streamed_stats.add(triangles.nearest_dist2(p));
+                                continue;
+                            }
+                            streamed_stats.add(triangles.nearest_dist2(p, kInf, other));
+                            interpolate(corners, values, bary, own);
+                            streamed_attributes.add(own, other);
+                        }
+                        float lo[3], hi[3];
+                        for (int x = 0; x < 3; ++x) {
+                            lo[x] = std::min({t[x], t[3 + x], t[6 + x]});
+                            hi[x] = std::max({t[x], t[3 + x], t[6 + x]});
+                        }
+                        samples.update(t, corners, lo, hi);
+                        if (far_samples.xyz.empty()) return;
+                        // Consecutive triangles of a mesh file are mostly near each other: a
+                        // chunk's box stays small.
+                        const bool first = chunk.xyz.empty();
+                        for (int x = 0; x < 3; ++x) {
+                            chunk_lo[x] = first ? lo[x] : std::min(chunk_lo[x], lo[x]);
+                            chunk_hi[x] = first ? hi[x] : std::max(chunk_hi[x], hi[x]);
+                        }
+                        chunk.xyz.insert(chunk.xyz.end(), t, t + 9);
+                        if (values)
+                            chunk.corner_values.insert(chunk.corner_values.end(), corners, corners + 3 * values);
+                        if (chunk.xyz.size() == 9 * kChunkTriangles) flush();
+                    });
         flush();
         if (check.triangles != streamed_summary.triangles || check.area != streamed_summary.area)
             throw io::Error(streamed.name, "changed between the two passes (" +
@@ -674,6 +954,10 @@ CompareResult compare_meshes(const MeshSource& a, const MeshSource& b, const Com
     StatsAccumulator held_stats;
     for (double d2 : samples.best2) held_stats.add(d2);
     for (double d2 : far_samples.best2) held_stats.add(d2);
+    AttributeAccumulator held_attributes{layout, {}, {}};
+    for (const SampleIndex* index : {&samples, &far_samples})
+        for (size_t i = 0; values && i < index->own.size() / values; ++i)
+            held_attributes.add(&index->own[values * i], &index->other[values * i]);
 
     CompareResult r;
     r.a = hold_a ? held_summary : streamed_summary;
@@ -681,6 +965,18 @@ CompareResult compare_meshes(const MeshSource& a, const MeshSource& b, const Com
     r.a_to_b = hold_a ? held_stats.stats() : streamed_stats.stats();
     r.b_to_a = hold_a ? streamed_stats.stats() : held_stats.stats();
     r.diagonal = r.a.diagonal();
+    if (options.attributes) {
+        const AttributeAccumulator& from_a = hold_a ? held_attributes : streamed_attributes;
+        const AttributeAccumulator& from_b = hold_a ? streamed_attributes : held_attributes;
+        AttributeErrors e;
+        e.color = layout.color;
+        e.normal = layout.normal;
+        e.color_a_to_b = from_a.color.stats();
+        e.color_b_to_a = from_b.color.stats();
+        e.normal_a_to_b = from_a.normal.stats();
+        e.normal_b_to_a = from_b.normal.stats();
+        r.attributes = e;
+    }
     return r;
 }
 

@@ -298,6 +298,328 @@ TEST(Metro, EmptyMeshIsAnErrorNamingTheFile) {
     }
 }
 
+// ---- Colour and normal error (CompareOptions::attributes) ----------------------------------
+
+namespace {
+
+// The square [0, size]² in z = 0 as an n × n grid (2 n² triangles) with per-corner colours
+// colour(x, y, centroid_x, rgba): the corner's position, and the x of its cell's centre, which
+// tells the cells on either side of a colour seam apart (rgba starts as opaque black).
+struct Plane {
+    std::vector<float> xyz, colors;
+};
+template <class Colour>
+Plane plane(int n, Colour colour, float size = 1) {
+    Plane m;
+    for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j) {
+            const float x0 = size * float(i) / float(n), x1 = size * float(i + 1) / float(n),
+                        y0 = size * float(j) / float(n), y1 = size * float(j + 1) / float(n);
+            const float a[3] = {x0, y0, 0}, b[3] = {x1, y0, 0}, c[3] = {x1, y1, 0}, d[3] = {x0, y1, 0};
+            const float cx = 0.5f * (x0 + x1);
+            const float* tris[2][3] = {{a, b, c}, {a, c, d}};
+            for (const auto& t : tris) {
+                push_tri(m.xyz, t[0], t[1], t[2]);
+                for (const float* v : t) {
+                    float rgba[4] = {0, 0, 0, 1};
+                    colour(v[0], v[1], cx, rgba);
+                    m.colors.insert(m.colors.end(), rgba, rgba + 4);
+                }
+            }
+        }
+    return m;
+}
+
+// The same triangles with each one's corners rotated by `by` (0..2): corner k becomes k + by.
+Plane rotate_corners(const Plane& m, int by) {
+    Plane out = m;
+    for (size_t t = 0; t < m.xyz.size() / 9; ++t)
+        for (int k = 0; k < 3; ++k) {
+            const int to = (k + by) % 3;
+            std::copy_n(&m.xyz[9 * t + 3 * k], 3, &out.xyz[9 * t + 3 * to]);
+            std::copy_n(&m.colors[12 * t + 4 * k], 4, &out.colors[12 * t + 4 * to]);
+        }
+    return out;
+}
+
+// Per-corner colours of a sphere from its positions: RGB = (p + 1) / 2 · 0.8, smooth and below
+// 0.9 so a shift by 0.1 stays in 0..1.
+std::vector<float> sphere_colours(const std::vector<float>& xyz, float shift_red = 0) {
+    std::vector<float> rgba;
+    for (size_t i = 0; i < xyz.size(); i += 3)
+        rgba.insert(rgba.end(), {0.4f * (xyz[i] + 1) + shift_red, 0.4f * (xyz[i + 1] + 1), 0.4f * (xyz[i + 2] + 1), 1});
+    return rgba;
+}
+
+CompareOptions with_attributes(uint64_t samples) {
+    CompareOptions options;
+    options.samples = samples;
+    options.attributes = true;
+    return options;
+}
+
+}  // namespace
+
+TEST(MetroAttributes, ColouredMeshAgainstItselfHasNoColourError) {
+    const std::vector<float> s = sphere(3);
+    const CompareResult r = compare_meshes(memory_source("a", s, {}, sphere_colours(s)),
+                                           memory_source("b", s, {}, sphere_colours(s)), with_attributes(20'000));
+    ASSERT_TRUE(r.attributes);
+    EXPECT_TRUE(r.attributes->color);
+    EXPECT_FALSE(r.attributes->normal);
+    // Held samples sit off their triangle by float rounding (~6e-8), so their nearest point's
+    // colour differs by about that much.
+    EXPECT_LT(r.attributes->color_a_to_b.max, 1e-5);
+    EXPECT_LT(r.attributes->color_b_to_a.max, 1e-5);
+    EXPECT_EQ(r.attributes->color_a_to_b.samples, r.a_to_b.samples);
+    EXPECT_EQ(r.attributes->color_b_to_a.samples, r.b_to_a.samples);
+    EXPECT_EQ(r.attributes->color_symmetric().samples, r.a_to_b.samples + r.b_to_a.samples);
+    EXPECT_EQ(r.attributes->normal_a_to_b.samples, 0u);
+    // Without the option nothing is measured and the figures are those of positions only.
+    CompareOptions plain;
+    plain.samples = 20'000;
+    const CompareResult p = compare_meshes(memory_source("a", s, {}, sphere_colours(s)),
+                                           memory_source("b", s, {}, sphere_colours(s)), plain);
+    EXPECT_FALSE(p.attributes);
+    EXPECT_EQ(p.a_to_b.rms, r.a_to_b.rms);
+    EXPECT_EQ(p.b_to_a.max, r.b_to_a.max);
+}
+
+TEST(MetroAttributes, ColoursShiftedByAConstantHaveThatError) {
+    // Every red + 0.1: each sample's colour differs from the other surface's by exactly 0.1,
+    // both ways (held and streamed), in RMS and max.
+    const std::vector<float> s = sphere(3);
+    const CompareResult r = compare_meshes(memory_source("a", s, {}, sphere_colours(s)),
+                                           memory_source("b", s, {}, sphere_colours(s, 0.1f)), with_attributes(20'000));
+    ASSERT_TRUE(r.attributes);
+    for (const AttributeStats& e : {r.attributes->color_a_to_b, r.attributes->color_b_to_a}) {
+        EXPECT_NEAR(e.rms, 0.1, 1e-5);
+        EXPECT_NEAR(e.max, 0.1, 1e-5);
+        EXPECT_GT(e.samples, 19'000u);
+        EXPECT_EQ(e.skipped, 0u);
+    }
+    EXPECT_NEAR(r.attributes->color_symmetric().rms, 0.1, 1e-5);
+}
+
+TEST(MetroAttributes, ColourIsInterpolatedAcrossTriangles) {
+    // A linear ramp (r = x, g = y) on a 40 × 40 grid against the same ramp on a 2 × 2 grid: the
+    // barycentric interpolation of a linear function is exact, so both directions are ~0. A
+    // triangle's one colour (its first corner's, say) would be off by up to a cell (0.5 on the
+    // coarse grid).
+    auto ramp = [](float x, float y, float, float* rgba) { rgba[0] = x, rgba[1] = y, rgba[2] = 0.5f; };
+    const Plane fine = plane(40, ramp), coarse = plane(2, ramp);
+    const CompareResult r =
+        compare_meshes(memory_source("fine", fine.xyz, {}, fine.colors),
+                       memory_source("coarse", coarse.xyz, {}, coarse.colors), with_attributes(20'000));
+    ASSERT_TRUE(r.attributes);
+    EXPECT_TRUE(r.b.in_memory);
+    EXPECT_LT(r.attributes->color_a_to_b.max, 1e-5);
+    EXPECT_LT(r.attributes->color_b_to_a.max, 1e-5);
+    EXPECT_GT(r.attributes->color_a_to_b.samples, 19'000u);
+    EXPECT_GT(r.attributes->color_b_to_a.samples, 19'000u);
+}
+
+TEST(MetroAttributes, NearestPointsOnEdgesAndCornersInterpolateThere) {
+    // B = [0, 2]² coloured (min(x, 1), min(y, 1)), piecewise linear on its grid; A = the unit
+    // square coloured (x, y). B's samples past x = 1 or y = 1 are nearest to A's edges (at
+    // (1, y) or (x, 1)) or its corner (1, 1), whose colours there are B's own: 0 both ways, if
+    // the closest point's barycentric coordinates are right in every region. A's corners are
+    // rotated so that its outer edges are each triangle's ab, bc and ca in turn.
+    const Plane b = plane(
+        16, [](float x, float y, float, float* rgba) { rgba[0] = std::min(x, 1.0f), rgba[1] = std::min(y, 1.0f); }, 2);
+    for (int by = 0; by < 3; ++by) {
+        const Plane a =
+            rotate_corners(plane(4, [](float x, float y, float, float* rgba) { rgba[0] = x, rgba[1] = y; }), by);
+        const CompareResult r = compare_meshes(memory_source("a", a.xyz, {}, a.colors),
+                                               memory_source("b", b.xyz, {}, b.colors), with_attributes(10'000));
+        ASSERT_TRUE(r.attributes);
+        EXPECT_GT(r.b_to_a.max, 1.3);  // samples near B's far corner, sqrt 2 from A's
+        EXPECT_LE(r.b_to_a.max, std::sqrt(2.0) + 1e-6);
+        EXPECT_LT(r.attributes->color_a_to_b.max, 1e-5) << by;
+        EXPECT_LT(r.attributes->color_b_to_a.max, 1e-5) << by;
+    }
+}
+
+TEST(MetroAttributes, NearestPointOnADegenerateTriangleInterpolatesAlongItsEdge) {
+    // A is one triangle with two equal corners (no area, so no samples of its own; the
+    // closest point falls back to its edges), red rising along it as x / 2; B is a triangle
+    // beside it coloured the same way. Each of B's samples is nearest to A's edge at its own
+    // x, where A's red is B's.
+    const std::vector<float> line = {0, 0, 0, 0, 0, 0, 2, 0, 0};
+    const std::vector<float> beside = {0, 0.1f, 0, 2, 0.1f, 0, 1, 0.5f, 0};
+    auto red_by_x = [](const std::vector<float>& xyz) {
+        std::vector<float> rgba;
+        for (size_t i = 0; i < xyz.size(); i += 3) rgba.insert(rgba.end(), {xyz[i] / 2, 0, 0, 1});
+        return rgba;
+    };
+    const CompareResult r =
+        compare_meshes(memory_source("line", line, {}, red_by_x(line)),
+                       memory_source("beside", beside, {}, red_by_x(beside)), with_attributes(5'000));
+    ASSERT_TRUE(r.attributes);
+    EXPECT_EQ(r.a_to_b.samples, 0u);
+    EXPECT_GT(r.attributes->color_b_to_a.samples, 4'900u);
+    EXPECT_LT(r.attributes->color_b_to_a.max, 1e-6);
+}
+
+TEST(MetroAttributes, HeldSamplesNearestToTheirFirstBoundKeepThatVertexsValue) {
+    // B (streamed) is three triangles shrunk to points, red, green and blue; A (held, fewer
+    // triangles) has a green triangle above the green point and a blue one above the blue
+    // point. Each held sample's first upper bound (from a reservoir vertex of B) is its true
+    // distance, which no triangle then lowers: the value it keeps is that vertex's.
+    const std::vector<float> points = {0, 0,  0, 0, 0,  0, 0, 0,  0, 10, 0,  0, 10, 0,
+                                       0, 10, 0, 0, 20, 0, 0, 20, 0, 0,  20, 0, 0};
+    const float rgb[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    std::vector<float> point_colours;
+    for (const auto& c : rgb)
+        for (int k = 0; k < 3; ++k) point_colours.insert(point_colours.end(), {c[0], c[1], c[2], 1});
+    const std::vector<float> above = {9.9f,  -0.1f, 1, 10.1f, -0.1f, 1, 10, 0.1f, 1,
+                                      19.9f, -0.1f, 1, 20.1f, -0.1f, 1, 20, 0.1f, 1};
+    std::vector<float> above_colours;
+    for (int k = 0; k < 3; ++k) above_colours.insert(above_colours.end(), {0, 1, 0, 1});
+    for (int k = 0; k < 3; ++k) above_colours.insert(above_colours.end(), {0, 0, 1, 1});
+    const CompareResult r = compare_meshes(memory_source("above", above, {}, above_colours),
+                                           memory_source("points", points, {}, point_colours), with_attributes(2'000));
+    ASSERT_TRUE(r.a.in_memory);
+    EXPECT_GT(r.attributes->color_a_to_b.samples, 1'900u);
+    EXPECT_EQ(r.attributes->color_a_to_b.max, 0.0);
+}
+
+TEST(MetroAttributes, MovedColourBorderShowsTheJump) {
+    // Red left of x = 0.5, blue right of it (per-corner colours, a seam along the grid line);
+    // B has the border one cell (1/16) further right. Samples in the strip between see red
+    // against blue, |(1,0,0) - (0,0,1)| = sqrt 2; all others 0. RMS = sqrt(2 / 16).
+    auto border = [](float at) {
+        return [at](float, float, float centroid_x, float* rgba) {
+            rgba[0] = centroid_x < at ? 1.0f : 0.0f;
+            rgba[2] = centroid_x < at ? 0.0f : 1.0f;
+        };
+    };
+    const Plane a = plane(16, border(0.5f)), b = plane(16, border(0.5625f));
+    const CompareResult r = compare_meshes(memory_source("a", a.xyz, {}, a.colors),
+                                           memory_source("b", b.xyz, {}, b.colors), with_attributes(40'000));
+    ASSERT_TRUE(r.attributes);
+    for (const AttributeStats& e : {r.attributes->color_a_to_b, r.attributes->color_b_to_a}) {
+        EXPECT_NEAR(e.max, std::sqrt(2.0), 1e-6);
+        EXPECT_NEAR(e.rms, std::sqrt(2.0 / 16), 0.02);
+    }
+}
+
+TEST(MetroAttributes, RotatedNormalsHaveTheirAngle) {
+    // Normals in the yz plane varying across the square, and the same rotated 30° about x: the
+    // interpolated normals, rotated too (rotation is linear), are 30° apart everywhere.
+    const Plane a = plane(8, [](float, float, float, float*) {});
+    std::vector<float> normals, rotated;
+    const double angle = 30 * 3.14159265358979323846 / 180;
+    for (size_t i = 0; i < a.xyz.size(); i += 3) {
+        const double phi = 0.8 * (a.xyz[i] - 0.5) + 0.3 * a.xyz[i + 1];  // tilt in yz, by position
+        const double ny = std::sin(phi), nz = std::cos(phi);
+        normals.insert(normals.end(), {0, float(ny), float(nz)});
+        rotated.insert(rotated.end(), {0, float(ny * std::cos(angle) - nz * std::sin(angle)),
+                                       float(ny * std::sin(angle) + nz * std::cos(angle))});
+    }
+    const CompareResult r =
+        compare_meshes(memory_source("a", a.xyz, normals), memory_source("b", a.xyz, rotated), with_attributes(20'000));
+    ASSERT_TRUE(r.attributes);
+    EXPECT_FALSE(r.attributes->color);
+    EXPECT_TRUE(r.attributes->normal);
+    for (const AttributeStats& e : {r.attributes->normal_a_to_b, r.attributes->normal_b_to_a}) {
+        EXPECT_NEAR(e.rms, 30, 1e-3);
+        EXPECT_NEAR(e.max, 30, 1e-3);
+        EXPECT_GT(e.samples, 19'000u);
+    }
+    // And against themselves, 0.
+    const CompareResult same =
+        compare_meshes(memory_source("a", a.xyz, normals), memory_source("b", a.xyz, normals), with_attributes(20'000));
+    EXPECT_LT(same.attributes->normal_symmetric().max, 1e-3);
+}
+
+TEST(MetroAttributes, ZeroNormalsAreSkippedAndCounted) {
+    const std::vector<float> s = sphere(2);
+    std::vector<float> zero(s.size(), 0.0f), outward = s;  // the unit sphere's normal is its position
+    const CompareResult r =
+        compare_meshes(memory_source("zero", s, zero), memory_source("outward", s, outward), with_attributes(10'000));
+    ASSERT_TRUE(r.attributes);
+    EXPECT_EQ(r.attributes->normal_a_to_b.samples, 0u);
+    EXPECT_EQ(r.attributes->normal_a_to_b.skipped, r.a_to_b.samples);
+    EXPECT_EQ(r.attributes->normal_b_to_a.skipped, r.b_to_a.samples);
+    EXPECT_EQ(r.attributes->normal_symmetric().skipped, r.a_to_b.samples + r.b_to_a.samples);
+}
+
+TEST(MetroAttributes, OnlyTheChannelsBothHaveAreMeasured) {
+    const std::vector<float> s = sphere(2);
+    const CompareResult r = compare_meshes(memory_source("both", s, s, sphere_colours(s)),
+                                           memory_source("colours", s, {}, sphere_colours(s)), with_attributes(5'000));
+    ASSERT_TRUE(r.attributes);
+    EXPECT_TRUE(r.attributes->color);
+    EXPECT_FALSE(r.attributes->normal);
+    EXPECT_TRUE(r.a.channels.normal);
+    EXPECT_FALSE(r.b.channels.normal);
+    try {
+        compare_meshes(memory_source("a.ply", s, {}, sphere_colours(s)), memory_source("b.ply", s, s),
+                       with_attributes(5'000));
+        FAIL() << "expected NoSharedAttributes";
+    } catch (const NoSharedAttributes& e) {
+        EXPECT_STREQ(e.what(),
+                     "no colours or normals in both meshes to compare: A (a.ply) has colours, B (b.ply) has "
+                     "normals");
+    }
+    try {
+        compare_meshes(memory_source("a.stl", s), memory_source("b.ply", s, s, sphere_colours(s)),
+                       with_attributes(5'000));
+        FAIL() << "expected NoSharedAttributes";
+    } catch (const NoSharedAttributes& e) {
+        EXPECT_STREQ(e.what(),
+                     "no colours or normals in both meshes to compare: A (a.stl) has neither colours nor "
+                     "normals, B (b.ply) has colours and normals");
+    }
+}
+
+TEST(MetroAttributes, HeldSamplesFarFromTheStreamedSurfaceTakeItsValuesToo) {
+    // The tilted square over the grid of HeldSamplesFarFromTheStreamedSurfaceAreExactToo, both
+    // coloured r = x: each held sample's nearest point is straight below it, at its own x, so
+    // its colour error is 0, for near samples (a triangle at a time) and far ones (a chunk at a
+    // time through its BVH) alike. A held sample left with the value of the vertex that first
+    // bounded it would be off by up to the grid's cell and more.
+    auto ramp = [](float x, float, float, float* rgba) { rgba[0] = x; };
+    const Plane grid = plane(60, ramp);
+    const std::vector<float> tilted = {0, 0, 0, 1, 0, 1, 1, 1, 1, 0, 0, 0, 1, 1, 1, 0, 1, 0};
+    std::vector<float> tilted_colours;
+    for (size_t i = 0; i < tilted.size(); i += 3) tilted_colours.insert(tilted_colours.end(), {tilted[i], 0, 0, 1});
+    const CompareResult r = compare_meshes(memory_source("tilted", tilted, {}, tilted_colours),
+                                           memory_source("grid", grid.xyz, {}, grid.colors), with_attributes(40'000));
+    ASSERT_TRUE(r.a.in_memory);
+    EXPECT_GT(r.a_to_b.max, 0.99);  // far samples were there
+    EXPECT_LT(r.attributes->color_a_to_b.max, 1e-5);
+    EXPECT_GT(r.attributes->color_a_to_b.samples, 39'000u);
+}
+
+TEST(MetroAttributes, ColoursAndNormalsFromPlyFiles) {
+    // Read through the PLY reader: uchar colours (value / 255) and float normals.
+    TempDir tmp;
+    const std::vector<float> s = sphere(2);
+    auto write_ply = [&](const fs::path& path, int red_offset) {
+        std::ofstream ply(path);
+        ply << "ply\nformat ascii 1.0\nelement vertex " << s.size() / 3
+            << "\nproperty float x\nproperty float y\nproperty float z\nproperty float nx\nproperty float ny\n"
+               "property float nz\nproperty uchar red\nproperty uchar green\nproperty uchar blue\nelement face "
+            << s.size() / 9 << "\nproperty list uchar int vertex_indices\nend_header\n";
+        for (size_t i = 0; i < s.size(); i += 3)
+            ply << s[i] << ' ' << s[i + 1] << ' ' << s[i + 2] << ' ' << s[i] << ' ' << s[i + 1] << ' ' << s[i + 2]
+                << ' ' << 100 + red_offset << " 50 200\n";
+        for (size_t t = 0; t < s.size() / 9; ++t) ply << "3 " << 3 * t << ' ' << 3 * t + 1 << ' ' << 3 * t + 2 << '\n';
+    };
+    write_ply(tmp.path() / "a.ply", 0);
+    write_ply(tmp.path() / "b.ply", 51);  // red + 0.2
+    const CompareResult r = compare_meshes(file_source((tmp.path() / "a.ply").string()),
+                                           file_source((tmp.path() / "b.ply").string()), with_attributes(5'000));
+    ASSERT_TRUE(r.attributes);
+    EXPECT_TRUE(r.attributes->color);
+    EXPECT_TRUE(r.attributes->normal);
+    EXPECT_NEAR(r.attributes->color_symmetric().rms, 0.2, 1e-6);
+    EXPECT_NEAR(r.attributes->color_symmetric().max, 0.2, 1e-6);
+    EXPECT_LT(r.attributes->normal_symmetric().max, 0.01);  // the ascii text's 6 digits
+}
+
 // ---- The CLI --------------------------------------------------------------------------------
 
 namespace {
