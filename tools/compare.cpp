@@ -1,5 +1,6 @@
-// `meshstream compare A B`: Metro-style surface error between two meshes (tools/metro.hpp),
-// as text or --json. Holds the smaller mesh in memory and streams the other one twice.
+// `meshstream compare A B`: Metro-style surface error between two meshes (compare/metro.hpp),
+// and with --attributes their colour and normal error, as text or --json. Holds the smaller
+// mesh in memory and streams the other one twice.
 #include "compare/metro.hpp"
 #include "io/error.hpp"
 #include "tools/cli_checks.hpp"
@@ -18,6 +19,8 @@
 namespace meshstream::tools {
 namespace {
 
+using compare::AttributeErrors;
+using compare::AttributeStats;
 using compare::compare_meshes;
 using compare::CompareOptions;
 using compare::CompareResult;
@@ -25,12 +28,21 @@ using compare::DistanceStats;
 using compare::file_source;
 using compare::MeshSource;
 using compare::MeshSummary;
+using compare::NoSharedAttributes;
+
+// The held mesh's bytes per sample at the peak, while its BVH is built, for refusing a
+// --samples past memory: 626 MB for 10 M samples against a 10 k-triangle mesh. --attributes
+// adds 24 for colours and 24 for normals (a sample's own value and the one at its nearest
+// point, 3 floats each): 1.06 GB against 571 MB on another such mesh with both.
+constexpr int kSampleBytes = 60;
+constexpr int kSampleBytesWithAttributes = 108;
 
 struct CompareCliOptions {
     std::string a, b;
     std::optional<uint64_t> samples;
     uint64_t seed = 1;
     bool json = false;
+    bool attributes = false;
     ReadFlags read;
 };
 
@@ -66,6 +78,25 @@ nlohmann::ordered_json stats_json(const DistanceStats& s, double diagonal) {
     return j;
 }
 
+// An attribute's errors one way (or both, symmetric): null figures without samples, as above.
+nlohmann::ordered_json attribute_json(const AttributeStats& s) {
+    auto value = [&](double v) { return s.samples > 0 ? nlohmann::ordered_json(v) : nlohmann::ordered_json(); };
+    nlohmann::ordered_json j;
+    j["max"] = value(s.max);
+    j["rms"] = value(s.rms);
+    j["samples"] = s.samples;
+    j["skipped"] = s.skipped;
+    return j;
+}
+
+// Adds --attributes' "color" and "normal_degrees" to a direction's object: null for a channel
+// the two meshes do not share.
+void add_attribute_json(nlohmann::ordered_json& j, const AttributeErrors& e, const AttributeStats& color,
+                        const AttributeStats& normal) {
+    j["color"] = e.color ? attribute_json(color) : nlohmann::ordered_json();
+    j["normal_degrees"] = e.normal ? attribute_json(normal) : nlohmann::ordered_json();
+}
+
 // compare measures each file as it is; with --strict a NaN/inf or degenerate triangle is an
 // error instead, as in the other commands (the read loop refuses it), and so is a header
 // whose promised count the file breaks.
@@ -81,8 +112,12 @@ private:
     io::TriangleInput in_;
 };
 
-MeshSource source(const std::string& path, const ReadFlags& flags) {
-    MeshSource s = file_source(path, flags.from, flags.options());
+MeshSource source(const std::string& path, const ReadFlags& flags, bool attributes) {
+    io::ReadOptions options = flags.options();
+    // Readers that keep vertices (PLY) then store only the channels compare reads.
+    options.channels = io::ChannelKinds::none();
+    options.channels.colors = options.channels.normals = attributes;
+    MeshSource s = file_source(path, flags.from, options);
     if (flags.strict)
         s.open = [open = s.open, path] {
             return std::make_unique<StrictReader>(open(), path == "-" ? "<stdin>" : path);
@@ -90,18 +125,61 @@ MeshSource source(const std::string& path, const ReadFlags& flags) {
     return s;
 }
 
+// --attributes' text: per channel a heading and the three rows, or why it is not measured.
+void print_attributes(const CompareResult& r) {
+    const AttributeErrors& e = *r.attributes;
+    auto row = [](const char* label, const AttributeStats& s, bool symmetric) {
+        if (s.samples == 0) {
+            if (s.skipped)
+                std::printf("%-10s not measured: all %llu samples skipped\n", label, (unsigned long long)s.skipped);
+            else
+                std::printf("%-10s no samples: not measured\n", label);
+            return;
+        }
+        // The figures are padded to line up with what follows them, if anything does.
+        const bool more = !symmetric || s.skipped;
+        std::printf(more ? "%-10s max %-12.6g rms %-12.6g" : "%-10s max %-12.6g rms %.6g", label, s.max, s.rms);
+        if (!symmetric) std::printf("  %llu samples", (unsigned long long)s.samples);
+        if (s.skipped) std::printf("%s%llu skipped", symmetric ? "  " : ", ", (unsigned long long)s.skipped);
+        std::printf("\n");
+    };
+    // Why a channel is not measured (the other one is: else compare refuses --attributes).
+    auto lacking = [](bool a, bool b, const char* what) {
+        return std::string(!a && !b ? "neither A nor B has " : !a ? "A has no " : "B has no ") + what;
+    };
+    if (e.color) {
+        std::printf("colour error (distance of RGB, each 0..1; alpha ignored):\n");
+        row("A -> B", e.color_a_to_b, false);
+        row("B -> A", e.color_b_to_a, false);
+        row("symmetric", e.color_symmetric(), true);
+    } else {
+        std::printf("colour error: not measured (%s)\n",
+                    lacking(r.a.channels.color.has_value(), r.b.channels.color.has_value(), "colours").c_str());
+    }
+    if (e.normal) {
+        std::printf("normal error (degrees between the normals; skipped: a zero-length or non-finite normal):\n");
+        row("A -> B", e.normal_a_to_b, false);
+        row("B -> A", e.normal_b_to_a, false);
+        row("symmetric", e.normal_symmetric(), true);
+    } else {
+        std::printf("normal error: not measured (%s)\n",
+                    lacking(r.a.channels.normal, r.b.channels.normal, "normals").c_str());
+    }
+}
+
 void run_compare(const CompareCliOptions& opt) {
     if (is_stream(opt.a) && is_stream(opt.b))
         throw UsageError("compare cannot read both A and B from stdin or pipes: one of them is read twice");
     // What compare prints must not land in a file it reads (`compare a.stl b.stl >> a.stl`).
     refuse_output_over_inputs("-", {}, {{opt.a, {}}, {opt.b, {}}});
-    // The held mesh keeps every sample (about 60 bytes each at the peak, while its BVH is built:
-    // 626 MB for 10 M samples against a 10 k-triangle mesh): a count past memory would only
-    // fail after minutes of work, as a bare "out of memory".
-    const double sample_bytes = 60.0 * double(opt.samples.value_or(0)), ram = physical_memory_bytes();
+    // The held mesh keeps every sample (kSampleBytes): a count past memory would only fail
+    // after minutes of work, as a bare "out of memory".
+    const int bytes_each = opt.attributes ? kSampleBytesWithAttributes : kSampleBytes;
+    const double sample_bytes = bytes_each * double(opt.samples.value_or(0)), ram = physical_memory_bytes();
     if (ram > 0 && sample_bytes > ram)
         throw UsageError("--samples " + std::to_string(*opt.samples) + ": the held mesh's samples alone take about " +
-                         human_bytes(sample_bytes) + " (60 bytes each), more than this machine's memory (" +
+                         human_bytes(sample_bytes) + " (" + std::to_string(bytes_each) + " bytes each" +
+                         (opt.attributes ? " with --attributes" : "") + "), more than this machine's memory (" +
                          human_bytes(ram) + ")");
     io::ReadOptions read = opt.read.options();
     CompareOptions co;
@@ -109,6 +187,7 @@ void run_compare(const CompareCliOptions& opt) {
     co.seed = opt.seed;
     co.memory_budget_bytes = read.memory_budget_bytes;
     co.tmpdir = read.tmpdir;
+    co.attributes = opt.attributes;
     Progress progress("comparing", std::nullopt);
     std::string last_phase;
     co.progress = [&](std::string_view phase, uint64_t done, std::optional<uint64_t> total) {
@@ -118,7 +197,12 @@ void run_compare(const CompareCliOptions& opt) {
         }
         progress.update(done);
     };
-    CompareResult r = compare_meshes(source(opt.a, opt.read), source(opt.b, opt.read), co);
+    CompareResult r;
+    try {
+        r = compare_meshes(source(opt.a, opt.read, opt.attributes), source(opt.b, opt.read, opt.attributes), co);
+    } catch (const NoSharedAttributes& e) {
+        throw UsageError(std::string("--attributes: ") + e.what());
+    }
     progress.done();
 
     double diag = r.diagonal;
@@ -150,6 +234,12 @@ void run_compare(const CompareCliOptions& opt) {
         sym.rms = r.rms();
         nlohmann::ordered_json s = stats_json(sym, diag);
         s.erase("samples");
+        if (r.attributes) {
+            const AttributeErrors& e = *r.attributes;
+            add_attribute_json(j["a_to_b"], e, e.color_a_to_b, e.normal_a_to_b);
+            add_attribute_json(j["b_to_a"], e, e.color_b_to_a, e.normal_b_to_a);
+            add_attribute_json(s, e, e.color_symmetric(), e.normal_symmetric());
+        }
         j["symmetric"] = s;
         j["diagonal"] = diag;
         std::printf("%s\n", j.dump(2).c_str());
@@ -193,6 +283,7 @@ void run_compare(const CompareCliOptions& opt) {
         row("symmetric", 0, 0, 0, 0);
     else
         row("symmetric", r.hausdorff(), r.mean(), r.rms(), std::nullopt);
+    if (r.attributes) print_attributes(r);
 }
 
 }  // namespace
@@ -205,7 +296,9 @@ void add_compare(CLI::App& app) {
         "A, B: mesh files ('-' for stdin, one of them at most), e.g. the original and its decimation.\n"
         "Area-weighted samples on each surface, their distance to the other one, both ways; and each mesh's\n"
         "boundary and non-manifold edges. The smaller mesh is held in memory, about 60 bytes a triangle and\n"
-        "60 a sample; the other one is streamed twice, so it may be far larger than memory (docs/cli.md).");
+        "60 a sample; the other one is streamed twice, so it may be far larger than memory (docs/cli.md).\n"
+        "--attributes adds colour and normal error: each sample's value against the other surface's at its\n"
+        "nearest point (RMS, max), for the channels both meshes have; each adds 24 bytes a held sample.");
     cmd->add_option("A", opt->a, "mesh A (the reference, e.g. the original; '-' = stdin)")->required();
     cmd->add_option("B", opt->b, "mesh B (e.g. the decimated mesh)")->required();
     cmd->add_option("--samples", opt->samples,
@@ -215,6 +308,8 @@ void add_compare(CLI::App& app) {
     cmd->add_option("--seed", opt->seed, "random seed of the sampling (default 1): same seed, same figures")
         ->type_name("N")
         ->check(whole_number(0, "a whole number"));
+    cmd->add_flag("--attributes", opt->attributes,
+                  "also measure colour and normal error at each sample (the channels both meshes have)");
     cmd->add_flag("--json", opt->json, "print JSON instead of text");
     add_read_flags(cmd, opt->read);
     cmd->get_option("--memory")
@@ -222,7 +317,8 @@ void add_compare(CLI::App& app) {
             "budget for counting the streamed mesh's edges (default 256M)\n"
             "Spills to --tmpdir past it; K, M, G, T are binary multiples");
     strict_reports_bad_triangles(cmd);
-    cmd->footer("  meshstream compare scan.ply scan_1.glb");
+    cmd->footer(
+        "  meshstream compare scan.ply scan_1.glb\n  meshstream compare --attributes coloured.ply coloured_10.ply");
     cmd->callback([opt] { run_compare(*opt); });
 }
 
