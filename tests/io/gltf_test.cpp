@@ -7,6 +7,7 @@
 
 #include "io/error.hpp"
 #include "io/format.hpp"
+#include "render_util.hpp"
 #include "web_test_util.hpp"
 
 #include <gtest/gtest.h>
@@ -30,11 +31,6 @@ using nlohmann::json;
 using Compression = meshstream::io::GltfSettings::Compression;
 
 namespace {
-
-std::string tools_modules_dir() {
-    const char* env = std::getenv("MESHSTREAM_TOOLS_DIR");
-    return std::string(env && *env ? env : MESHSTREAM_TOOLS_DIR) + "/node_modules";
-}
 
 // Runs tests/tools/validate_gltf.mjs; a missing node or validator fails the test (the set-up
 // script installs both), it is never skipped.
@@ -68,27 +64,6 @@ void expect_valid_allowing(const std::string& path, const std::set<std::string>&
 }
 
 void expect_valid(const std::string& path) { expect_valid_allowing(path, {}); }
-
-// Renders `files` with three.js in headless Chromium (tests/tools/render_gltf.mjs, one browser
-// for all) and returns the report per file: triangles, covered, saturated, distinct, mean,
-// error. A missing node, Chromium or three.js fails the test.
-json render(const TempDir& dir, const std::vector<std::string>& files) {
-    std::vector<std::string> words = {MESHSTREAM_NODE, MESHSTREAM_RENDER_GLTF, dir / "shots"};
-    words.insert(words.end(), files.begin(), files.end());
-    words.push_back("--modules");
-    words.push_back(tools_modules_dir());
-    std::string command;
-    for (const std::string& w : words) command.append(quote(w)).append(" ");
-    command.append("2>&1");
-    std::string out;
-    const int status = run(command, &out);
-    EXPECT_EQ(status, 0) << "render_gltf could not run (tools/bootstrap.sh installs chromium and three): " << out;
-    json report = json::parse(out, nullptr, false);
-    EXPECT_TRUE(report.is_array()) << out;
-    if (!report.is_array() || report.size() != files.size()) return json::array();
-    for (const json& r : report) EXPECT_FALSE(r.contains("error")) << r.dump();
-    return report;
-}
 
 json glb_json(const std::string& path) {
     std::string bytes = slurp(path);

@@ -3,10 +3,16 @@
 // positions only (ranges, a spooled stream).
 #include "io/format.hpp"
 #include "tools/cli_util.hpp"
+#ifdef MESHSTREAM_RENDER_GLTF
+#include "io/render_util.hpp"
+#endif
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <string>
 
 namespace {
@@ -135,3 +141,99 @@ TEST(CliDecimateChannels, AStreamWithColoursIsNotSortedFirst) {
     ASSERT_EQ(r.code, 0) << r.err;
     EXPECT_TRUE(read_back(dir / "read.ply").channels.color.has_value());
 }
+
+#ifdef MESHSTREAM_RENDER_GLTF
+namespace {
+
+// A textured UV sphere (OBJ with a material whose map_Kd is BoxTextured's logo): `n` × n/2 quads,
+// u = longitude / 2π, v = latitude / π. The meridian u = 0 ≡ 1 is a UV seam (its corners have u 0
+// on one side, 1 on the other), and each pole's corners differ in u.
+std::string textured_sphere(const TempDir& dir, int n) {
+    const int rows = n / 2;
+    std::ofstream obj(dir / "sphere.obj"), mtl(dir / "sphere.mtl");
+    mtl << "newmtl logo\nKd 1 1 1\nmap_Kd CesiumLogoFlat.png\n";
+    std::filesystem::copy_file(std::string(MESHSTREAM_FIXTURES_DIR) + "/gltf/BoxTextured_external/CesiumLogoFlat.png",
+                               dir / "CesiumLogoFlat.png");
+    obj << "mtllib sphere.mtl\nusemtl logo\n";
+    const double pi = 3.14159265358979323846;
+    // Positions: the two poles, then rows 1 .. rows-1 of n each.
+    obj << "v 0 1 0\nv 0 -1 0\n";
+    for (int j = 1; j < rows; ++j)
+        for (int i = 0; i < n; ++i) {
+            const double t = pi * j / rows, f = 2 * pi * i / n;
+            obj << "v " << std::sin(t) * std::cos(f) << ' ' << std::cos(t) << ' ' << std::sin(t) * std::sin(f) << '\n';
+        }
+    for (int j = 0; j <= rows; ++j)
+        for (int i = 0; i <= n; ++i) obj << "vt " << double(i) / n << ' ' << 1 - double(j) / rows << '\n';
+    auto v = [&](int i, int j) { return j == 0 ? 1 : j == rows ? 2 : 3 + (j - 1) * n + i % n; };
+    auto vt = [&](int i, int j) { return 1 + j * (n + 1) + i; };
+    auto corner = [&](int i, int j) { return std::to_string(v(i, j)) + "/" + std::to_string(vt(i, j)); };
+    for (int j = 0; j < rows; ++j)
+        for (int i = 0; i < n; ++i) {
+            if (j > 0) obj << "f " << corner(i, j) << ' ' << corner(i + 1, j) << ' ' << corner(i + 1, j + 1) << '\n';
+            if (j < rows - 1)
+                obj << "f " << corner(i, j) << ' ' << corner(i + 1, j + 1) << ' ' << corner(i, j + 1) << '\n';
+        }
+    return dir / "sphere.obj";
+}
+
+// Per triangle: the extent of u and the ratio of UV area to surface area.
+struct UvShape {
+    double widest_u = 0, largest_ratio = 0;
+    uint64_t triangles = 0;
+    bool has_uv = false, has_material = false;
+};
+
+UvShape uv_shape(const std::string& path) {
+    io::Input in = io::open_input(path);
+    const io::Channels channels = in.reader->header().channels;
+    UvShape s;
+    s.has_uv = channels.uv_sets > 0;
+    s.has_material = channels.material;
+    io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, channels);
+    while (in.reader->next(chunk))
+        for (size_t t = 0; t < chunk.size(); ++t, ++s.triangles) {
+            if (!s.has_uv) continue;
+            const float* p = &chunk.xyz()[9 * t];
+            const float* uv = chunk.uv_at(t, 0);
+            double e1[3], e2[3];
+            for (int a = 0; a < 3; ++a) e1[a] = p[3 + a] - p[a], e2[a] = p[6 + a] - p[a];
+            const double cx = e1[1] * e2[2] - e1[2] * e2[1], cy = e1[2] * e2[0] - e1[0] * e2[2],
+                         cz = e1[0] * e2[1] - e1[1] * e2[0];
+            const double area = 0.5 * std::sqrt(cx * cx + cy * cy + cz * cz);
+            const double uv_area =
+                0.5 * std::fabs((uv[2] - uv[0]) * (uv[5] - uv[1]) - (uv[4] - uv[0]) * (uv[3] - uv[1]));
+            s.widest_u =
+                std::max({s.widest_u, double(std::max({uv[0], uv[2], uv[4]}) - std::min({uv[0], uv[2], uv[4]}))});
+            if (area > 0) s.largest_ratio = std::max(s.largest_ratio, uv_area / area);
+        }
+    return s;
+}
+
+}  // namespace
+
+TEST(CliDecimateChannels, ATexturedSphereKeepsItsSeamAndRendersTextured) {
+    TempDir dir;
+    const std::string sphere = textured_sphere(dir, 96);
+    ASSERT_EQ(run("convert " + sphere + " " + dir / "sphere.glb").code, 0);
+    CliRun r = run("decimate -r 0.25 " + sphere + " " + dir / "quarter.glb");
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
+    const UvShape in = uv_shape(dir / "sphere.glb"), out = uv_shape(dir / "quarter.glb");
+    ASSERT_TRUE(out.has_uv && out.has_material);
+    EXPECT_EQ(out.triangles, uint64_t(std::llround(0.25 * double(in.triangles))));
+    // No triangle spans the seam (one that did would reach across u, 0 to 1), and none stretches
+    // the texture past what the input's own triangles do.
+    EXPECT_LT(in.widest_u, 0.1);
+    EXPECT_LT(out.widest_u, 0.5);
+    EXPECT_LE(out.largest_ratio, 1.25 * in.largest_ratio);
+    // three.js shows the decimated sphere with its texture as it shows the input.
+    const nlohmann::json report = web_test::render(dir, {dir / "sphere.glb", dir / "quarter.glb"});
+    ASSERT_EQ(report.size(), 2u);
+    const nlohmann::json &a = report[0], &b = report[1];
+    EXPECT_GT(a["saturated"].get<double>(), 0.2) << a.dump();
+    EXPECT_NEAR(b["covered"].get<double>(), a["covered"].get<double>(), 0.02) << b.dump();
+    EXPECT_NEAR(b["saturated"].get<double>(), a["saturated"].get<double>(), 0.05) << b.dump();
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(b["mean"][c].get<double>(), a["mean"][c].get<double>(), 8.0) << c;
+}
+#endif
