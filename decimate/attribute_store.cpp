@@ -228,18 +228,24 @@ double AttributeStore::error(const HalfEdgeBuffer& buffer, uint32_t v, const dou
 
 Quadric AttributeStore::combined(const Quadric& g, const Quadric& r) {
     const double w = g.a00 + g.a11 + g.a22;
-    Quadric out = g;
-    out.a00 += w * r.a00;
-    out.a01 += w * r.a01;
-    out.a02 += w * r.a02;
-    out.a11 += w * r.a11;
-    out.a12 += w * r.a12;
-    out.a22 += w * r.a22;
-    out.b0 += w * r.b0;
-    out.b1 += w * r.b1;
-    out.b2 += w * r.b2;
-    out.c += w * r.c;
+    const double s = w > 0 ? 1 / w : 0;
+    Quadric out = r;
+    out.a00 += s * g.a00;
+    out.a01 += s * g.a01;
+    out.a02 += s * g.a02;
+    out.a11 += s * g.a11;
+    out.a12 += s * g.a12;
+    out.a22 += s * g.a22;
+    out.b0 += s * g.b0;
+    out.b1 += s * g.b1;
+    out.b2 += s * g.b2;
+    out.c += s * g.c;
     return out;
+}
+
+double AttributeStore::combined_error(const Quadric& g, double geometric_error, double attribute_error) {
+    const double w = g.a00 + g.a11 + g.a22;
+    return (w > 0 ? std::max(0.0, geometric_error) / w : 0) + attribute_error;
 }
 
 }  // namespace meshstream::decimate

@@ -93,8 +93,12 @@ public:
     void settle(const HalfEdgeBuffer& buffer, uint32_t v);
 
     // The quadric (in the position) a collapse into a vertex of merged geometric quadric `g`
-    // and reduced attribute quadric `r` minimizes: g + W·r, W = trace of g.
+    // and reduced attribute quadric `r` is rated and placed by: g / W + r, W = trace of g (the
+    // sum of its planes' weights), so the geometric part is a mean squared distance, as
+    // meshoptimizer 1.2 rates collapses with attributes (attributes.hpp).
     static Quadric combined(const Quadric& g, const Quadric& r);
+    // The same rating from a geometric error of `g` and an attribute error.
+    static double combined_error(const Quadric& g, double geometric_error, double attribute_error);
 
     // Vertices marked kSeam so far.
     uint64_t seam_vertices() const { return seam_vertices_; }

@@ -10,11 +10,12 @@
 //
 // Balance with geometry: the plane quadrics weigh a triangle by the square root of its area, so
 // the geometric error over a neighbourhood of total weight W is W times a mean squared distance;
-// the attribute error is the area times the squared value difference. A collapse is rated by
-// geometric + W · attribute error: W times meshoptimizer 1.2's geometric mean + attribute error,
-// the same balance between distance and value difference at every scale (a value step of 1 over
-// a distance d weighs as a move of d). A channel's weight multiplies its values (error ∝ weight²),
-// as meshoptimizer's attribute weights do.
+// the attribute error is the area times the squared value difference. With channels a collapse
+// is rated, as meshoptimizer 1.2 rates it, by geometric error / W + attribute error: the same
+// balance between distance and value difference at every scale (a value step of 1 over a
+// distance d weighs as a move of d). A channel's weight multiplies its values (error ∝ weight²),
+// as meshoptimizer's attribute weights do. Positions-only streams keep the geometric error as it
+// is (not divided by W).
 //
 // Seams: a vertex whose corners disagree (a UV or normal seam, a colour border stored per corner)
 // or whose triangles have different materials is a seam vertex (kSeam): it is never removed and
@@ -37,7 +38,9 @@ namespace meshstream::decimate {
 // Per-channel weights (multipliers of the values; 0 leaves a channel out of the error, but it is
 // still interpolated).
 struct AttributeWeights {
-    double normal = 1;
+    // Normals weigh half: at 1 their error pulls the geometry off more than meshoptimizer's does
+    // at the same normal error (docs/decimation.md, measured).
+    double normal = 0.5;
     double color = 1;  // RGB(A) in 0..1
     double uv = 1;
     // Named vertex scalars (intensity, confidence): interpolated, weighted only when named here.

@@ -164,8 +164,8 @@ double fixed_error(const HalfEdgeBuffer& buffer, const AttributeStore& attribute
     const Quadric sum = buffer.quadric(p) + buffer.quadric(q);
     double x[3];
     buffer.position(q, x);
-    const double w = sum.a00 + sum.a11 + sum.a22;
-    return std::max(0.0, sum.error(x)) + w * attributes.error(buffer, p, x, attributes.shown(buffer, next_in_face(h)));
+    return AttributeStore::combined_error(sum, sum.error(x),
+                                          attributes.error(buffer, p, x, attributes.shown(buffer, next_in_face(h))));
 }
 
 bool values_fixed(const HalfEdgeBuffer& buffer, uint32_t q) {

@@ -53,7 +53,8 @@ inline bool collapse_target_free(const HalfEdgeBuffer& buffer, uint32_t h) {
 }
 
 // The quadric a merge of p and q minimizes: Q_p + Q_q, plus, when the buffer carries weighted
-// channels, the attribute error minimized over the merged vertex's values (attributes.hpp).
+// channels, (Q_p + Q_q) / W plus the attribute error minimized over the merged vertex's values
+// (AttributeStore::combined; attributes.hpp).
 Quadric merged_quadric(const HalfEdgeBuffer& buffer, uint32_t p, uint32_t q);
 
 // The quadric error of collapsing h = p→q without moving q: merged_quadric evaluated at q; when

@@ -852,7 +852,7 @@ void add_decimate(CLI::App& app, RangeProcesses* processes) {
         ->check(CLI::IsMember({"auto", "always", "never"}));
     cmd->add_option("--weights", opt->weights,
                     "weights of the attribute errors: normal, color, uv, or a vertex scalar's name\n"
-                    "Default: 1 for normals, colours and texture coordinates, none for scalars. "
+                    "Default: 0.5 for normals, 1 for colours and texture coordinates, none for scalars. "
                     "Collapses are rated by geometric plus attribute error. A weight multiplies the values (colours "
                     "in 0..1), so the error grows with its square; 0 rates by geometry alone (values are still "
                     "interpolated); e.g. --weights color=W,normal=W")
