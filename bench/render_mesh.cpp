@@ -1,6 +1,7 @@
 // Bench/docs helper: renders a mesh to PNG with a streaming z-buffer rasteriser (orthographic
-// view, two-sided Lambert shading, optional wireframe), so docs/decimation.md can show the same
-// model at several resolutions in the same frame. Two passes over the file: bounds, then
+// view, two-sided Lambert shading, optional wireframe; a mesh with vertex colours shows them,
+// interpolated over each triangle), so docs/decimation.md can show the same model at several
+// resolutions in the same frame. Two passes over the file: bounds, then
 // triangles straight into the z-buffer; memory is the image only. PNG is written through zlib.
 //   render_mesh IN OUT.png [--size W] [--view X,Y,Z] [--frame REF] [--wire]
 // --frame REF: frame the picture with REF's bounding box (the full-resolution mesh), so all
@@ -141,7 +142,9 @@ int main(int argc, char** argv) {
         std::vector<unsigned char> rgb(size_t(w) * h * 3, 255);
 
         io::Input in = io::open_input(in_path);
-        io::TriangleChunk chunk;
+        io::Channels colour_only;
+        colour_only.color = in.reader->header().channels.color;
+        io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, colour_only);
         while (in.reader->next(chunk)) {
             auto xyz = chunk.xyz();
             for (size_t t = 0; t < chunk.size(); ++t) {
@@ -183,9 +186,10 @@ int main(int argc, char** argv) {
                                                     l2 * std::fabs(area) / len[2]});
                             if (dist < 0.7) s *= 0.45;
                         }
-                        rgb[3 * at] = uint8_t(std::clamp(s * 235, 0.0, 255.0));
-                        rgb[3 * at + 1] = uint8_t(std::clamp(s * 215, 0.0, 255.0));
-                        rgb[3 * at + 2] = uint8_t(std::clamp(s * 180, 0.0, 255.0));
+                        double base[3] = {235, 215, 180};
+                        if (const float* c = chunk.color_at(t))
+                            for (int k = 0; k < 3; ++k) base[k] = 255 * (l0 * c[k] + l1 * c[4 + k] + l2 * c[8 + k]);
+                        for (int k = 0; k < 3; ++k) rgb[3 * at + k] = uint8_t(std::clamp(s * base[k], 0.0, 255.0));
                     }
             }
         }

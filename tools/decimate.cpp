@@ -750,7 +750,11 @@ void run_decimate(const DecimateOptions& opt, RangeProcesses* processes) {
     if (decimator) decimator->finish(emit);
     gate.release();
     // A reader may have added materials while reading (OBJ: names met after the first face).
-    if (carried.channels.material) out->writer->update_materials((sorted ? sorted->end_header : in.header()).materials);
+    if (carried.channels.material)
+        out->writer->update_materials((sorted     ? sorted->end_header
+                                       : threaded ? threaded->end_header
+                                                  : in.header())
+                                          .materials);
     progress.done();
     out->finish();
     const double seconds = seconds_since(start);

@@ -237,3 +237,44 @@ TEST(CliDecimateChannels, ATexturedSphereKeepsItsSeamAndRendersTextured) {
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(b["mean"][c].get<double>(), a["mean"][c].get<double>(), 8.0) << c;
 }
 #endif
+
+TEST(CliDecimateChannels, MaterialsStayOnTheirSideThroughRanges) {
+    // A flat 130 × 130 grid, material "left" where x < 0.5 and "right" beyond; named in an OBJ
+    // whose second material first appears half-way through the faces.
+    TempDir dir;
+    const int n = 130;
+    {
+        std::ofstream mtl(dir / "two.mtl");
+        mtl << "newmtl left\nKd 1 0 0\nnewmtl right\nKd 0 0 1\n";
+        std::ofstream obj(dir / "two.obj");
+        obj << "mtllib two.mtl\n";
+        for (int j = 0; j <= n; ++j)
+            for (int i = 0; i <= n; ++i) obj << "v " << double(i) / n << ' ' << double(j) / n << " 0\n";
+        auto v = [&](int i, int j) { return 1 + j * (n + 1) + i; };
+        for (const bool left : {true, false}) {
+            obj << "usemtl " << (left ? "left" : "right") << '\n';
+            for (int j = 0; j < n; ++j)
+                for (int i = left ? 0 : n / 2; i < (left ? n / 2 : n); ++i)
+                    obj << "f " << v(i, j) << ' ' << v(i + 1, j) << ' ' << v(i + 1, j + 1) << "\nf " << v(i, j) << ' '
+                        << v(i + 1, j + 1) << ' ' << v(i, j + 1) << '\n';
+        }
+    }
+    const CliRun r = run("decimate -r 0.1 --threads 2 --buffer 16384 " + dir / "two.obj" + " " + dir / "out.glb");
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
+    io::Input in = io::open_input(dir / "out.glb");
+    const io::MeshHeader header = in.reader->header();
+    ASSERT_TRUE(header.channels.material);
+    ASSERT_EQ(header.materials.size(), 2u);
+    io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, header.channels);
+    uint64_t triangles = 0, wrong_side = 0;
+    while (in.reader->next(chunk))
+        for (size_t t = 0; t < chunk.size(); ++t, ++triangles) {
+            const float* p = &chunk.xyz()[9 * t];
+            const double x = (double(p[0]) + p[3] + p[6]) / 3;
+            const std::string& name = header.materials[*chunk.material_at(t)].name;
+            wrong_side += (x < 0.5) != (name == "left");
+        }
+    EXPECT_EQ(triangles, uint64_t(std::llround(0.1 * 2 * n * n)));
+    EXPECT_EQ(wrong_side, 0u);
+}
