@@ -10,24 +10,8 @@
 namespace meshstream::decimate {
 namespace {
 
-// Re-expresses an attribute quadric given in y = x − a in y' = x − a' with t = a' − a:
-// Q(y' + t) has b + A t and c + 2 bᵀt + tᵀA t, and the values G·(y' + t) + D have D + G·t.
-void translate(double* q, int m, const double t[3]) {
-    Quadric a = AttributeQuadric::part(q);
-    const double at[3] = {a.a00 * t[0] + a.a01 * t[1] + a.a02 * t[2], a.a01 * t[0] + a.a11 * t[1] + a.a12 * t[2],
-                          a.a02 * t[0] + a.a12 * t[1] + a.a22 * t[2]};
-    a.c += 2 * (a.b0 * t[0] + a.b1 * t[1] + a.b2 * t[2]) + (at[0] * t[0] + at[1] * t[1] + at[2] * t[2]);
-    a.b0 += at[0];
-    a.b1 += at[1];
-    a.b2 += at[2];
-    AttributeQuadric::set_part(q, a);
-    for (int j = 0; j < m; ++j) {
-        double* g = q + 11 + 4 * j;
-        g[3] += g[0] * t[0] + g[1] * t[1] + g[2] * t[2];
-    }
-}
-
-// The same for a Quadric alone.
+// Re-expresses a quadric given in y = x − a in y' = x − a' with t = a' − a: Q(y' + t) has
+// b + A t and c + 2 bᵀt + tᵀA t.
 Quadric translated(Quadric a, const double t[3]) {
     const double at[3] = {a.a00 * t[0] + a.a01 * t[1] + a.a02 * t[2], a.a01 * t[0] + a.a11 * t[1] + a.a12 * t[2],
                           a.a02 * t[0] + a.a12 * t[1] + a.a22 * t[2]};
@@ -36,6 +20,15 @@ Quadric translated(Quadric a, const double t[3]) {
     a.b1 += at[1];
     a.b2 += at[2];
     return a;
+}
+
+// The same for a whole attribute quadric: its values G·(y' + t) + D have D + G·t.
+void translate(double* q, int m, const double t[3]) {
+    AttributeQuadric::set_part(q, translated(AttributeQuadric::part(q), t));
+    for (int j = 0; j < m; ++j) {
+        double* g = q + 11 + 4 * j;
+        g[3] += g[0] * t[0] + g[1] * t[1] + g[2] * t[2];
+    }
 }
 
 }  // namespace

@@ -658,6 +658,13 @@ ChannelResult run_with_channels(const ChannelMesh& m, const Options& options, co
 }
 
 std::array<float, 2> uv_is_xy(float x, float y, int, int) { return {x, y}; }
+// Weights that leave the grid's channels (colour, uv) out of the error.
+AttributeWeights geometry_only() {
+    AttributeWeights w;
+    w.color = 0;
+    w.uv = 0;
+    return w;
+}
 std::array<float, 3> ramp(float x, float y) { return {0.1f + 0.8f * x, 0.9f - 0.5f * y, 0.3f + 0.2f * x + 0.3f * y}; }
 
 }  // namespace
@@ -755,11 +762,8 @@ TEST(StreamDecimatorChannels, ColourErrorKeepsASharpBorderThatGeometryAloneSmear
     Options options;
     options.ratio = 0.1;
     options.buffer_triangles = 1000;
-    AttributeWeights geometry_only;
-    geometry_only.color = 0;
-    geometry_only.uv = 0;
     const double weighted = colour_rms(m, run_with_channels(m, options, {}));
-    const double unweighted = colour_rms(m, run_with_channels(m, options, geometry_only));
+    const double unweighted = colour_rms(m, run_with_channels(m, options, geometry_only()));
     EXPECT_LT(weighted, 0.5 * unweighted) << weighted << " vs " << unweighted;
 }
 
@@ -769,10 +773,7 @@ TEST(StreamDecimatorChannels, UnweightedChannelsLeaveTheGeometryAsPositionsOnly)
     Options options;
     options.ratio = 0.2;
     options.buffer_triangles = 600;
-    AttributeWeights none;
-    none.color = 0;
-    none.uv = 0;
-    const ChannelResult with = run_with_channels(m, options, none);
+    const ChannelResult with = run_with_channels(m, options, geometry_only());
     const Decimated without = run_decimator(m.xyz, options, 1000);
     EXPECT_EQ(with.xyz, without.xyz);
 }

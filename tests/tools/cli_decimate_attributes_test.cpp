@@ -55,6 +55,17 @@ Read read_back(const std::string& path) {
     return r;
 }
 
+// `out`, decimated from `in` at 10 %: coloured, the exact count, and colours within the input's
+// range (interpolated, not invented).
+void expect_coloured_tenth(const Read& in, const std::string& out) {
+    const Read after = read_back(out);
+    ASSERT_TRUE(after.channels.color.has_value());
+    EXPECT_EQ(after.triangles, uint64_t(std::llround(0.1 * double(in.triangles))));
+    EXPECT_GE(after.colour_min, in.colour_min - 1.0 / 255);
+    EXPECT_LE(after.colour_max, in.colour_max + 1.0 / 255);
+    EXPECT_GT(after.colour_max - after.colour_min, 0.5 * (in.colour_max - in.colour_min));
+}
+
 }  // namespace
 
 TEST(CliDecimateChannels, ColoursAreKeptAndSaidNothingAbout) {
@@ -64,13 +75,7 @@ TEST(CliDecimateChannels, ColoursAreKeptAndSaidNothingAbout) {
     CliRun r = run("decimate -r 0.1 --threads 1 " + in + " " + dir / "out.ply");
     ASSERT_EQ(r.code, 0) << r.err;
     EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
-    const Read after = read_back(dir / "out.ply");
-    ASSERT_TRUE(after.channels.color.has_value());
-    EXPECT_EQ(after.triangles, uint64_t(std::llround(0.1 * double(before.triangles))));
-    // The colours stay within the input's range (interpolated, not invented).
-    EXPECT_GE(after.colour_min, before.colour_min - 1.0 / 255);
-    EXPECT_LE(after.colour_max, before.colour_max + 1.0 / 255);
-    EXPECT_GT(after.colour_max - after.colour_min, 0.5 * (before.colour_max - before.colour_min));
+    expect_coloured_tenth(before, dir / "out.ply");
 }
 
 TEST(CliDecimateChannels, AnOutputThatCannotHoldThemSaysWhatWasDropped) {
@@ -115,11 +120,7 @@ TEST(CliDecimateChannels, RangesCarryTheColoursThroughTheirSpoolsAndTheSeamPass)
     ASSERT_EQ(r.code, 0) << r.err;
     EXPECT_NE(cli_test::slurp(dir / "two.json").find("\"threads\":2"), std::string::npos);
     EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
-    const Read after = read_back(dir / "two.ply");
-    ASSERT_TRUE(after.channels.color.has_value());
-    EXPECT_EQ(after.triangles, uint64_t(std::llround(0.1 * double(before.triangles))));
-    EXPECT_GE(after.colour_min, before.colour_min - 1.0 / 255);
-    EXPECT_LE(after.colour_max, before.colour_max + 1.0 / 255);
+    expect_coloured_tenth(before, dir / "two.ply");
     // The same run again: the same bytes.
     ASSERT_EQ(run(common + "--threads 2 " + dir / "again.ply > /dev/null").code, 0);
     EXPECT_EQ(cli_test::slurp(dir / "two.ply"), cli_test::slurp(dir / "again.ply"));
