@@ -279,3 +279,19 @@ TEST(CliDecimateChannels, MaterialsStayOnTheirSideThroughRanges) {
     EXPECT_EQ(triangles, uint64_t(std::llround(0.1 * 2 * n * n)));
     EXPECT_EQ(wrong_side, 0u);
 }
+
+TEST(CliDecimateChannels, NonFiniteColourValuesAreReadAsZeroAndCounted) {
+    TempDir dir;
+    std::ofstream(dir / "nan.ply") << "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+                                      "property float z\nproperty float red\nproperty float green\nproperty float "
+                                      "blue\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n"
+                                      "0 0 0 1 0 0\n1 0 0 nan 0 0\n1 1 0 0 1 0\n0 1 0 0 0 1\n3 0 1 2\n3 0 2 3\n";
+    const CliRun r = run("decimate -r 1 " + dir / "nan.ply" + " " + dir / "out.ply");
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.err.find("warning: non-finite normal, colour, texture or scalar values read as 0 (1)"),
+              std::string::npos)
+        << r.err;
+    const Read out = read_back(dir / "out.ply");
+    EXPECT_EQ(out.triangles, 2u);
+    EXPECT_GE(out.colour_min, 0.0);  // the NaN came out as 0, not as garbage
+}
