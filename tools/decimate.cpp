@@ -166,14 +166,15 @@ double seconds_since(std::chrono::steady_clock::time_point t) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
 }
 
-// The positions of every triangle read from an input that can be read once only (stdin, a
-// pipe), spooled to a temporary file so that it can still be sorted: 36 bytes a triangle,
-// with the bounding box of its finite coordinates. The file is made on the first add(); a
-// file that cannot be made or written stops the spool (ok() false, error() says why) instead
-// of failing the command, which then decimates the input as it comes.
-class PositionSpool {
+// Every triangle read from an input that can be read once only (stdin, a pipe), spooled to a
+// temporary file so that it can still be sorted: its positions and the channels decimate
+// carries (TriangleRecords: 36 bytes a triangle plus those), with the bounding box of its finite
+// coordinates. The file is made on the first add(); a file that cannot be made or written stops
+// the spool (ok() false, error() says why) instead of failing the command, which then decimates
+// the input as it comes.
+class InputSpool {
 public:
-    explicit PositionSpool(std::string tmpdir) : tmpdir_(std::move(tmpdir)) {
+    InputSpool(std::string tmpdir, const io::Channels& channels) : tmpdir_(std::move(tmpdir)), records_(channels) {
         box_.min.fill(std::numeric_limits<float>::infinity());
         box_.max.fill(-std::numeric_limits<float>::infinity());
     }
@@ -181,7 +182,9 @@ public:
         if (!error_.empty()) return;
         try {
             if (!file_) file_ = std::make_unique<io::TempFile>(tmpdir_, "meshstream-spool");
-            file_->write(chunk.xyz().data(), chunk.xyz().size_bytes());
+            bytes_.clear();
+            records_.encode(chunk, bytes_);
+            file_->write(bytes_.data(), bytes_.size());
         } catch (const io::Error& e) {
             error_ = e.what();
             file_.reset();
@@ -199,20 +202,26 @@ public:
     bool ok() const { return error_.empty(); }
     const std::string& error() const { return error_; }
     const io::Bounds& bounds() const { return box_; }
-    uint64_t bytes() const { return triangles_ * 36; }
-    // Reads the spool back in order, a chunk at a time (positions only); false at the end.
+    uint64_t bytes() const { return triangles_ * records_.bytes(); }
+    // Reads the spool back in order, a chunk (with the spool's channels) at a time; false at the
+    // end.
     bool next(io::TriangleChunk& chunk) {
-        chunk.clear();
         const uint64_t n = std::min<uint64_t>(chunk.capacity(), triangles_ - read_);
-        if (n == 0) return false;
-        file_->read_at(read_ * 36, chunk.xyz_storage(), size_t(n) * 36);
-        chunk.resize(size_t(n));
+        if (n == 0) {
+            chunk.clear();
+            return false;
+        }
+        bytes_.resize(size_t(n) * records_.bytes());
+        file_->read_at(read_ * records_.bytes(), bytes_.data(), bytes_.size());
+        records_.decode(bytes_.data(), size_t(n), chunk);
         read_ += n;
         return true;
     }
 
 private:
     std::string tmpdir_;
+    TriangleRecords records_;
+    std::vector<char> bytes_;
     std::unique_ptr<io::TempFile> file_;
     std::string error_;
     io::Bounds box_;
@@ -385,10 +394,10 @@ SortedInput sort_file(const DecimateOptions& opt, uint64_t sort_budget, const io
 }
 
 // Sorts an input read once: the rest of it goes to the spool, which is then sorted.
-SortedInput sort_spooled(io::TriangleInput& in, PositionSpool& spool, uint64_t sort_budget, const std::string& tmpdir,
-                         Progress& progress) {
+SortedInput sort_spooled(io::TriangleInput& in, InputSpool& spool, uint64_t sort_budget, const std::string& tmpdir,
+                         Progress& progress, const io::Channels& channels) {
     progress.phase("spooling the input", in.header().triangle_count);
-    io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, io::Channels{});
+    io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, channels);
     while (in.next(chunk)) {
         spool.add(chunk);
         progress.update(in.count().read, in.source());
@@ -399,7 +408,7 @@ SortedInput sort_spooled(io::TriangleInput& in, PositionSpool& spool, uint64_t s
     s.dropped = dropped_triangles(in);
     s.end_header = in.header();
     s.axis = longest_axis(spool.bounds());
-    s.sorter = make_sorter(s.axis, sort_budget, tmpdir, progress);
+    s.sorter = make_sorter(s.axis, sort_budget, tmpdir, progress, channels);
     progress.phase("sorting: reading the spool", s.count.passed());
     uint64_t done = 0;
     while (spool.next(chunk)) {
@@ -550,7 +559,6 @@ void run_decimate(const DecimateOptions& opt, RangeProcesses* processes) {
     const std::optional<uint64_t> input_count = counted ? counted->count.promised : header.triangle_count;
     const decimate::Options options = decimation_options(opt, header, input_name, in.format().name, input_count);
     const Carried carried = carried_channels(opt, header, out_format, wo, input_name);
-    const bool with_channels = carried.layout.any();
     wo.channels = carried.channels;
     if (carried.channels.material) wo.materials = header.materials;
 
@@ -600,19 +608,13 @@ void run_decimate(const DecimateOptions& opt, RangeProcesses* processes) {
     // --sort: what may happen. Input known to be sorted (its flag, --sorted-axis) is decimated
     // as it comes in auto: sorting again cannot help it, a larger buffer can.
     const bool read_once = !is_regular_file(opt.input);
-    // A stream is spooled to be sorted as positions only: with channels it is decimated as read.
-    const bool spool_loses = read_once && with_channels;
-    if (sort_first && spool_loses)
-        throw UsageError("<stdin>: --sort always spools a stream as positions only, and decimate keeps its " +
-                         io::describe_missing(carried.channels, io::Channels{}) +
-                         ": give the input as a file, or sort first (meshstream sort IN SORTED.mstream)");
-    const bool may_restart = opt.sort == "auto" && !options.sorted_axis && !spool_loses;
+    const bool may_restart = opt.sort == "auto" && !options.sorted_axis;
     const uint64_t budget = opt.read.options().memory_budget_bytes;
     io::ReadOptions sort_ro = read;  // the reader's share while sorting
     sort_ro.memory_budget_bytes = budget / 4;
     const uint64_t sort_budget = budget / 2;
-    std::optional<PositionSpool> spool;
-    if (read_once && (sort_first || may_restart)) spool.emplace(opt.read.tmpdir);
+    std::optional<InputSpool> spool;
+    if (read_once && (sort_first || may_restart)) spool.emplace(opt.read.tmpdir, carried.channels);
 
     std::optional<io::Output> out(io::open_output(opt.output, out_format.name, wo, opt.write.gzip_level));
     // An output written in place cannot be taken back: it is held while a restart may come, up
@@ -687,11 +689,6 @@ void run_decimate(const DecimateOptions& opt, RangeProcesses* processes) {
                                   : "its output to " + out->sink->name() + " was already under way (" +
                                         human_count(double(gate.held_triangles())) +
                                         " triangles held back first; write to a file, or sort first)";
-        } else if (spool_loses && opt.sort == "auto" && !options.sorted_axis && decimator->stats().forced_writes > 0) {
-            outcome.kind = SortOutcome::Kind::kCouldNot;
-            outcome.why_not = "a stream is spooled as positions only, and decimate keeps its " +
-                              io::describe_missing(carried.channels, io::Channels{}) +
-                              " (give the input as a file, or sort first)";
         }
     }
     if (sort_first || outcome.kind == SortOutcome::Kind::kSorted) {
@@ -712,7 +709,7 @@ void run_decimate(const DecimateOptions& opt, RangeProcesses* processes) {
         if (!read_once) in.close();
         const auto sorting = std::chrono::steady_clock::now();
         try {
-            sorted = spool ? sort_spooled(in, *spool, sort_budget, opt.read.tmpdir, progress)
+            sorted = spool ? sort_spooled(in, *spool, sort_budget, opt.read.tmpdir, progress, carried.channels)
                            : sort_file(opt, sort_budget, sort_ro, opt.read.tmpdir, progress, carried.channels);
         } catch (const io::Error& e) {
             // A sort auto chose may fail (a full --tmpdir) where decimating as read would not:

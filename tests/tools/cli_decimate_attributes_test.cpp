@@ -126,21 +126,28 @@ TEST(CliDecimateChannels, RangesCarryTheColoursThroughTheirSpoolsAndTheSeamPass)
     EXPECT_EQ(cli_test::slurp(dir / "two.ply"), cli_test::slurp(dir / "again.ply"));
 }
 
-TEST(CliDecimateChannels, AStreamWithColoursIsNotSortedFirst) {
+TEST(CliDecimateChannels, AStreamWithColoursIsSpooledAndSortedWithThem) {
     TempDir dir;
-    const std::string in = coloured_mesh(dir, 2000);
-    CliRun r = run("decimate --sort always - " + dir / "out.ply" + " --from ply < " + in);
-    EXPECT_EQ(r.code, 2);
-    EXPECT_NE(r.err.find("--sort always spools a stream as positions only"), std::string::npos) << r.err;
-    EXPECT_FALSE(std::filesystem::exists(dir / "out.ply"));
-    // Sorted from a file, the colours come through the sort.
-    r = run("decimate --sort always -r 0.1 " + in + " " + dir / "sorted.ply");
+    const std::string in = coloured_mesh(dir, 20000);
+    const Read before = read_back(in);
+    // A shuffled copy: in no streaming order, so --sort auto sorts it (from the spool of stdin).
+    ASSERT_EQ(std::system((std::string(MESHSTREAM_GEN_BINARY) + " -q --color --shuffle -n 20000 --tmpdir " +
+                           dir.path().string() + " " + dir / "shuffled.ply")
+                              .c_str()),
+              0);
+    for (const std::string sort : {"always", "auto"}) {
+        SCOPED_TRACE(sort);
+        const CliRun r = run("decimate --sort " + sort + " --buffer 2000 -r 0.1 --json - " + dir / "out.ply" +
+                             " --from ply < " + dir / "shuffled.ply" + " > " + dir / "out.json");
+        ASSERT_EQ(r.code, 0) << r.err;
+        EXPECT_NE(cli_test::slurp(dir / "out.json").find("\"sorted_first\""), std::string::npos)
+            << cli_test::slurp(dir / "out.json");
+        expect_coloured_tenth(before, dir / "out.ply");
+    }
+    // Sorted from a file, the colours come through the sort too.
+    const CliRun r = run("decimate --sort always -r 0.1 " + in + " " + dir / "sorted.ply");
     ASSERT_EQ(r.code, 0) << r.err;
-    EXPECT_TRUE(read_back(dir / "sorted.ply").channels.color.has_value());
-    // Decimated as read from the stream, they come through too.
-    r = run("decimate -r 0.1 - " + dir / "read.ply" + " --from ply < " + in);
-    ASSERT_EQ(r.code, 0) << r.err;
-    EXPECT_TRUE(read_back(dir / "read.ply").channels.color.has_value());
+    expect_coloured_tenth(before, dir / "sorted.ply");
 }
 
 #ifdef MESHSTREAM_RENDER_GLTF
