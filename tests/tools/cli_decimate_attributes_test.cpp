@@ -302,3 +302,48 @@ TEST(CliDecimateChannels, NonFiniteColourValuesAreReadAsZeroAndCounted) {
     EXPECT_EQ(out.triangles, 2u);
     EXPECT_GE(out.colour_min, 0.0);  // the NaN came out as 0, not as garbage
 }
+
+TEST(CliDecimateChannels, VertexAndFaceScalarsComeThrough) {
+    // A flat 40 × 40 grid: vertex "intensity" = x, a linear field, and face "label" 1 left of
+    // x = 0.5, 2 right of it.
+    TempDir dir;
+    const int n = 40;
+    {
+        std::ofstream ply(dir / "scalars.ply");
+        ply << "ply\nformat ascii 1.0\nelement vertex " << (n + 1) * (n + 1)
+            << "\nproperty float x\nproperty float y\nproperty float z\nproperty float intensity\nelement face "
+            << 2 * n * n << "\nproperty list uchar int vertex_indices\nproperty int label\nend_header\n";
+        for (int j = 0; j <= n; ++j)
+            for (int i = 0; i <= n; ++i) ply << double(i) / n << ' ' << double(j) / n << " 0 " << double(i) / n << '\n';
+        for (int j = 0; j < n; ++j)
+            for (int i = 0; i < n; ++i) {
+                const int a = j * (n + 1) + i, label = i < n / 2 ? 1 : 2;
+                ply << "3 " << a << ' ' << a + 1 << ' ' << a + n + 2 << ' ' << label << "\n3 " << a << ' ' << a + n + 2
+                    << ' ' << a + n + 1 << ' ' << label << '\n';
+            }
+    }
+    const CliRun r = run("decimate -r 0.1 --weights intensity=1 " + dir / "scalars.ply" + " " + dir / "out.ply");
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
+    io::Input in = io::open_input(dir / "out.ply");
+    const io::Channels channels = in.reader->header().channels;
+    ASSERT_EQ(channels.vertex_scalars.size(), 1u);
+    ASSERT_EQ(channels.face_scalars.size(), 1u);
+    io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, channels);
+    uint64_t triangles = 0, on_their_side = 0;
+    double worst = 0;
+    while (in.reader->next(chunk))
+        for (size_t t = 0; t < chunk.size(); ++t, ++triangles) {
+            for (int k = 0; k < 3; ++k)  // the field is linear: exact wherever a vertex went
+                worst = std::max(worst, std::fabs(chunk.vertex_scalar_at(t, 0)[k] - chunk.xyz()[9 * t + 3 * k]));
+            const double x = (double(chunk.xyz()[9 * t]) + chunk.xyz()[9 * t + 3] + chunk.xyz()[9 * t + 6]) / 3;
+            // A face scalar travels with its triangle (it is no border, as a material is): most
+            // triangles still lie on their label's side.
+            const double label = *chunk.face_scalar_at(t, 0);
+            EXPECT_TRUE(label == 1 || label == 2) << label;
+            on_their_side += (x < 0.5) == (label == 1);
+        }
+    EXPECT_EQ(triangles, uint64_t(0.1 * 2 * n * n));
+    EXPECT_GT(on_their_side, 0.9 * double(triangles));
+    EXPECT_LT(worst, 1e-4);
+}
