@@ -150,13 +150,99 @@ bool AttributeStore::seam_allows(const HalfEdgeBuffer& buffer, uint32_t h) const
            std::memcmp(corner_value(q_corner), corner_value(t), 4 * size_t(m_)) == 0;
 }
 
+bool AttributeStore::slides(const HalfEdgeBuffer& buffer, uint32_t h) const {
+    const uint32_t t = buffer.twin(h);
+    const uint32_t q = buffer.corner_vertex(next_in_face(h));
+    if (!is_half_edge(t) || (buffer.vertex(q).flags & kSeam) == 0) return false;
+    // Along the seam at both ends: t runs q→p, so p's corner on t's face is next_in_face(t), q's is t.
+    if (same_wedge(h, next_in_face(t)) || same_wedge(next_in_face(h), t)) return false;
+    // Round p's fan (c → p's corner on the face across the edge into c): two changes of wedge.
+    int changes = 0;
+    uint32_t c = h;
+    for (uint32_t steps = 0;; ++steps) {
+        const uint32_t across = buffer.twin(prev_in_face(c));
+        if (!is_half_edge(across) || steps > buffer.vertex(buffer.corner_vertex(h)).face_count) return false;
+        changes += !same_wedge(c, across);
+        c = across;
+        if (c == h) break;
+    }
+    return changes == 2;
+}
+
+void AttributeStore::slide_error(const HalfEdgeBuffer& buffer, uint32_t h, double& geometric, double& attribute) const {
+    // The other seam edge at p: crossing the edge into corner c (from w to p) changes wedge, w ≠ q.
+    const uint32_t q_corner = next_in_face(h);
+    uint32_t r_side[2] = {kNoIndex, kNoIndex};  // r's corners on p's side A (h's wedge) and side B
+    double side_area[2] = {0, 0};
+    double pp[3], pq[3], pr[3] = {0, 0, 0};
+    buffer.position(buffer.corner_vertex(h), pp);
+    buffer.position(buffer.corner_vertex(q_corner), pq);
+    uint32_t c = h;
+    do {
+        const uint32_t into = prev_in_face(c), across = buffer.twin(into);
+        const uint32_t w = buffer.corner_vertex(into);
+        {
+            double a[3], b[3], e1[3], e2[3];
+            buffer.position(buffer.corner_vertex(next_in_face(c)), a);
+            buffer.position(w, b);
+            for (int i = 0; i < 3; ++i) e1[i] = a[i] - pp[i], e2[i] = b[i] - pp[i];
+            const double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                                 e1[0] * e2[1] - e1[1] * e2[0]};
+            side_area[same_wedge(c, h) ? 0 : 1] += 0.5 * std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        }
+        if (!same_wedge(c, across) && w != buffer.corner_vertex(q_corner)) {
+            buffer.position(w, pr);
+            // w's corner on c's face is `into`; on the face across, the corner after `across`.
+            const bool c_is_a = same_wedge(c, h);
+            r_side[c_is_a ? 0 : 1] = into;
+            r_side[c_is_a ? 1 : 0] = next_in_face(across);
+        }
+        c = across;
+    } while (c != h);
+    // Position: p's distance² from the line r–q, weighted by |r − q|.
+    double d[3], e[3];
+    for (int i = 0; i < 3; ++i) d[i] = pq[i] - pr[i], e[i] = pp[i] - pr[i];
+    const double dd = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+    const double s = dd > 0 ? std::clamp((e[0] * d[0] + e[1] * d[1] + e[2] * d[2]) / dd, 0.0, 1.0) : 0.0;
+    double off2 = 0;
+    for (int i = 0; i < 3; ++i) off2 += (e[i] - s * d[i]) * (e[i] - s * d[i]);
+    geometric += off2 * std::sqrt(dd);
+    if (r_side[0] == kNoIndex) return;
+    // Values, per side: p's against r's and q's interpolated at p's place along the line.
+    const uint32_t q_side[2] = {q_corner, buffer.twin(h)};
+    const uint32_t p_side[2] = {h, next_in_face(buffer.twin(h))};
+    const double* w = omega();
+    for (int k = 0; k < 2; ++k) {
+        const float* vp = corner_value(p_side[k]);
+        const float* vq = shown(buffer, q_side[k]);
+        const float* vr = shown(buffer, r_side[k]);
+        double dev = 0;
+        for (int j = 0; j < m_; ++j) {
+            const double x = vp[j] - ((1 - s) * vr[j] + s * vq[j]);
+            dev += w[j] * x * x;
+        }
+        attribute += side_area[k] * dev;
+    }
+}
+
 void AttributeStore::merge(HalfEdgeBuffer& buffer, uint32_t h) {
     const uint32_t p = buffer.corner_vertex(h), q_corner = next_in_face(h), q = buffer.corner_vertex(q_corner);
     if (buffer.vertex(q).flags & kSeam) {
-        // p's corners join q on h's side of the seam: they show q's value there.
-        const float* wedge = corner_value(q_corner);
-        for (uint32_t c = buffer.vertex(p).first_corner; c != kNoIndex; c = buffer.next_corner(c))
-            std::copy_n(wedge, m_, corner_value(c));
+        // p's corners join q on their side of the seam: they show q's value there (a p off the
+        // seam has one side, h's; a sliding p has two, h's and its twin's).
+        const bool slide = (buffer.vertex(p).flags & kSeam) != 0;
+        float side_a[kMaxAttributeComponents], side_b[kMaxAttributeComponents], wedge_a[kMaxAttributeComponents];
+        std::copy_n(corner_value(q_corner), m_, side_a);
+        if (slide) {
+            std::copy_n(corner_value(buffer.twin(h)), m_, side_b);
+            std::copy_n(corner_value(h), m_, wedge_a);
+        }
+        const uint32_t material_a = material(face_of(h));
+        for (uint32_t c = buffer.vertex(p).first_corner; c != kNoIndex; c = buffer.next_corner(c)) {
+            const bool on_a = !slide || (material(face_of(c)) == material_a &&
+                                         std::memcmp(corner_value(c), wedge_a, 4 * size_t(m_)) == 0);
+            std::copy_n(on_a ? side_a : side_b, m_, corner_value(c));
+        }
     }
     // p's quadric, relative to p's reference point, into q's.
     double from_p[AttributeQuadric::size(kMaxAttributeComponents)], rp[3];

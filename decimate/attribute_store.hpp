@@ -25,6 +25,7 @@
 #include "decimate/halfedge_buffer.hpp"
 
 #include <cstdint>
+#include <cstring>
 
 namespace meshstream::decimate {
 
@@ -82,8 +83,19 @@ public:
     const double* face_scalars(uint32_t f) const { return &face_scalars_[f * face_scalar_count_]; }
 
     // A collapse p→q of half-edge h is about to happen: p's corners take the value q shows on
-    // h's face (when q is a seam vertex), and q's quadric and range gain p's.
+    // their side of the seam (when q is a seam vertex), and q's quadric and range gain p's.
     void merge(HalfEdgeBuffer& buffer, uint32_t h);
+    // True when seam vertex p may slide along its seam into q (h = p→q): p's one closed fan has
+    // exactly two wedges (runs of corners that agree), h is one of the two edges between them,
+    // and q is a seam vertex whose corners differ across h too (the seam goes on through q).
+    // p's corners then take q's value on their side, and the seam loses p.
+    bool slides(const HalfEdgeBuffer& buffer, uint32_t h) const;
+    // The error of such a slide besides the geometric error at q: how far p lies off the seam's
+    // line from its other seam neighbour r to q, in position (a distance², weighted by |r−q| like
+    // the boundary planes) and, per side, in value (p's value against the interpolation of r's and
+    // q's there, weighted by the area of p's faces on that side). `geometric` is added to the
+    // first, `attribute` to the second.
+    void slide_error(const HalfEdgeBuffer& buffer, uint32_t h, double& geometric, double& attribute) const;
     // True when a collapse into q along h keeps the seams: q is no seam vertex, or its corners
     // on the two faces of the edge agree (else the seam runs along the edge).
     bool seam_allows(const HalfEdgeBuffer& buffer, uint32_t h) const;
@@ -108,6 +120,11 @@ public:
     void sanitize(float* values, size_t n);
 
 private:
+    // Corners c and d (of one vertex) show the same value on faces of the same material.
+    bool same_wedge(uint32_t c, uint32_t d) const {
+        return material(face_of(c)) == material(face_of(d)) &&
+               std::memcmp(corner_value(c), corner_value(d), 4 * size_t(m_)) == 0;
+    }
     void init_vertex(HalfEdgeBuffer& buffer, uint32_t v, const float* value, uint32_t material);
     void make_seam(HalfEdgeBuffer& buffer, uint32_t v);
     float* record(uint32_t v) { return &records_[v * stride_]; }

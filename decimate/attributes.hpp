@@ -18,10 +18,11 @@
 // is (not divided by W).
 //
 // Seams: a vertex whose corners disagree (a UV or normal seam, a colour border stored per corner)
-// or whose triangles have different materials is a seam vertex (kSeam): it is never removed and
-// never moved, so no texture stretches across a seam, and a collapse into it gives the removed
-// vertex's corners the value its corner has on that side (refused where the two triangles on the
-// edge disagree there, the seam running along the edge).
+// or whose triangles have different materials is a seam vertex (kSeam): it never moves, so no
+// texture stretches across a seam; a collapse into it gives the removed vertex's corners the
+// value its corner has on that side (refused where the two triangles on the edge disagree there,
+// the seam running along the edge); and it is removed only by sliding along its seam into a seam
+// neighbour, each side taking that neighbour's value there (AttributeStore::slides).
 #pragma once
 
 #include "decimate/quadric.hpp"

@@ -148,6 +148,11 @@ bool seam_allows(const HalfEdgeBuffer& buffer, uint32_t h) {
     return attributes == nullptr || attributes->seam_allows(buffer, h);
 }
 
+bool seam_slides(const HalfEdgeBuffer& buffer, uint32_t h) {
+    const AttributeStore* attributes = buffer.attributes();
+    return attributes != nullptr && attributes->slides(buffer, h);
+}
+
 Quadric merged_quadric(const HalfEdgeBuffer& buffer, uint32_t p, uint32_t q) {
     const Quadric sum = buffer.quadric(p) + buffer.quadric(q);
     const AttributeStore* attributes = buffer.attributes();
@@ -158,26 +163,37 @@ Quadric merged_quadric(const HalfEdgeBuffer& buffer, uint32_t p, uint32_t q) {
 namespace {
 
 // The error of h = p→q when q keeps its position and values (written, or a seam vertex): the
-// geometric error at q plus p's attribute error at q with the values q shows on h's face.
+// geometric error at q plus p's attribute error at q with the values q shows on h's face; for a
+// seam vertex p sliding along its seam, plus how far off the seam's line p lay
+// (AttributeStore::slide_error: p's quadric mixes the seam's two sides).
 double fixed_error(const HalfEdgeBuffer& buffer, const AttributeStore& attributes, uint32_t h) {
     const uint32_t p = buffer.corner_vertex(h), q = buffer.corner_vertex(next_in_face(h));
     const Quadric sum = buffer.quadric(p) + buffer.quadric(q);
     double x[3];
     buffer.position(q, x);
+    if (buffer.vertex(p).flags & kSeam) {
+        double geometric = std::max(0.0, sum.error(x)), attribute = 0;
+        attributes.slide_error(buffer, h, geometric, attribute);
+        return attributes.weighted() ? AttributeStore::combined_error(sum, geometric, attribute) : geometric;
+    }
     return AttributeStore::combined_error(sum, sum.error(x),
                                           attributes.error(buffer, p, x, attributes.shown(buffer, next_in_face(h))));
 }
 
-bool values_fixed(const HalfEdgeBuffer& buffer, uint32_t q) {
+// q keeps its values (written, or a seam vertex) and weighs them, or p slides along a seam (then
+// q is a seam vertex too: neither moves).
+bool values_fixed(const HalfEdgeBuffer& buffer, uint32_t p, uint32_t q) {
     const AttributeStore* attributes = buffer.attributes();
-    return attributes != nullptr && attributes->weighted() && (buffer.vertex(q).flags & (kSeam | kFrozen)) != 0;
+    if (attributes == nullptr) return false;
+    if (buffer.vertex(p).flags & kSeam) return true;
+    return attributes->weighted() && (buffer.vertex(q).flags & (kSeam | kFrozen)) != 0;
 }
 
 }  // namespace
 
 double collapse_error(const HalfEdgeBuffer& buffer, uint32_t h) {
     const uint32_t p = buffer.corner_vertex(h), q = buffer.corner_vertex(next_in_face(h));
-    if (values_fixed(buffer, q)) return fixed_error(buffer, *buffer.attributes(), h);
+    if (values_fixed(buffer, p, q)) return fixed_error(buffer, *buffer.attributes(), h);
     double x[3];
     buffer.position(q, x);
     return merged_quadric(buffer, p, q).error(x);
@@ -188,7 +204,7 @@ CollapsePlacement collapse_placement(const HalfEdgeBuffer& buffer, uint32_t h) {
     const uint32_t p = buffer.corner_vertex(h), q = buffer.corner_vertex(next_in_face(h));
     CollapsePlacement out;
     buffer.position(q, out.target);
-    if (values_fixed(buffer, q)) {  // q does not move either (collapse_target_free)
+    if (values_fixed(buffer, p, q)) {  // q does not move either (collapse_target_free)
         out.error = fixed_error(buffer, *buffer.attributes(), h);
         return out;
     }

@@ -27,12 +27,18 @@ inline constexpr uint32_t kMaxMovedFaces = 32;
 // Beyond the paper: a true-boundary p (a hole, off P_in and P_out, one open fan) may also
 // collapse along its outgoing boundary edge (twin kOpenEdge), as in Garland & Heckbert; its
 // quadric holds the boundary planes added when it left P_in, which keep the hole's outline.
-// With channels (attribute_store.hpp): p is no seam vertex, and a seam vertex q takes the collapse
-// only where its corners on the edge's two faces agree (seam_allows).
+// With channels (attribute_store.hpp): a seam vertex p collapses only along its seam (seam_slides),
+// and a seam vertex q takes any other collapse only where its corners on the edge's two faces
+// agree (seam_allows).
 bool seam_allows(const HalfEdgeBuffer& buffer, uint32_t h);
+bool seam_slides(const HalfEdgeBuffer& buffer, uint32_t h);
 inline bool collapse_eligible(const HalfEdgeBuffer& buffer, uint32_t h) {
     const Vertex& p = buffer.vertex(buffer.corner_vertex(h));
-    if ((p.flags & (kInHash | kFrozen | kNonManifold | kManyFans | kSeam)) != 0) return false;
+    if ((p.flags & (kInHash | kFrozen | kNonManifold | kManyFans)) != 0) return false;
+    if (p.flags & kSeam) {
+        const Vertex& q = buffer.vertex(buffer.corner_vertex(next_in_face(h)));
+        return p.open_edges == 0 && (q.flags & (kInHash | kNonManifold)) == 0 && seam_slides(buffer, h);
+    }
     if (p.open_edges == 0) {
         if (!is_half_edge(buffer.twin(h))) return false;
     } else if (p.open_edges != 2 || buffer.twin(h) != kOpenEdge) {

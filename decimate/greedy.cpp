@@ -20,16 +20,24 @@ void rate_edge(HalfEdgeBuffer& buffer, CollapseQueue& queue, uint32_t h) {
     constexpr uint16_t kNoSource = kInHash | kFrozen | kNonManifold | kManyFans | kSeam;
     constexpr uint16_t kNoTarget = kInHash | kNonManifold;
     const bool twin_real = is_half_edge(t);
-    const bool forward = (vp.flags & kNoSource) == 0 && (vq.flags & kNoTarget) == 0 &&
-                         (vp.open_edges == 0 ? twin_real : vp.open_edges == 2 && t == kOpenEdge) &&
-                         ((vq.flags & kSeam) == 0 || seam_allows(buffer, h));
-    const bool backward = twin_real && (vq.flags & kNoSource) == 0 && (vp.flags & kNoTarget) == 0 &&
-                          vq.open_edges == 0 && ((vp.flags & kSeam) == 0 || seam_allows(buffer, t));
+    // A seam vertex collapses only along its seam (seam_slides).
+    auto slides = [&](const Vertex& from, const Vertex& to, uint32_t along) {
+        return (from.flags & (kNoSource & ~kSeam)) == 0 && (from.flags & kSeam) && from.open_edges == 0 &&
+               (to.flags & kNoTarget) == 0 && seam_slides(buffer, along);
+    };
+    const bool forward = ((vp.flags & kNoSource) == 0 && (vq.flags & kNoTarget) == 0 &&
+                          (vp.open_edges == 0 ? twin_real : vp.open_edges == 2 && t == kOpenEdge) &&
+                          ((vq.flags & kSeam) == 0 || seam_allows(buffer, h))) ||
+                         ((vp.flags & kSeam) && slides(vp, vq, h));
+    const bool backward = twin_real && (((vq.flags & kNoSource) == 0 && (vp.flags & kNoTarget) == 0 &&
+                                         vq.open_edges == 0 && ((vp.flags & kSeam) == 0 || seam_allows(buffer, t))) ||
+                                        ((vq.flags & kSeam) && slides(vq, vp, t)));
     if (!forward && !backward) {
         CollapseQueue::forget(buffer, h);
         return;
     }
-    if (forward && backward && vp.face_count <= kMaxMovedFaces && vq.face_count <= kMaxMovedFaces) {
+    if (forward && backward && ((vp.flags | vq.flags) & kSeam) == 0 && vp.face_count <= kMaxMovedFaces &&
+        vq.face_count <= kMaxMovedFaces) {
         // Both ends free (collapse_target_free either way): the same merge at the minimum of
         // Q_p + Q_q. Rated at the exact minimum; collapse_placement() rounds it to floats.
         const Quadric sum = merged_quadric(buffer, p, q);

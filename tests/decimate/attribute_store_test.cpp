@@ -57,29 +57,75 @@ TEST(AttributeStore, CornersThatAgreeMakeNoSeam) {
     EXPECT_EQ(fan.store.seam_vertices(), 0u);
 }
 
-TEST(AttributeStore, CornersThatDisagreeMakeASeamVertexThatNeverMoves) {
-    Fan fan;
+// The fan with triangles 2 and 3 (y ≤ 0) from another texture chart (u shifted by 10): the seam
+// runs from (−1, 0) through the centre to (1, 0); (0, ±1) lie inside one chart each.
+void add_two_charts(Fan& fan) {
     for (size_t t = 0; t < kFan.size(); ++t) {
         std::array<float, 6> uv;
-        // Triangles 2 and 3 (y ≤ 0) come from another texture chart: u shifted by 10.
         for (int k = 0; k < 3; ++k)
             uv[2 * k] = kFan[t][3 * k] + (t >= 2 ? 10.0f : 0.0f), uv[2 * k + 1] = kFan[t][3 * k + 1];
         fan.add(kFan[t], uv, 0);
     }
+}
+
+TEST(AttributeStore, ASeamVertexCollapsesOnlyAlongItsSeamAndNeverMoves) {
+    Fan fan;
+    add_two_charts(fan);
     const uint32_t c = fan.centre();
     EXPECT_NE(fan.buffer.vertex(c).flags & kSeam, 0);
-    // The seam runs through the centre and (±1, 0, 0); (0, ±1, 0) lie inside one chart each.
     EXPECT_EQ(fan.store.seam_vertices(), 3u);
     fan.buffer.finalize_all();
-    // Every half-edge from the centre: it is a seam vertex, so it is never removed.
+    // From the centre: along the seam (to (±1, 0)) yes, across it (to (0, ±1)) no.
+    int along = 0;
     for (uint32_t f : fan.faces)
         for (uint32_t k = 0; k < 3; ++k) {
             const uint32_t h = half_edge(f, k);
-            if (fan.buffer.corner_vertex(h) == c) {
-                EXPECT_FALSE(collapse_eligible(fan.buffer, h));
-            }
+            if (fan.buffer.corner_vertex(h) != c) continue;
+            const float to_y = fan.buffer.vertex(fan.buffer.corner_vertex(next_in_face(h))).pos[1];
+            EXPECT_EQ(collapse_eligible(fan.buffer, h), to_y == 0) << "towards y = " << to_y;
+            along += to_y == 0;
         }
+    EXPECT_EQ(along, 2);
     EXPECT_FALSE(collapse_target_free(fan.buffer, half_edge(fan.faces[0], 2)));  // (0,1,0)→centre
+}
+
+TEST(AttributeStore, ASlideGivesEachSideTheValueItsNewVertexHasThere) {
+    Fan fan;
+    add_two_charts(fan);
+    fan.buffer.finalize_all();
+    const uint32_t h = half_edge(fan.faces[0], 0);  // centre → (1, 0), along the seam
+    ASSERT_TRUE(fan.store.slides(fan.buffer, h));
+    fan.store.merge(fan.buffer, h);
+    // The centre's corners on triangle 1 (chart A) and triangle 2 (chart B) now show (1, 0)'s
+    // values on their charts: (1, 0) and (11, 0).
+    EXPECT_EQ(fan.store.corner_value(half_edge(fan.faces[1], 0))[0], 1.0f);
+    EXPECT_EQ(fan.store.corner_value(half_edge(fan.faces[2], 0))[0], 11.0f);
+    EXPECT_EQ(fan.store.corner_value(half_edge(fan.faces[2], 0))[1], 0.0f);
+}
+
+TEST(AttributeStore, ASlideOffAStraightSeamCostsNothingAndOffABentOneCosts) {
+    Fan fan;
+    add_two_charts(fan);
+    fan.buffer.finalize_all();
+    double geometric = 0, attribute = 0;
+    fan.store.slide_error(fan.buffer, half_edge(fan.faces[0], 0), geometric, attribute);
+    EXPECT_NEAR(geometric, 0, 1e-12);  // the centre lies on the line from (−1, 0) to (1, 0)
+    EXPECT_NEAR(attribute, 0, 1e-12);  // and its values halfway between theirs on each chart
+    // The same seam bent: the centre lifted off the line by 0.5.
+    Fan bent;
+    for (size_t t = 0; t < kFan.size(); ++t) {
+        std::array<float, 9> tri = kFan[t];
+        for (int k = 0; k < 3; ++k)
+            if (tri[3 * k] == 0 && tri[3 * k + 1] == 0) tri[3 * k + 2] = 0.5f;
+        std::array<float, 6> uv;
+        for (int k = 0; k < 3; ++k)
+            uv[2 * k] = kFan[t][3 * k] + (t >= 2 ? 10.0f : 0.0f), uv[2 * k + 1] = kFan[t][3 * k + 1];
+        bent.add(tri, uv, 0);
+    }
+    bent.buffer.finalize_all();
+    geometric = attribute = 0;
+    bent.store.slide_error(bent.buffer, half_edge(bent.faces[0], 0), geometric, attribute);
+    EXPECT_NEAR(geometric, 0.25 * 2, 1e-9);  // 0.5² off, weighted by |(−1,0) − (1,0)| = 2
 }
 
 TEST(AttributeStore, DifferentMaterialsMakeASeam) {
@@ -126,8 +172,7 @@ TEST(AttributeStore, ACollapseIntoASeamVertexTakesItsValueOnThatSide) {
     const float* moved = s.store.corner_value(half_edge(a.face, 1));
     EXPECT_EQ(moved[0], 1.0f);  // (1,1)'s value on this chart, not (7,7)
     EXPECT_EQ(moved[1], 1.0f);
-    EXPECT_NEAR(s.store.quadric_area(seam),
-                area_before + s.store.quadric_area(corner), 1e-12);
+    EXPECT_NEAR(s.store.quadric_area(seam), area_before + s.store.quadric_area(corner), 1e-12);
 }
 
 TEST(AttributeStore, NoCollapseAlongASeamEdgeIntoASeamVertex) {
