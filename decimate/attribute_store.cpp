@@ -199,6 +199,7 @@ void AttributeStore::slide_error(const HalfEdgeBuffer& buffer, uint32_t h, doubl
         }
         c = across;
     } while (c != h);
+    if (r_side[0] == kNoIndex) return;  // no other seam edge (slides() rules that out)
     // Position: p's distance² from the line r–q, weighted by |r − q|.
     double d[3], e[3];
     for (int i = 0; i < 3; ++i) d[i] = pq[i] - pr[i], e[i] = pp[i] - pr[i];
@@ -207,7 +208,6 @@ void AttributeStore::slide_error(const HalfEdgeBuffer& buffer, uint32_t h, doubl
     double off2 = 0;
     for (int i = 0; i < 3; ++i) off2 += (e[i] - s * d[i]) * (e[i] - s * d[i]);
     geometric += off2 * std::sqrt(dd);
-    if (r_side[0] == kNoIndex) return;
     // Values, per side: p's against r's and q's interpolated at p's place along the line.
     const uint32_t q_side[2] = {q_corner, buffer.twin(h)};
     const uint32_t p_side[2] = {h, next_in_face(buffer.twin(h))};
