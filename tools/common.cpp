@@ -287,9 +287,10 @@ io::ChannelKinds kept_channel_kinds(const std::string& drop_list) {
 
 unsigned every_core() { return std::max(1u, std::thread::hardware_concurrency()); }
 
-void add_threads_option(CLI::App* cmd, unsigned& threads, const std::string& what) {
+void add_threads_option(CLI::App* cmd, unsigned& threads, const std::string& what, const std::string& details) {
     cmd->add_option("--threads", threads,
-                    what + " (default: every core, " + std::to_string(every_core()) + " here; 1: none)")
+                    what + " (default: every core, " + std::to_string(every_core()) + " here; 1: none)" +
+                        (details.empty() ? "" : "\n" + details))
         ->type_name("N")
         ->check(CLI::Range(1u, 1024u));
 }

@@ -54,9 +54,10 @@ io::ChannelKinds kept_channel_kinds(const std::string& drop_list);
 void add_drop_flag(CLI::App* cmd, ReadFlags& flags);
 // The cores of this machine (at least 1): --threads' default.
 unsigned every_core();
-// --threads N for convert and sort: `what` says what the threads (from 2) do; the default
-// (every core), "1: none" and the range 1..1024 are added.
-void add_threads_option(CLI::App* cmd, unsigned& threads, const std::string& what);
+// --threads N for convert, sort and decimate: `what` says what the threads (from 2) do, `details`
+// (a second paragraph, for --help-all) how; the default (every core), "1: none" and the range
+// 1..1024 are added.
+void add_threads_option(CLI::App* cmd, unsigned& threads, const std::string& what, const std::string& details = {});
 // For commands that measure the input as it is (info, compare): --strict's help says that it
 // makes bad triangles errors, without the skipping that convert, sort and decimate do.
 void strict_reports_bad_triangles(CLI::App* cmd);

@@ -863,15 +863,9 @@ void add_decimate(CLI::App& app, RangeProcesses* processes) {
                   "measure the output's error against the input at the end\n"
                   "Hausdorff, mean and RMS distance, as compare does");
     if (!processes)
-        cmd->add_option(
-               "--threads", opt->threads,
-               "decimate a file in N ranges at once (default: every core, " + std::to_string(every_core()) +
-                   " here)\n"
-                   "Each range of at least --buffer triangles is decimated with its own --buffer, and the seams "
-                   "between them are joined by one more pass; the output depends on N, not on timing. 1: one "
-                   "stream decimator")
-            ->type_name("N")
-            ->check(CLI::Range(1u, 1024u));
+        add_threads_option(cmd, opt->threads, "decimate a file in N ranges at once",
+                           "Each range of at least --buffer triangles is decimated with its own --buffer, and the "
+                           "seams between them are joined by one more pass; the output depends on N, not on timing");
     add_json_flag(cmd, opt->json);
     add_write_flags(cmd, opt->write);
     add_read_flags(cmd, opt->read);
