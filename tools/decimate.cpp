@@ -322,12 +322,14 @@ std::unique_ptr<decimate::StreamDecimator> make_decimator(const decimate::Option
     try {  // on the heap only to catch a refused reservation here
         return std::make_unique<decimate::StreamDecimator>(options, count, attributes);
     } catch (const std::bad_alloc&) {
+        // Per triangle: about 580 bytes for positions, more with the channels carried.
+        const size_t bytes = decimate::StreamDecimator::reserved_bytes(options.buffer_triangles, attributes);
         throw std::runtime_error(
-            "--buffer " + std::to_string(options.buffer_triangles) + " reserves " +
-            human_bytes(double(decimate::StreamDecimator::reserved_bytes(options.buffer_triangles, attributes))) +
-            " of memory (about 580 bytes a triangle), which this system refused: give a smaller --buffer (the "
+            "--buffer " + std::to_string(options.buffer_triangles) + " reserves " + human_bytes(double(bytes)) +
+            " of memory (about " + std::to_string(bytes / std::max<size_t>(options.buffer_triangles, 1)) +
+            " bytes a triangle), which this system refused: give a smaller --buffer (the "
             "default 400000 reserves " +
-            human_bytes(double(decimate::StreamDecimator::reserved_bytes(400000))) + ")");
+            human_bytes(double(decimate::StreamDecimator::reserved_bytes(400000, attributes))) + ")");
     }
 }
 
