@@ -52,11 +52,8 @@ SCANS=${SCANS:-1}
 RUNS=${RUNS:-3}
 DECIMATE_ARGS=${DECIMATE_ARGS:-}
 
-die() { echo "bench/attributes.sh: $*" >&2; exit 1; }
 # shellcheck source=bench/lib.sh
-source "$src/bench/lib.sh"  # measure, load
-[ -x /usr/bin/time ] || die "GNU time is missing: apt-get install time"
-command -v python3 >/dev/null || die "python3 is missing"
+source "$src/bench/lib.sh"  # die, measure, load; checks for GNU time and python3
 SHARED=$(cd "$SHARED" 2>/dev/null && pwd) || die "no shared directory (set SHARED)"
 mkdir -p "$BENCH_DIR"
 

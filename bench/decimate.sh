@@ -31,11 +31,8 @@ CGAL_MAX=${CGAL_MAX:-1500000}
 COMPARE=${COMPARE:-1}
 DECIMATE_ARGS=${DECIMATE_ARGS:-}
 
-die() { echo "bench/decimate.sh: $*" >&2; exit 1; }
 # shellcheck source=bench/lib.sh
-source "$src/bench/lib.sh"  # measure, load
-[ -x /usr/bin/time ] || die "GNU time is missing: apt-get install time"
-command -v python3 >/dev/null || die "python3 is missing"
+source "$src/bench/lib.sh"  # die, measure, load; checks for GNU time and python3
 mkdir -p "$BENCH_DIR"
 
 echo "== building in $BUILD_DIR" >&2

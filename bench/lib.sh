@@ -1,5 +1,12 @@
-# Shared by the bench scripts, sourced once they have set MEASURE_DIR (where GNU time's log and
-# the measured command's output go) and defined die().
+# Shared by the bench scripts. Sourcing it checks for GNU time and python3 (measure() needs both)
+# and defines die(); measure() needs MEASURE_DIR (where GNU time's log and the measured command's
+# output go) set before it is called.
+
+# die MESSAGE: the script's name and MESSAGE on stderr, exit 1.
+die() { echo "bench/$(basename "$0"): $*" >&2; exit 1; }
+
+[ -x /usr/bin/time ] || die "GNU time is missing: apt-get install time"
+command -v python3 >/dev/null || die "python3 is missing"
 
 # measure CMD...: runs CMD under GNU time; prints "wall_s<TAB>cpu_s<TAB>rss_kb" (CPU: user +
 # system of CMD and every process it waited for; RSS: the largest one's peak, as time reports it).

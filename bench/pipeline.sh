@@ -32,11 +32,8 @@ RUNS=${RUNS:-3}
 ALL_CASES="stl-to-ply-ascii ply-ascii-to-stl stl-to-ply-gz ply-gz-to-stl stl-to-obj obj-to-stl ply-gz-to-obj sort-stl-gz"
 CASES=${CASES:-$ALL_CASES}
 
-die() { echo "bench/pipeline.sh: $*" >&2; exit 1; }
 # shellcheck source=bench/lib.sh
-source "$src/bench/lib.sh"  # measure, load
-[ -x /usr/bin/time ] || die "GNU time is missing: apt-get install time"
-command -v python3 >/dev/null || die "python3 is missing"
+source "$src/bench/lib.sh"  # die, measure, load; checks for GNU time and python3
 mkdir -p "$BENCH_DIR"
 
 echo "== building in $BUILD_DIR" >&2
