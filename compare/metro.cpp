@@ -356,8 +356,8 @@ double bvh_nearest(const std::vector<BvhNode>& nodes, const double p[3], double 
 
 // Triangles held in memory, with their BVH and their corners' attribute values.
 struct TriangleIndex {
-    std::vector<float> xyz;  // 9 floats per triangle, in BVH order
-    int values = 0;          // attribute floats per corner (AttributeLayout::floats())
+    std::vector<float> xyz;            // 9 floats per triangle, in BVH order
+    int values = 0;                    // attribute floats per corner (AttributeLayout::floats())
     std::vector<float> corner_values;  // 3 × values floats per triangle, in BVH order
     std::vector<BvhNode> nodes;
 
@@ -406,15 +406,15 @@ struct SampleIndex {
     // floats far from the origin round by up to half a float step, 0.125 m at 4 000 000 as in
     // UTM coordinates, which showed as error in a mesh compared with itself.
     double origin[3] = {0, 0, 0};
-    std::vector<float> xyz;     // 3 floats per sample relative to origin, in BVH order
+    std::vector<float> xyz;  // 3 floats per sample relative to origin, in BVH order
     // Attribute floats per sample (AttributeLayout::floats()), and the samples' values: their
     // own, and at their nearest point of the streamed mesh so far (the point best2 measures).
-    // They stay in the order the samples were added (a permuted copy of them was compare's
-    // peak memory): sample i's are at record slot[i].
+    // They stay in the order the samples were added (a permuted copy would double the largest
+    // part of compare's memory): sample i's are at record slot[i].
     int values = 0;
     std::vector<float> own, other;  // `values` floats per sample each
     std::vector<uint32_t> slot;     // with values, after build()
-    std::vector<double> best2;  // running minimum squared distance
+    std::vector<double> best2;      // running minimum squared distance
     std::vector<BvhNode> nodes;
 
     // Appends a sample at p with its own attribute values (`values` floats; may be null when
