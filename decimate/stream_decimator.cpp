@@ -68,6 +68,7 @@ StreamDecimator::StreamDecimator(const Options& options, io::InputCount own, con
       rng_(options.seed),
       output_(options.output_chunk_triangles, attributes_ ? &attributes_->layout() : nullptr) {
     buffer_.set_attributes(attributes_.get());
+    face_scalars_.resize(attributes.face_scalar_count());
     stats_.buffer_capacity = options.buffer_triangles;
     if (options.sorted_axis) {
         sweep_capacity_ = 3 * options.buffer_triangles + 3;
@@ -123,22 +124,15 @@ void StreamDecimator::read_triangle(const io::TriangleChunk& in, size_t i, const
     if (buffer_.full() || buffer_.free_vertex_count() < 3) make_room(out);
     // The triangle's channels, as the attribute store keeps them.
     float corners[3 * kMaxAttributeComponents];
-    double face_scalars[64];
     uint32_t material = 0;
-    const size_t face_scalar_count = attributes_ ? attributes_->layout().face_scalar_count() : 0;
-    std::vector<double> many_face_scalars;
-    double* fs = face_scalars;
+    double* fs = face_scalars_.data();
     if (attributes_) {
         const AttributeLayout& layout = attributes_->layout();
         const int m = layout.size();
         for (int k = 0; k < 3; ++k) layout.gather(in, i, k, corners + k * m);
         attributes_->sanitize(corners, 3 * size_t(m));
         if (const uint32_t* mat = in.material_at(i)) material = *mat;
-        if (face_scalar_count > 64) {
-            many_face_scalars.resize(face_scalar_count);
-            fs = many_face_scalars.data();
-        }
-        for (size_t c = 0; c < face_scalar_count; ++c) fs[c] = *in.face_scalar_at(i, c);
+        for (size_t c = 0; c < face_scalars_.size(); ++c) fs[c] = *in.face_scalar_at(i, c);
     }
     if (options_.sorted_axis) track_sweep(tri);
     const HalfEdgeBuffer::Added added = [&] {

@@ -24,6 +24,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <vector>
 
 namespace meshstream::decimate {
 
@@ -157,6 +158,7 @@ private:
     double ratio_;
     HalfEdgeBuffer buffer_;
     std::unique_ptr<AttributeStore> attributes_;  // null for positions only
+    std::vector<double> face_scalars_;            // the triangle being read's (with attributes_)
     CollapseQueue queue_;
     Rng rng_;
     TriangleOutput output_;
