@@ -135,6 +135,9 @@ struct Carried {
     io::Channels channels;  // what the reader fills and the writer gets (no vertex ids)
     decimate::AttributeLayout layout;
     std::string dropped;  // in words; empty when nothing is
+    // Vertex scalars whose type float cannot hold exactly (the decimator keeps a corner's values
+    // as float), in words; empty when none.
+    std::string rounded;
 };
 
 Carried carried_channels(const DecimateOptions& opt, const io::MeshHeader& header, const io::Format& out_format,
@@ -156,6 +159,9 @@ Carried carried_channels(const DecimateOptions& opt, const io::MeshHeader& heade
                          " normal, colour, texture and scalar values per corner, more than the " +
                          std::to_string(decimate::kMaxAttributeComponents) +
                          " decimate carries: leave some out with --drop extra (or uvs)");
+    for (const io::ScalarChannel& s : c.channels.vertex_scalars)
+        if (s.type == io::ScalarType::kFloat64 || s.type == io::ScalarType::kInt32 || s.type == io::ScalarType::kUInt32)
+            c.rounded += (c.rounded.empty() ? "'" : ", '") + s.name + "' (" + io::scalar_type_name(s.type) + ")";
     return c;
 }
 
@@ -788,6 +794,10 @@ void run_decimate(const DecimateOptions& opt, RangeProcesses* processes) {
     // --drop's channels were not read: their loss was asked for, so it goes unsaid.
     if (!carried.dropped.empty())
         warnings.note("channels_dropped", dropped_channels_text(carried.dropped, *out->format, carried.channels));
+    if (!carried.rounded.empty())
+        warnings.note("channels_rounded", "vertex scalars " + carried.rounded +
+                                              " carried through decimation as float: values rounded to about 7 "
+                                              "significant digits");
     note_unused_write_flags(opt.write, *out->format, opt.output, warnings);
     for (const std::string& note : out->writer->notes()) warnings.note("output_note", note);
     note_dropped_triangles(sorted     ? sorted->dropped

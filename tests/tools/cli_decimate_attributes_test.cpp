@@ -347,3 +347,15 @@ TEST(CliDecimateChannels, VertexAndFaceScalarsComeThrough) {
     EXPECT_GT(on_their_side, 0.9 * double(triangles));
     EXPECT_LT(worst, 1e-4);
 }
+
+TEST(CliDecimateChannels, DoubleVertexScalarsAreSaidToBeRoundedToFloat) {
+    TempDir dir;
+    std::ofstream(dir / "d.ply") << "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+                                    "property float z\nproperty double t\nelement face 2\nproperty list uchar int "
+                                    "vertex_indices\nend_header\n0 0 0 0.1\n1 0 0 0.2\n1 1 0 0.3\n0 1 0 0.4\n"
+                                    "3 0 1 2\n3 0 2 3\n";
+    const CliRun r = run("decimate -r 1 " + dir / "d.ply" + " " + dir / "out.ply");
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.err.find("warning: vertex scalars 't' (double) carried through decimation as float"), std::string::npos)
+        << r.err;
+}
