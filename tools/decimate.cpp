@@ -14,10 +14,12 @@
 #include "decimate/stream_decimator.hpp"
 #include "io/byte_stream.hpp"
 #include "io/error.hpp"
+#include "io/triangle_stream.hpp"
 #include "sort/external_sort.hpp"
 #include "tools/cli_checks.hpp"
 #include "tools/commands.hpp"
 #include "tools/common.hpp"
+#include "tools/decimate_parts.hpp"
 #include "tools/decimate_report.hpp"
 #include "tools/decimate_threads.hpp"
 #include "tools/help.hpp"
@@ -53,7 +55,10 @@ struct DecimateOptions {
     std::optional<int> sorted_axis;
     std::string sort = "auto";  // --sort auto|always|never
     unsigned threads = every_core();
-    std::string weights;  // --weights normal=W,color=W,uv=W,NAME=W
+    bool threads_given = false;      // --threads given (else every core)
+    std::string part;                // --part k/K
+    std::vector<std::string> merge;  // --merge PART ... (the merge job, --part K/K)
+    std::string weights;             // --weights normal=W,color=W,uv=W,NAME=W
     bool report = false;
     bool json = false;
     ReadFlags read;
@@ -475,6 +480,125 @@ io::ReadOptions decimate_read_options(const DecimateOptions& opt, const io::Form
     return read;
 }
 
+// The ranges of `ranges` of an input of `cut_triangles` triangles (--threads, meshstream-mpi,
+// --part): every job that decimates a range of the input plans it here, so that their plans agree.
+RangesJob ranges_job(const DecimateOptions& opt, const io::ReadOptions& read, const Carried& carried,
+                     const decimate::Options& options, uint64_t cut_triangles, unsigned ranges) {
+    RangesJob job;
+    job.open = [&opt, &read] { return open_triangle_input(opt.input, opt.read, read, Command::kDecimate); };
+    job.make_decimator = [&carried](const decimate::Options& o) {
+        static const io::InputCount kNoCount;  // a range and the seam pass take a ratio
+        return make_decimator(o, kNoCount, carried.layout);
+    };
+    job.tmpdir = opt.read.tmpdir;
+    job.channels = carried.channels;
+    job.options = options;
+    job.options.target.reset();
+    if (options.target) job.options.ratio = std::min(1.0, double(*options.target) / double(cut_triangles));
+    job.target = options.target;
+    job.cut_triangles = cut_triangles;
+    job.ranges = ranges;
+    return job;
+}
+
+// What a part file records of the plan, for the merge to check (decimate_parts.hpp).
+PartPlan part_plan(const RangesJob& job, const Carried& carried) {
+    PartPlan plan;
+    plan.options = job.options;
+    plan.target = job.target;
+    plan.cut_triangles = job.cut_triangles;
+    plan.ranges = job.ranges;
+    plan.omega = carried.layout.omega();
+    plan.channels = carried.channels;
+    return plan;
+}
+
+// --part k/K: the input must be cut into exactly K ranges, as --threads K would cut it.
+void refuse_other_range_count(const DecimateOptions& opt, PartIndex part, const std::string& input_name,
+                              uint64_t cut_triangles, unsigned ranges) {
+    if (ranges == part.parts) return;
+    if (opt.buffer < kMinRangeBuffer)
+        throw UsageError("--part " + opt.part + ": a --buffer below " + std::to_string(kMinRangeBuffer) +
+                         " is never cut into ranges (--buffer " + std::to_string(opt.buffer) + ")");
+    throw UsageError(input_name + ": " + std::to_string(cut_triangles) + " triangles through --buffer " +
+                     std::to_string(opt.buffer) + " make at most " + std::to_string(ranges) +
+                     (ranges == 1 ? " range" : " ranges") + " (each holds at least --buffer triangles), not " +
+                     std::to_string(part.parts) + ": " +
+                     (ranges >= 2 ? "use --part k/" + std::to_string(ranges) + " or a smaller --buffer"
+                                  : std::string("the input is too small to cut; decimate it in one job")));
+}
+
+// --part k/K with k < K: range k-1 of the plan --threads K makes, decimated into the part file
+// OUT. The channels carried are the ones the merge's output keeps: --to's format's, else every
+// channel of the input (less --drop).
+void decimate_part(const DecimateOptions& opt, PartIndex part) {
+    const auto start = std::chrono::steady_clock::now();
+    if (opt.json) refuse_json_with_stdout_output(opt.output);
+    const io::Format& out_format =
+        opt.write.to.empty() ? io::kTriangleStreamFormat : resolve_output_format(opt.output, opt.write);
+    const io::WriteOptions wo = opt.write.options(opt.read, out_format);
+    const io::ReadOptions read = decimate_read_options(opt, out_format, wo);
+    io::TriangleInput in = open_triangle_input(opt.input, opt.read, read, Command::kDecimate);
+    const io::MeshHeader header = in.header();
+    const std::string input_name = in.name();
+    const std::string format_name(in.format().name);
+    const RunFile input_file{opt.input, format_name, in.source().gzip()};
+    refuse_output_over_inputs(opt.output, std::vector<std::string>{}, {input_files(opt.input, header)});
+    std::optional<CountPass> counted;
+    std::optional<uint64_t> input_count = header.triangle_count;
+    in.close();                        // every pass below, and the range, open the input afresh
+    if (opt.target && !input_count) {  // as the merge counts it (run_decimate)
+        counted = count_usable_triangles(opt, read);
+        input_count = counted->count.promised;
+    }
+    const decimate::Options options = decimation_options(opt, header, input_name, format_name, input_count);
+    const Carried carried = carried_channels(opt, header, out_format, wo, input_name);
+    std::optional<uint64_t> cut_count = input_count ? input_count : header.triangle_estimate;
+    if (!cut_count) {
+        counted = count_usable_triangles(opt, read);
+        counted->for_threads = true;
+        cut_count = counted->count.promised;
+    }
+    const unsigned ranges = range_count(part.parts, *cut_count, opt.buffer);
+    refuse_other_range_count(opt, part, input_name, *cut_count, ranges);
+
+    const RangesJob job = ranges_job(opt, read, carried, options, *cut_count, ranges);
+    PartFileSink sink(opt.output, part, fingerprint_file(opt.input), part_plan(job, carried));
+    std::atomic<bool> stop{false};
+    run_range(job, part.k - 1, sink, stop);
+    if (sink.error()) std::rethrow_exception(sink.error());
+    const double seconds = seconds_since(start);
+
+    // The range's figures; the merge reports the whole decimation (its warnings included).
+    const uint64_t first = *cut_count * (part.k - 1) / part.parts, end = *cut_count * part.k / part.parts;
+    const uint64_t in_range = sink.decimated();
+    if (!opt.json && !global().quiet) {
+        std::fprintf(stderr, "decimated part %s of %s -> %s\n", opt.part.c_str(), input_name.c_str(),
+                     opt.output.c_str());
+        std::fprintf(stderr, "  range: triangles [%llu, %llu) of %llu, decimated to %llu (%s in the part file)\n",
+                     (unsigned long long)first, (unsigned long long)end, (unsigned long long)*cut_count,
+                     (unsigned long long)sink.triangles(), human_bytes(double(sink.bytes())).c_str());
+        std::fprintf(stderr, "  time %.3f s, peak RSS %s; merge with --part %u/%u\n", seconds,
+                     human_bytes(double(peak_rss_bytes())).c_str(), part.parts, part.parts);
+    }
+    if (opt.json) {
+        RunReport report;
+        report.command = "decimate";
+        report.inputs = {input_file};
+        report.outputs = {{opt.output, "part", false}};
+        report.triangles_in = in_range;
+        report.triangles_out = sink.triangles();
+        report.seconds = seconds;
+        report.peak_rss_bytes = peak_rss_bytes();
+        report.details = {{"part", part.k},
+                          {"parts", part.parts},
+                          {"range_first", first},
+                          {"range_end", end},
+                          {"part_file_bytes", sink.bytes()}};
+        print_json(run_report_json(report, Warnings{}));
+    }
+}
+
 // meshstream-mpi, every process but the first: the range process 0's plan gives it, decimated
 // and sent to process 0 (which reports everything, failures included).
 void decimate_one_range(const DecimateOptions& opt, RangeProcesses& processes) {
@@ -524,6 +648,35 @@ private:
 
 void run_decimate(const DecimateOptions& opt, RangeProcesses* processes) {
     if (processes && processes->rank() > 0) return decimate_one_range(opt, *processes);
+    std::optional<PartIndex> part;
+    if (!opt.part.empty()) part = parse_part(opt.part);  // checked by the option
+    if (!opt.merge.empty() && !part)
+        throw UsageError("--merge gives the part files to the merge job, --part K/K: give --part too");
+    if (part) {
+        const std::string both = "--part " + opt.part;
+        if (opt.threads_given)
+            throw UsageError(both + " decimates one range of the input in this job; --threads does not go with it");
+        // Every job opens IN by its name and reads it from its start to its range.
+        if (!is_regular_file(opt.input))
+            throw UsageError((opt.input == "-" ? std::string("<stdin>") : opt.input) + ": " + both +
+                             ": every job reads IN from its start, so IN must be a file, not '-' or a pipe");
+        if (opt.sort == "always")
+            throw UsageError(both +
+                             ": --sort always decimates a sorted stream in one job; sort first (meshstream sort IN "
+                             "SORTED.stl), then make the parts from the sorted file");
+        if (!part->merge()) {
+            if (!opt.merge.empty())
+                throw UsageError("--merge goes with the merge job, --part " + std::to_string(part->parts) + "/" +
+                                 std::to_string(part->parts) + ", not " + both);
+            if (opt.report) throw UsageError(both + " writes a part file, not a mesh: give --report to the merge job");
+            return decimate_part(opt, *part);
+        }
+        if (opt.merge.size() != part->parts - 1)
+            throw UsageError(both + " merges parts 1/" + std::to_string(part->parts) + " to " +
+                             std::to_string(part->parts - 1) + "/" + std::to_string(part->parts) +
+                             ": give --merge once for each of their " + std::to_string(part->parts - 1) +
+                             " part files, found " + std::to_string(opt.merge.size()));
+    }
     PlanSharing sharing(processes);
     if (processes) {
         // Every process opens the input by its name, and each decimates a range of it as read.
@@ -576,12 +729,13 @@ void run_decimate(const DecimateOptions& opt, RangeProcesses* processes) {
     // bytes a triangle or more, uncompressed).
     const bool sort_first = opt.sort == "always";
     std::optional<uint64_t> cut_count = input_count ? input_count : header.triangle_estimate;
-    const unsigned cut_into = processes ? processes->count() : opt.threads;
+    const unsigned cut_into = processes ? processes->count() : part ? part->parts : opt.threads;
     unsigned ranges = 1;
     if (cut_into > 1 && !sort_first && is_regular_file(opt.input)) {
         const uint64_t bytes = in.source().stored_size().value_or(0);
         const uint64_t most = in.source().gzip() ? std::numeric_limits<uint64_t>::max() : bytes / 8;
-        if (!cut_count && most >= 2 * uint64_t(opt.buffer)) {
+        // The merge counts whatever the size, to say how many ranges the input makes.
+        if (!cut_count && (most >= 2 * uint64_t(opt.buffer) || part)) {
             in.close();
             counted = count_usable_triangles(opt, read);
             counted->for_threads = true;
@@ -590,14 +744,35 @@ void run_decimate(const DecimateOptions& opt, RangeProcesses* processes) {
         }
         if (cut_count) ranges = range_count(cut_into, *cut_count, opt.buffer);
     }
-    // The ranges' outputs wait in --tmpdir: where nothing can be written, one thread decimates.
+    // The ranges' outputs wait in --tmpdir: where nothing can be written, one thread decimates
+    // (the merge of --part fails: its ranges were decimated elsewhere).
     std::string one_thread_why;
     if (ranges > 1) {
         try {
             io::TempFile probe(opt.read.tmpdir, "meshstream-range");
         } catch (const io::Error& e) {
+            if (part) throw;
             ranges = 1;
             one_thread_why = e.what();
+        }
+    }
+    // The merge: its plan is the parts' (each part file says it was made with it), read before
+    // anything is written; in range order.
+    std::vector<std::unique_ptr<PartFileReader>> part_files;
+    if (part) {
+        if (!cut_count)
+            throw UsageError(input_name + ": --part needs the input's triangle count, which it cannot find");
+        refuse_other_range_count(opt, *part, input_name, *cut_count, ranges);
+        const PartPlan plan = part_plan(ranges_job(opt, read, carried, options, *cut_count, ranges), carried);
+        const InputFingerprint fingerprint = fingerprint_file(opt.input);
+        part_files.resize(part->parts - 1);
+        for (const std::string& path : opt.merge) {
+            auto file = std::make_unique<PartFileReader>(path, part->parts, fingerprint, plan);
+            std::unique_ptr<PartFileReader>& slot = part_files[file->k() - 1];
+            if (slot)
+                throw UsageError(path + ": part " + std::to_string(file->k()) + "/" + std::to_string(part->parts) +
+                                 " is given twice, as " + slot->path() + " too");
+            slot = std::move(file);
         }
     }
 
@@ -616,7 +791,8 @@ void run_decimate(const DecimateOptions& opt, RangeProcesses* processes) {
     // --sort: what may happen. Input known to be sorted (its flag, --sorted-axis) is decimated
     // as it comes in auto: sorting again cannot help it, a larger buffer can.
     const bool read_once = !is_regular_file(opt.input);
-    const bool may_restart = opt.sort == "auto" && !options.sorted_axis;
+    // (--part: every job decimates as read; a sort would have to be one job's.)
+    const bool may_restart = opt.sort == "auto" && !options.sorted_axis && !part;
     const uint64_t budget = opt.read.options().memory_budget_bytes;
     io::ReadOptions sort_ro = read;  // the reader's share while sorting
     sort_ro.memory_budget_bytes = budget / 4;
@@ -640,20 +816,7 @@ void run_decimate(const DecimateOptions& opt, RangeProcesses* processes) {
     if (!sort_first && ranges > 1) {
         in.close();  // each range opens the input itself
         const auto attempt = std::chrono::steady_clock::now();
-        RangesJob job;
-        job.open = [&] { return open_triangle_input(opt.input, opt.read, read, Command::kDecimate); };
-        job.make_decimator = [&carried](const decimate::Options& o) {
-            static const io::InputCount kNoCount;  // a range and the seam pass take a ratio
-            return make_decimator(o, kNoCount, carried.layout);
-        };
-        job.tmpdir = opt.read.tmpdir;
-        job.channels = carried.channels;
-        job.options = options;
-        job.options.target.reset();
-        if (options.target) job.options.ratio = std::min(1.0, double(*options.target) / double(*cut_count));
-        job.target = options.target;
-        job.cut_triangles = *cut_count;
-        job.ranges = ranges;
+        RangesJob job = ranges_job(opt, read, carried, options, *cut_count, ranges);
         job.stop_at_forced_write = may_restart;
         // Output that cannot be taken back is held until no range can call for a sort any more.
         job.seams_after_ranges = may_restart && gate.holding();
@@ -664,6 +827,13 @@ void run_decimate(const DecimateOptions& opt, RangeProcesses* processes) {
                 processes->receive(sinks, stop, carried.channels);
             };
             sharing.share(RangePlan{job.options, job.cut_triangles, job.ranges, job.stop_at_forced_write});
+        }
+        if (part) {
+            // Ranges 0 .. K-2 from their part files, in range order, as they are read.
+            job.remote_ranges = ranges - 1;
+            job.receive_remote = [&part_files, &carried](std::span<RangeSink* const> sinks, std::atomic<bool>& stop) {
+                for (size_t i = 0; i < sinks.size(); ++i) part_files[i]->feed(*sinks[i], stop, carried.channels);
+            };
         }
         threaded = decimate_in_ranges(job, emit, [&](uint64_t done) { progress.update(done); });
         if (threaded->stopped_at_forced_write) {
@@ -767,7 +937,8 @@ void run_decimate(const DecimateOptions& opt, RangeProcesses* processes) {
     DecimateFacts facts;
     facts.stats = threaded ? threaded->stats : decimator->stats();
     facts.ratio = threaded ? threaded->ratio : decimator->ratio();
-    facts.threads = threaded && !processes ? ranges : 1;
+    facts.threads = threaded && !processes && !part ? ranges : 1;
+    if (part) facts.parts = ranges;
     if (processes) facts.processes = threaded ? ranges : 1;
     if (threaded) {
         facts.seam_buffer = seam_buffer(opt.buffer);
@@ -823,6 +994,15 @@ void run_decimate(const DecimateOptions& opt, RangeProcesses* processes) {
     report.seconds = seconds;
     report.peak_rss_bytes = peak_rss_bytes();
     report.details = decimate_details_json(facts);
+    if (part) {
+        nlohmann::ordered_json files = nlohmann::ordered_json::array();
+        for (const auto& f : part_files)
+            files.push_back({{"path", f->path()},
+                             {"part", f->k()},
+                             {"triangles_in", f->outcome().stats.triangles_in},
+                             {"triangles", f->triangles()}});
+        report.details["part_files"] = files;
+    }
     if (opt.report) report.details["error"] = report_error(opt, facts);
     if (opt.json) print_json(run_report_json(report, warnings));
 }
@@ -874,10 +1054,35 @@ void add_decimate(CLI::App& app, RangeProcesses* processes) {
     cmd->add_flag("--report", opt->report,
                   "measure the output's error against the input at the end\n"
                   "Hausdorff, mean and RMS distance, as compare does");
-    if (!processes)
+    CLI::Option* threads = nullptr;
+    if (!processes) {
         add_threads_option(cmd, opt->threads, "decimate a file in N ranges at once",
                            "Each range of at least --buffer triangles is decimated with its own --buffer, and the "
                            "seams between them are joined by one more pass; the output depends on N, not on timing");
+        threads = cmd->get_option("--threads");
+        cmd->add_option("--part", opt->part,
+                        "one of K jobs: k < K writes range k to the part file OUT, K/K merges them\n"
+                        "The ranges of --threads K as separate jobs, every one with the same options: job k (1 .. "
+                        "K-1) decimates range k of IN into the part file OUT (--to names the merge's output format, "
+                        "which decides the channels carried); job K/K, with --merge, decimates the last range, joins "
+                        "the parts' seams and writes OUT, the bytes --threads K writes. IN must be a file; every job "
+                        "decimates as read (--sort never)")
+            ->type_name("k/K")
+            ->group(kMoreOptions)
+            ->check(CLI::Validator(
+                [](const std::string& text) -> std::string {
+                    if (parse_part(text)) return {};
+                    return "must be k/K with 1 <= k <= K and 2 <= K <= 1024, found '" + text + "'";
+                },
+                ""));
+        cmd->add_option("--merge", opt->merge,
+                        "a part file of --part k/K (k < K), for the merge job --part K/K\n"
+                        "Once for each part, in any order; each is checked against this job's input and options "
+                        "before any work")
+            ->type_name("PART")
+            ->allow_extra_args(false)  // one file a --merge: the next argument may be IN
+            ->group(kMoreOptions);
+    }
     add_json_flag(cmd, opt->json);
     add_write_flags(cmd, opt->write);
     add_read_flags(cmd, opt->read);
@@ -907,7 +1112,10 @@ void add_decimate(CLI::App& app, RangeProcesses* processes) {
     cmd->footer(
         "  meshstream decimate scan.ply scan.glb -r 0.01\n"
         "  meshstream sort big.stl - | meshstream decimate - out.glb -r 0.01");
-    cmd->callback([opt, processes] { run_decimate(*opt, processes); });
+    cmd->callback([opt, processes, threads] {
+        opt->threads_given = threads && threads->count() > 0;
+        run_decimate(*opt, processes);
+    });
 }
 
 }  // namespace meshstream::tools

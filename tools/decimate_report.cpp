@@ -64,7 +64,9 @@ void note_decimate_warnings(const DecimateFacts& f, Warnings& warnings) {
                           " triangles) filled with triangles along seams it could not join yet: " +
                           std::to_string(f.seam_forced_writes) +
                           " triangles force-written at full resolution there; raise --buffer or " +
-                          (f.processes > 0 ? "use fewer ranks" : "lower --threads"));
+                          (f.processes > 0 ? "use fewer ranks"
+                           : f.parts > 0   ? "use fewer parts"
+                                           : "lower --threads"));
     if (s.sort_violations > 0)
         warnings.note(
             "not_sorted_as_stated",
@@ -192,6 +194,7 @@ nlohmann::ordered_json decimate_details_json(const DecimateFacts& f) {
     if (f.count_pass_seconds) j["count_pass_seconds"] = *f.count_pass_seconds;
     j["threads"] = f.threads;
     if (f.processes > 0) j["processes"] = f.processes;
+    if (f.parts > 0) j["parts"] = f.parts;
     if (f.sort.kind == SortOutcome::Kind::kSorted)
         j["sorted_first"] = {{"axis", std::string(1, axis_name(f.sort.axis))},
                              {"requested", f.sort.requested},
@@ -226,6 +229,11 @@ void print_decimate_summary(const DecimateFacts& f, const std::string& output, d
                      "  processes %u: %u ranges decimated at once by MPI ranks, seams joined by a pass through %zu "
                      "triangles\n",
                      f.processes, f.processes, f.seam_buffer);
+    if (f.parts > 1)
+        std::fprintf(stderr,
+                     "  parts %u: ranges 1 to %u read from part files, range %u decimated here, seams joined by a "
+                     "pass through %zu triangles\n",
+                     f.parts, f.parts - 1, f.parts, f.seam_buffer);
     if (f.weld_eps > 0)
         std::fprintf(stderr, "  weld %.6g: %llu vertices merged\n", f.weld_eps, (unsigned long long)s.vertices_merged);
     if (f.used_axis)

@@ -54,6 +54,9 @@ struct DecimateFacts {
     // meshstream-mpi: the processes (MPI ranks) that decimated one range each (0: none; threads
     // is then 1).
     unsigned processes = 0;
+    // --part K/K (the merge job): the K ranges, K-1 of them decimated by other jobs into part
+    // files (0: none; threads is then 1).
+    unsigned parts = 0;
     size_t seam_buffer = 0;
     uint64_t seam_forced_writes = 0;
 };
