@@ -351,7 +351,10 @@ void PartFileSink::close(const RangeOutcome& outcome, std::exception_ptr error) 
         end.value(outcome.forced_at);
         end.value(pieces_);
         end.value(triangles_);
-        end.value(hash_);
+        // The hash covers the end's figures too: a damaged one is refused, not summed.
+        const uint64_t hash =
+            io::hash_bytes(reinterpret_cast<const std::byte*>(end.bytes.data()), end.bytes.size(), hash_);
+        end.value(hash);
         end.bytes.insert(end.bytes.end(), kEndMagic, kEndMagic + sizeof kEndMagic);
         sink_->write(end.bytes.data(), end.bytes.size());
         sink_->commit();
@@ -472,8 +475,13 @@ bool PartFileReader::read_pieces(
         ++pieces;
         triangles += n;
     }
+    // The end's figures, as the writer hashed them (all of the end but the hash and the magic).
+    std::vector<char> end(kEndBytes - 12);
+    if (!read_at(fd.get(), offset, end.data(), end.size(), path_))
+        throw io::Error(path_, offset, 0, "part file cut short while it was read");
+    hash = io::hash_bytes(reinterpret_cast<const std::byte*>(end.data()), end.size(), hash);
     if (hash != hash_)
-        throw io::Error(path_, "damaged part file: its pieces' bytes are not the ones written (their hash differs)");
+        throw io::Error(path_, "damaged part file: its bytes are not the ones written (their hash differs)");
     return true;
 }
 

@@ -16,11 +16,11 @@
 //   pieces:  u8 1, u8 piece (Piece), f64 weight, u64 n, then n TriangleRecords (as the MPI
 //            ranks send them)
 //   end:     u8 2, decimate::Stats (the range's), u8 forced, u64 forced_at, u64 pieces,
-//            u64 triangles, u64 hash of the pieces' bytes, 'M' 'S' 'P' 'E'
+//            u64 triangles, u64 hash of every byte from the first piece to here, 'M' 'S' 'P' 'E'
 //
-// The end has a fixed size, so a part file is checked complete before the merge starts; a
-// corrupt piece is found while it is read (its hash at the end), before the output is renamed
-// into place. Memory: a part file is written and read a chunk at a time (the range's output
+// The end has a fixed size, so a part file is checked complete before the merge starts; its
+// pieces are read through once then, so that a damaged byte (the hash) is refused before any
+// work. Memory: a part file is written and read a chunk at a time (the range's output
 // chunks).
 #pragma once
 

@@ -165,9 +165,15 @@ TEST(CliDecimateParts, AMissingCutShortOrDamagedPartIsRefused) {
     std::string flipped = whole;
     flipped[flipped.size() / 2] ^= 0x40;
     write_file(damaged, flipped);
+    // A byte of the range's statistics in the file's end.
+    const std::string damaged_end = dir / "damaged_end";
+    std::string end_flipped = whole;
+    end_flipped[end_flipped.size() - 60] ^= 0x01;
+    write_file(damaged_end, end_flipped);
     for (const auto& [file, message] :
          {std::pair{cut, "not a complete part file: cut short"}, std::pair{damaged, "damaged part file"},
-          std::pair{missing, "cannot open: No such file or directory"}, std::pair{mesh(), "not a part file"}}) {
+          std::pair{damaged_end, "damaged part file"}, std::pair{missing, "cannot open: No such file or directory"},
+          std::pair{mesh(), "not a part file"}}) {
         const CliRun r = run("decimate " + options + " --part 3/3 --merge " + parts.front() + " --merge " + file + " " +
                              mesh() + " " + out);
         EXPECT_EQ(r.code, 1) << file << ": " << r.err;
