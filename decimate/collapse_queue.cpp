@@ -41,7 +41,9 @@ void CollapseQueue::push(HalfEdgeBuffer& buffer, uint32_t h, bool reverse, doubl
     const uint32_t t = buffer.twin(h);
     if (is_half_edge(t)) buffer.queue_key(t) = kNotQueued;
     const uint32_t bucket = bucket_of(error);
-    buffer.queue_key(h) = static_cast<uint16_t>(bucket | (reverse ? kReverse : 0));
+    const uint16_t key = static_cast<uint16_t>(bucket | (reverse ? kReverse : 0));
+    if (buffer.queue_key(h) == key) return;
+    buffer.queue_key(h) = key;
     if (fill_[bucket] % kChunkEntries == 0 && free_chunk_count_ == 0 && chunk_high_ == chunk_capacity_) purge(buffer);
     append(bucket, h);
 }
@@ -80,7 +82,7 @@ bool CollapseQueue::current(const HalfEdgeBuffer& buffer, uint32_t h, uint32_t b
     return buffer.face_alive(face_of(h)) && key != kNotQueued && (key & kBucketMask) == bucket;
 }
 
-uint32_t CollapseQueue::pop(HalfEdgeBuffer& buffer, bool& dirty) {
+uint32_t CollapseQueue::pop(HalfEdgeBuffer& buffer, bool& rerate) {
     for (;;) {
         const int found = lowest_bucket();
         if (found < 0) return kNoIndex;
@@ -101,12 +103,12 @@ uint32_t CollapseQueue::pop(HalfEdgeBuffer& buffer, bool& dirty) {
         if (!current(buffer, h, bucket)) continue;
         const uint16_t key = buffer.queue_key(h);
         buffer.queue_key(h) = kNotQueued;
-        dirty = (key & kDirty) != 0;
+        rerate = false;
         if ((key & kReverse) == 0) return h;
         const uint32_t t = buffer.twin(h);
         if (is_half_edge(t)) return t;
         // The twin is gone since (written, or the edge opened): h is rated afresh.
-        dirty = true;
+        rerate = true;
         return h;
     }
 }

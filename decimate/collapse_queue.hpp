@@ -12,10 +12,9 @@
 // Entries are half-edge indices in chunks of 15 from a fixed pool; when the pool runs out, the
 // skipped-to-be entries are dropped (purge()), which frees at least a quarter of it.
 //
-// A key may be a lower bound (kDirty): an edge whose end just gained a quadric's planes costs
-// at least what it cost before (quadrics only grow), so it keeps its place and is rated again
-// only when it comes up (lazy evaluation; Garland & Heckbert re-rate every edge of the merged
-// vertex at once, and most of those ratings are superseded before they are used).
+// Edges whose cost changed are queued again at once (Garland & Heckbert): after a collapse p→q
+// the caller rates q's edges while q's fan is still in the cache from checking and applying the
+// collapse; their old entries are skipped when they come up.
 //
 // Memory: for a buffer of N triangles, about (4·N / 15 + 16 400) chunks of 64 bytes (8 MB at
 // the default 400 000) plus 80 KB of bucket heads and bitmaps, allocated once.
@@ -32,8 +31,7 @@ class CollapseQueue {
 public:
     static constexpr uint32_t kBuckets = 1u << 14;
     static constexpr uint16_t kBucketMask = kBuckets - 1;  // in a Face::key: the bucket,
-    static constexpr uint16_t kReverse = 1u << 14;         // the twin collapses,
-    static constexpr uint16_t kDirty = 1u << 15;           // the key is a lower bound only
+    static constexpr uint16_t kReverse = 1u << 14;         // the twin collapses
 
     explicit CollapseQueue(size_t face_capacity);
     static size_t reserved_bytes(size_t face_capacity);
@@ -43,22 +41,16 @@ public:
     static uint32_t bucket_of(double error);
 
     // Queues the collapse of the edge of half-edge h, in the direction of h or (`reverse`) of
-    // its twin, rated `error`. Whatever was queued for the edge before no longer counts.
+    // its twin, rated `error`. Whatever was queued for the edge before no longer counts; an
+    // edge queued under the same key already keeps its entry.
     void push(HalfEdgeBuffer& buffer, uint32_t h, bool reverse, double error);
     // Nothing is queued for the edge of h any more.
     static void forget(HalfEdgeBuffer& buffer, uint32_t h);
-    // The edge of h (when queued) keeps its key as a lower bound of its error, which has grown
-    // (an end's quadric gained planes, or an end was written): it is rated again when it
-    // comes up. Its direction may change then.
-    static void mark_dirty(HalfEdgeBuffer& buffer, uint32_t h) {
-        uint16_t& key = buffer.queue_key(h);
-        if (key != kNotQueued) key |= kDirty;
-    }
     // Removes the cheapest current entry and returns the half-edge p→q to collapse, or
-    // kNoIndex when nothing is queued; `dirty` tells whether its key was only a lower bound (or
-    // the edge must be rated afresh: the twin it was queued to collapse is gone).
-    // The edge is no longer queued afterwards.
-    uint32_t pop(HalfEdgeBuffer& buffer, bool& dirty);
+    // kNoIndex when nothing is queued; `rerate` tells that the edge must be rated afresh
+    // instead (the twin it was queued to collapse is gone). The edge is no longer queued
+    // afterwards.
+    uint32_t pop(HalfEdgeBuffer& buffer, bool& rerate);
     // Empties the queue; every face's keys become kNotQueued.
     void clear(HalfEdgeBuffer& buffer);
 

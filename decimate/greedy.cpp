@@ -58,11 +58,14 @@ namespace {
 // Rates the edges of v; with `skip_pending`, not those whose other end is still listed for
 // take_pending() (it rates them when its turn comes: each edge once).
 void rate_edges_around(HalfEdgeBuffer& buffer, CollapseQueue& queue, uint32_t v, bool skip_pending) {
-    // With channels every rating reads both ends' attribute records, far apart in their pool:
-    // asked for all at once, their cache misses overlap (a hint only).
-    if (const AttributeStore* attributes = buffer.attributes())
-        for (uint32_t c = buffer.vertex(v).first_corner; c != kNoIndex; c = buffer.next_corner(c))
-            attributes->prefetch(buffer.corner_vertex(next_in_face(c)));
+    // Every rating reads both ends' vertex records (and attribute records, with channels), far
+    // apart in their pools: asked for all at once, their cache misses overlap (a hint only).
+    const AttributeStore* attributes = buffer.attributes();
+    for (uint32_t c = buffer.vertex(v).first_corner; c != kNoIndex; c = buffer.next_corner(c)) {
+        const uint32_t to = buffer.corner_vertex(next_in_face(c));
+        buffer.prefetch_vertex(to);
+        if (attributes) attributes->prefetch(to);
+    }
     for (uint32_t c = buffer.vertex(v).first_corner; c != kNoIndex; c = buffer.next_corner(c)) {
         const uint32_t to = buffer.corner_vertex(next_in_face(c));
         if (!skip_pending || (buffer.vertex(to).flags & kPending) == 0) rate_edge(buffer, queue, c);  // v→next
@@ -102,12 +105,10 @@ void rate_all(HalfEdgeBuffer& buffer, CollapseQueue& queue) {
 bool collapse_cheapest(HalfEdgeBuffer& buffer, CollapseQueue& queue) {
     const PhaseTimer timer(Phase::kQueue);
     for (;;) {
-        bool dirty = false;
-        const uint32_t h = queue.pop(buffer, dirty);
+        bool rerate = false;
+        const uint32_t h = queue.pop(buffer, rerate);
         if (h == kNoIndex) return false;
-        if (dirty) {
-            // Its key was a lower bound: rated now, it goes back where it belongs (straight
-            // back out, when that is still the cheapest bucket).
+        if (rerate) {
             rate_edge(buffer, queue, h);
             continue;
         }
@@ -122,21 +123,10 @@ bool collapse_cheapest(HalfEdgeBuffer& buffer, CollapseQueue& queue) {
             continue;
         }
         apply_collapse(buffer, h, placement.target);
-        // q's queued edges cost at least what they did (Q_q only grew): their keys stay, as
-        // lower bounds. Its other edges (refused before, or not eligible) are rated afresh, as
-        // are blocked neighbours', which may have valid collapses now.
+        // q's edges are rated again at once, while its fan is in the cache from validating and
+        // applying the collapse, as are blocked neighbours' (they may have valid collapses now).
+        rate_vertex_edges(buffer, queue, q);
         for (uint32_t c = buffer.vertex(q).first_corner; c != kNoIndex; c = buffer.next_corner(c)) {
-            for (const uint32_t e : {c, prev_in_face(c)}) {
-                const uint32_t t = buffer.twin(e);
-                const bool queued =
-                    buffer.queue_key(e) != kNotQueued || (is_half_edge(t) && buffer.queue_key(t) != kNotQueued);
-                if (!queued) {
-                    rate_edge(buffer, queue, e);
-                    continue;
-                }
-                CollapseQueue::mark_dirty(buffer, e);
-                if (is_half_edge(t)) CollapseQueue::mark_dirty(buffer, t);
-            }
             for (const uint32_t w : {buffer.corner_vertex(next_in_face(c)), buffer.corner_vertex(prev_in_face(c))}) {
                 Vertex& x = buffer.vertex(w);
                 if ((x.flags & kBlocked) == 0) continue;
