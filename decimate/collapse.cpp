@@ -261,6 +261,34 @@ bool pinches_link(HalfEdgeBuffer& buffer, const Edge& e) {
     auto other = [&](uint32_t x) { return x != e.p && x != e.q && x != e.r && x != e.s; };
     const Vertex& vp = buffer.vertex(e.p);
     const Vertex& vq = buffer.vertex(e.q);
+    if (vq.face_count <= kMaxRing && vp.face_count <= kMaxRing) {
+        // q's neighbours marked (each corner names two; repeats do no harm), p's gathered, then
+        // looked up. The two corner lists are walked in step: each is a chain of cache misses,
+        // and the two chains overlap.
+        const uint32_t mark = buffer.new_mark();
+        uint32_t around_p[2 * kMaxRing];
+        uint32_t count = 0;
+        uint32_t a = vq.first_corner, b = vp.first_corner;
+        while (a != kNoIndex || b != kNoIndex) {
+            if (a != kNoIndex) {
+                const Face& face = buffer.face(face_of(a));
+                const uint32_t k = corner_of(a);
+                buffer.mark(face.vertex[k == 2 ? 0 : k + 1]) = mark;
+                buffer.mark(face.vertex[k == 0 ? 2 : k - 1]) = mark;
+                a = face.next[k];
+            }
+            if (b != kNoIndex) {
+                const Face& face = buffer.face(face_of(b));
+                const uint32_t k = corner_of(b);
+                around_p[count++] = face.vertex[k == 2 ? 0 : k + 1];
+                around_p[count++] = face.vertex[k == 0 ? 2 : k - 1];
+                b = face.next[k];
+            }
+        }
+        for (uint32_t i = 0; i < count; ++i)
+            if (buffer.mark(around_p[i]) == mark && other(around_p[i])) return true;
+        return false;
+    }
     if (vq.face_count <= kMaxRing) {
         // q's neighbours marked (each corner names two; repeats do no harm), p's looked up.
         const uint32_t mark = buffer.new_mark();

@@ -90,6 +90,10 @@ uint32_t CollapseQueue::pop(HalfEdgeBuffer& buffer, bool& rerate) {
         const uint32_t c = head_[bucket];
         const uint32_t h = chunks_[c].entry[--fill_[bucket]];
         --entries_;
+        // Most entries are skipped (their edge was queued again since), each after a look at
+        // its face record: the records of the entries a few places on are fetched meanwhile
+        // (a hint only).
+        if (fill_[bucket] >= kLookAhead) buffer.prefetch_face(face_of(chunks_[c].entry[fill_[bucket] - kLookAhead]));
         if (fill_[bucket] == 0) {
             // The head chunk is empty: the next one (full) becomes the head.
             free_chunks_[free_chunk_count_++] = c;

@@ -59,6 +59,7 @@ public:
 
 private:
     static constexpr uint32_t kChunkEntries = 15;
+    static constexpr uint32_t kLookAhead = 4;
     static constexpr uint32_t kNone = 0xFFFFFFFFu;
     struct alignas(64) Chunk {
         uint32_t next;
