@@ -199,6 +199,7 @@ public:
         else
             pending_overflow_ = true;  // take_pending() then scans every vertex
     }
+    bool has_pending() const { return pending_count_ > 0 || pending_overflow_; }
     // Calls f(v) for each marked vertex still alive, unmarking it, and empties the list.
     template <class F>
     void take_pending(F&& f) {

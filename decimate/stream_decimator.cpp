@@ -163,6 +163,10 @@ void StreamDecimator::read_triangle(const io::TriangleChunk& in, size_t i, const
         return;
     }
     if (attributes_) attributes_->add_face(buffer_, added.face, corners, material, fs);
+    // A vertex whose fan this triangle closed left P_in: its edges are rated now, while the fan
+    // is in the cache, not when the buffer is next full. (The seam pass rates only when a
+    // collapse is due: make_room.)
+    if (options_.part != Part::kSeams && buffer_.has_pending()) rate_pending(buffer_, queue_);
     stats_.peak_buffer_triangles = std::max(stats_.peak_buffer_triangles, buffer_.face_count());
     if (options_.sorted_axis) {
         // New P_in vertices join the sweep queue in reading order, which on sorted input is
