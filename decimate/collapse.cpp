@@ -348,6 +348,44 @@ bool may_double_written_edge(const HalfEdgeBuffer& buffer, uint32_t h) {
     return may_double_written_edge(buffer, edge_of(buffer, h));
 }
 
+void prefetch_neighbourhood(const HalfEdgeBuffer& buffer, uint32_t h) {
+    // Round p: from h = p→q one way (the half-edge into p in each face, then its twin), from
+    // h's twin q→p the other way (the half-edge out of p after it, then its twin); the same
+    // round q from h's twin and h. A chain ends at an edge without a twin.
+    const uint32_t t = buffer.twin(h);
+    if (!is_half_edge(t)) return;
+    constexpr int kSteps = 4;
+    // Each chain's half-edge ends at (into) or starts at (out of) its vertex.
+    uint32_t into[2] = {prev_in_face(h), prev_in_face(t)};     // x→p, x→q
+    uint32_t out_of[2] = {next_in_face(t), next_in_face(h)};  // p→x, q→x
+    for (int step = 0; step < kSteps; ++step) {
+        bool any = false;
+        for (int i = 0; i < 2; ++i) {
+            if (into[i] != kNoIndex) {
+                const uint32_t w = buffer.twin(into[i]);  // the same edge from the vertex
+                if (is_half_edge(w)) {
+                    into[i] = prev_in_face(w);  // from the next neighbour round
+                    buffer.prefetch_vertex(buffer.corner_vertex(into[i]));
+                    any = true;
+                } else {
+                    into[i] = kNoIndex;
+                }
+            }
+            if (out_of[i] != kNoIndex) {
+                const uint32_t w = buffer.twin(out_of[i]);  // the same edge into the vertex
+                if (is_half_edge(w)) {
+                    buffer.prefetch_vertex(buffer.corner_vertex(prev_in_face(w)));  // the next neighbour
+                    out_of[i] = next_in_face(w);
+                    any = true;
+                } else {
+                    out_of[i] = kNoIndex;
+                }
+            }
+        }
+        if (!any) return;
+    }
+}
+
 bool collapse_valid(HalfEdgeBuffer& buffer, uint32_t h) {
     double to[3];
     buffer.position(buffer.corner_vertex(next_in_face(h)), to);

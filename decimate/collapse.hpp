@@ -95,6 +95,10 @@ bool collapses_tetrahedron(const HalfEdgeBuffer& buffer, uint32_t h);
 bool pinches_link(HalfEdgeBuffer& buffer, uint32_t h);
 bool may_double_written_edge(const HalfEdgeBuffer& buffer, uint32_t h);
 bool collapse_valid(HalfEdgeBuffer& buffer, uint32_t h, const double target[3]);
+// A hint only: fetches the face records and vertex records round both ends of h (what
+// collapse_valid reads), walking four chains of twins at once (both ways round p and q from
+// the edge), so that their cache misses overlap instead of following each other.
+void prefetch_neighbourhood(const HalfEdgeBuffer& buffer, uint32_t h);
 // The same for the half-edge collapse (target: q's position).
 bool collapse_valid(HalfEdgeBuffer& buffer, uint32_t h);
 

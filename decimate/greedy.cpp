@@ -113,6 +113,7 @@ bool collapse_cheapest(HalfEdgeBuffer& buffer, CollapseQueue& queue) {
             continue;
         }
         if (!collapse_eligible(buffer, h)) continue;
+        prefetch_neighbourhood(buffer, h);
         const uint32_t p = buffer.corner_vertex(h), q = buffer.corner_vertex(next_in_face(h));
         const CollapsePlacement placement = collapse_placement(buffer, h);
         if (!collapse_valid(buffer, h, placement.target)) {
