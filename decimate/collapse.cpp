@@ -354,7 +354,7 @@ void prefetch_neighbourhood(const HalfEdgeBuffer& buffer, uint32_t h) {
     // round q from h's twin and h. A chain ends at an edge without a twin.
     const uint32_t t = buffer.twin(h);
     if (!is_half_edge(t)) return;
-    constexpr int kSteps = 4;
+    constexpr int kSteps = 4;  // each way: a fan of up to 10 faces (more are walked by the checks)
     // Each chain's half-edge ends at (into) or starts at (out of) its vertex.
     uint32_t into[2] = {prev_in_face(h), prev_in_face(t)};     // x→p, x→q
     uint32_t out_of[2] = {next_in_face(t), next_in_face(h)};  // p→x, q→x

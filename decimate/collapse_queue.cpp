@@ -93,7 +93,14 @@ uint32_t CollapseQueue::pop(HalfEdgeBuffer& buffer, bool& rerate) {
         // Most entries are skipped (their edge was queued again since), each after a look at
         // its face record: the records of the entries a few places on are fetched meanwhile
         // (a hint only).
-        if (fill_[bucket] >= kLookAhead) buffer.prefetch_face(face_of(chunks_[c].entry[fill_[bucket] - kLookAhead]));
+        // The next chunk of the bucket (full: the head is the only part-filled one) is fetched
+        // as this one is started, and the look-ahead runs on into it.
+        const uint32_t rest = fill_[bucket], next = chunks_[c].next;
+        if (rest == kChunkEntries - 1 && next != kNone) __builtin_prefetch(&chunks_[next]);
+        if (rest >= kLookAhead)
+            buffer.prefetch_face(face_of(chunks_[c].entry[rest - kLookAhead]));
+        else if (next != kNone)
+            buffer.prefetch_face(face_of(chunks_[next].entry[kChunkEntries - kLookAhead + rest]));
         if (fill_[bucket] == 0) {
             // The head chunk is empty: the next one (full) becomes the head.
             free_chunks_[free_chunk_count_++] = c;
