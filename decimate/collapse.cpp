@@ -261,47 +261,34 @@ bool pinches_link(HalfEdgeBuffer& buffer, const Edge& e) {
     auto other = [&](uint32_t x) { return x != e.p && x != e.q && x != e.r && x != e.s; };
     const Vertex& vp = buffer.vertex(e.p);
     const Vertex& vq = buffer.vertex(e.q);
-    if (vq.face_count <= kMaxRing && vp.face_count <= kMaxRing) {
-        // q's neighbours marked (each corner names two; repeats do no harm), p's gathered, then
-        // looked up. The two corner lists are walked in step: each is a chain of cache misses,
-        // and the two chains overlap.
+    if (vq.face_count <= kMaxRing) {
+        // q's neighbours marked (each corner names two; repeats do no harm), p's looked up. The
+        // two corner lists are walked in step, as each is a chain of cache misses and the two
+        // chains overlap: p's neighbours met before q's list ends wait in `early`.
         const uint32_t mark = buffer.new_mark();
-        uint32_t around_p[2 * kMaxRing];
+        uint32_t early[2 * kMaxRing];
         uint32_t count = 0;
         uint32_t a = vq.first_corner, b = vp.first_corner;
-        while (a != kNoIndex || b != kNoIndex) {
-            if (a != kNoIndex) {
-                const Face& face = buffer.face(face_of(a));
-                const uint32_t k = corner_of(a);
-                buffer.mark(face.vertex[k == 2 ? 0 : k + 1]) = mark;
-                buffer.mark(face.vertex[k == 0 ? 2 : k - 1]) = mark;
-                a = face.next[k];
-            }
-            if (b != kNoIndex) {
-                const Face& face = buffer.face(face_of(b));
-                const uint32_t k = corner_of(b);
-                around_p[count++] = face.vertex[k == 2 ? 0 : k + 1];
-                around_p[count++] = face.vertex[k == 0 ? 2 : k - 1];
-                b = face.next[k];
-            }
+        auto neighbours = [&](uint32_t c, uint32_t& x, uint32_t& y) {
+            const Face& face = buffer.face(face_of(c));
+            const uint32_t k = corner_of(c);
+            x = face.vertex[k == 2 ? 0 : k + 1];
+            y = face.vertex[k == 0 ? 2 : k - 1];
+            return face.next[k];
+        };
+        uint32_t x, y;
+        while (a != kNoIndex) {
+            a = neighbours(a, x, y);
+            buffer.mark(x) = mark;
+            buffer.mark(y) = mark;
+            if (b == kNoIndex) continue;
+            b = neighbours(b, early[count], early[count + 1]);
+            count += 2;
         }
         for (uint32_t i = 0; i < count; ++i)
-            if (buffer.mark(around_p[i]) == mark && other(around_p[i])) return true;
-        return false;
-    }
-    if (vq.face_count <= kMaxRing) {
-        // q's neighbours marked (each corner names two; repeats do no harm), p's looked up.
-        const uint32_t mark = buffer.new_mark();
-        for (uint32_t c = vq.first_corner; c != kNoIndex; c = buffer.next_corner(c)) {
-            const Face& face = buffer.face(face_of(c));
-            const uint32_t k = corner_of(c);
-            buffer.mark(face.vertex[k == 2 ? 0 : k + 1]) = mark;
-            buffer.mark(face.vertex[k == 0 ? 2 : k - 1]) = mark;
-        }
-        for (uint32_t c = vp.first_corner; c != kNoIndex; c = buffer.next_corner(c)) {
-            const Face& face = buffer.face(face_of(c));
-            const uint32_t k = corner_of(c);
-            const uint32_t x = face.vertex[k == 2 ? 0 : k + 1], y = face.vertex[k == 0 ? 2 : k - 1];
+            if (buffer.mark(early[i]) == mark && other(early[i])) return true;
+        while (b != kNoIndex) {
+            b = neighbours(b, x, y);
             if ((buffer.mark(x) == mark && other(x)) || (buffer.mark(y) == mark && other(y))) return true;
         }
         return false;

@@ -91,10 +91,9 @@ uint32_t CollapseQueue::pop(HalfEdgeBuffer& buffer, bool& rerate) {
         const uint32_t h = chunks_[c].entry[--fill_[bucket]];
         --entries_;
         // Most entries are skipped (their edge was queued again since), each after a look at
-        // its face record: the records of the entries a few places on are fetched meanwhile
-        // (a hint only).
-        // The next chunk of the bucket (full: the head is the only part-filled one) is fetched
-        // as this one is started, and the look-ahead runs on into it.
+        // its face record: the records of the entries a few places on are fetched meanwhile,
+        // running on into the bucket's next chunk (full: only the head is part-filled), which
+        // is fetched as this one is started. Hints only.
         const uint32_t rest = fill_[bucket], next = chunks_[c].next;
         if (rest == kChunkEntries - 1 && next != kNone) __builtin_prefetch(&chunks_[next]);
         if (rest >= kLookAhead)
