@@ -135,6 +135,10 @@ TEST(CliDecimateParts, APartOfOtherOptionsOrAnotherInputIsRefused) {
                "part 2/3 was made with the ranges decimating at ratio 0.05, this "
                "job's is 0.1 (--ratio or --target differ)"},
           Case{"--buffer 20000 -r 0.05 --seed 7", mesh(), "part 2/3 was made with --seed 1, this job has 7"},
+          Case{"--buffer 20000 -r 0.05 --weld 0.001", mesh(),
+               "part 2/3 was made welding on a grid of 0, this job's is 0.001 (--weld differs)"},
+          Case{"--buffer 20000 -r 0.05 --sorted-axis z", mesh(),
+               "part 2/3 was made with the input sorted along none, this job has z (--sorted-axis differs)"},
           Case{"--buffer 20000 -r 0.05", changed, "part 2/3 was made from another input of the same size"},
           Case{
               "--buffer 20000 -r 0.05", other,
