@@ -153,10 +153,10 @@ bool seam_slides(const HalfEdgeBuffer& buffer, uint32_t h) {
     return attributes != nullptr && attributes->slides(buffer, h);
 }
 
-Quadric merged_quadric(const HalfEdgeBuffer& buffer, uint32_t p, uint32_t q) {
+Quadric merged_quadric_with_attributes(const HalfEdgeBuffer& buffer, uint32_t p, uint32_t q) {
     const Quadric sum = buffer.quadric(p) + buffer.quadric(q);
     const AttributeStore* attributes = buffer.attributes();
-    if (attributes == nullptr || !attributes->weighted()) return sum;
+    if (!attributes->weighted()) return sum;
     return AttributeStore::combined(sum, attributes->merged_reduced(buffer, p, q));
 }
 

@@ -61,7 +61,12 @@ inline bool collapse_target_free(const HalfEdgeBuffer& buffer, uint32_t h) {
 // The quadric a merge of p and q minimizes: Q_p + Q_q, plus, when the buffer carries weighted
 // channels, (Q_p + Q_q) / W plus the attribute error minimized over the merged vertex's values
 // (AttributeStore::combined; attributes.hpp).
-Quadric merged_quadric(const HalfEdgeBuffer& buffer, uint32_t p, uint32_t q);
+// Inline for the common case (no channels): every rating of a free edge sums two quadrics.
+Quadric merged_quadric_with_attributes(const HalfEdgeBuffer& buffer, uint32_t p, uint32_t q);
+inline Quadric merged_quadric(const HalfEdgeBuffer& buffer, uint32_t p, uint32_t q) {
+    if (buffer.attributes() != nullptr) return merged_quadric_with_attributes(buffer, p, q);
+    return buffer.quadric(p) + buffer.quadric(q);
+}
 
 // The quadric error of collapsing h = p→q without moving q: merged_quadric evaluated at q; when
 // q's values are fixed (written or a seam vertex), the attribute error of p's quadric at q's

@@ -27,25 +27,16 @@ size_t CollapseQueue::reserved_bytes(size_t face_capacity) {
     return chunks * (sizeof(Chunk) + 4) + sizeof(CollapseQueue);
 }
 
-uint32_t CollapseQueue::bucket_of(double error) {
-    if (error != error) return kBuckets - 2;  // NaN (bucket kBuckets − 1 could read kNotQueued)
-    if (!(error > 0)) return 0;
-    const float f = error < double(FLT_MAX) ? static_cast<float>(error) : FLT_MAX;
-    // Positive floats order as their bit patterns: the top 14 bits below the sign bit.
-    return std::bit_cast<uint32_t>(f) >> 17;
-}
-
-void CollapseQueue::push(HalfEdgeBuffer& buffer, uint32_t h, bool reverse, double error) {
-    // The key goes to h; the twin's is cleared, so that an entry left under it by an earlier
-    // rating is skipped.
-    const uint32_t t = buffer.twin(h);
-    if (is_half_edge(t)) buffer.queue_key(t) = kNotQueued;
-    const uint32_t bucket = bucket_of(error);
-    const uint16_t key = static_cast<uint16_t>(bucket | (reverse ? kReverse : 0));
-    if (buffer.queue_key(h) == key) return;
-    buffer.queue_key(h) = key;
-    if (fill_[bucket] % kChunkEntries == 0 && free_chunk_count_ == 0 && chunk_high_ == chunk_capacity_) purge(buffer);
-    append(bucket, h);
+void CollapseQueue::new_chunk(HalfEdgeBuffer& buffer, uint32_t bucket) {
+    if (free_chunk_count_ == 0 && chunk_high_ == chunk_capacity_) purge(buffer);
+    // A purge may have left the bucket a part-filled head chunk.
+    if (head_[bucket] != kNone && fill_[bucket] < kChunkEntries) return;
+    const uint32_t c = free_chunk_count_ > 0 ? free_chunks_[--free_chunk_count_] : chunk_high_++;
+    chunks_[c].next = head_[bucket];
+    head_[bucket] = c;
+    fill_[bucket] = 0;
+    nonempty_[bucket / 64] |= uint64_t{1} << (bucket % 64);
+    nonempty_words_[bucket / 4096] |= uint64_t{1} << (bucket / 64 % 64);
 }
 
 void CollapseQueue::forget(HalfEdgeBuffer& buffer, uint32_t h) {

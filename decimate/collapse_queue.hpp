@@ -22,6 +22,8 @@
 
 #include "decimate/halfedge_buffer.hpp"
 
+#include <bit>
+#include <cfloat>
 #include <cstddef>
 #include <cstdint>
 
@@ -38,12 +40,33 @@ public:
 
     // The bucket of an error: monotone (a larger error never gets a smaller bucket); negative
     // round-off counts as 0, NaN last.
-    static uint32_t bucket_of(double error);
+    static uint32_t bucket_of(double error) {
+        if (error != error) return kBuckets - 2;  // NaN (bucket kBuckets − 1 could read kNotQueued)
+        if (!(error > 0)) return 0;
+        const float f = error < double(FLT_MAX) ? static_cast<float>(error) : FLT_MAX;
+        // Positive floats order as their bit patterns: the top 14 bits below the sign bit.
+        return std::bit_cast<uint32_t>(f) >> 17;
+    }
 
     // Queues the collapse of the edge of half-edge h, in the direction of h or (`reverse`) of
     // its twin, rated `error`. Whatever was queued for the edge before no longer counts; an
     // edge queued under the same key already keeps its entry.
-    void push(HalfEdgeBuffer& buffer, uint32_t h, bool reverse, double error);
+    // Inline: every rating ends here.
+    void push(HalfEdgeBuffer& buffer, uint32_t h, bool reverse, double error) {
+        // The key goes to h; the twin's is cleared, so that an entry left under it by an earlier
+        // rating is skipped.
+        const uint32_t t = buffer.twin(h);
+        if (is_half_edge(t)) buffer.queue_key(t) = kNotQueued;
+        const uint32_t bucket = bucket_of(error);
+        const uint16_t key = static_cast<uint16_t>(bucket | (reverse ? kReverse : 0));
+        if (buffer.queue_key(h) == key) return;
+        buffer.queue_key(h) = key;
+        if (fill_[bucket] == kChunkEntries || head_[bucket] == kNone) {
+            new_chunk(buffer, bucket);
+        }
+        chunks_[head_[bucket]].entry[fill_[bucket]++] = h;
+        ++entries_;
+    }
     // Nothing is queued for the edge of h any more.
     static void forget(HalfEdgeBuffer& buffer, uint32_t h);
     // Removes the cheapest current entry and returns the half-edge p→q to collapse, or
@@ -67,6 +90,8 @@ private:
     };
     bool current(const HalfEdgeBuffer& buffer, uint32_t h, uint32_t bucket) const;
     void append(uint32_t bucket, uint32_t h);
+    // Starts a chunk at the head of `bucket`, purging the queue first when the pool is used up.
+    void new_chunk(HalfEdgeBuffer& buffer, uint32_t bucket);
     void purge(HalfEdgeBuffer& buffer);
     int lowest_bucket() const;
 

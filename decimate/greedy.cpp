@@ -11,6 +11,18 @@
 
 namespace meshstream::decimate {
 
+namespace {
+
+// Queues the merge of both free ends p and q of h at the minimum of Q_p + Q_q, rated at the
+// exact minimum (collapse_placement() rounds it to floats).
+void rate_merge(HalfEdgeBuffer& buffer, CollapseQueue& queue, uint32_t h, uint32_t p, uint32_t q) {
+    const Quadric sum = merged_quadric(buffer, p, q);
+    double x[3];
+    queue.push(buffer, h, false, sum.minimum(x) ? sum.error_at_minimum(x) : collapse_placement(buffer, h).error);
+}
+
+}  // namespace
+
 void rate_edge(HalfEdgeBuffer& buffer, CollapseQueue& queue, uint32_t h) {
     // collapse_eligible() both ways, from the two vertex records and h's twin.
     const uint32_t t = buffer.twin(h);
@@ -18,6 +30,13 @@ void rate_edge(HalfEdgeBuffer& buffer, CollapseQueue& queue, uint32_t h) {
     const Vertex& vp = buffer.vertex(p);
     const Vertex& vq = buffer.vertex(q);
     constexpr uint16_t kNoSource = kInHash | kFrozen | kNonManifold | kManyFans | kSeam;
+    // Most edges first: an interior edge whose ends carry none of those flags, have no open
+    // edge and small fans is eligible both ways, as the same merge (collapse_target_free).
+    if (is_half_edge(t) && ((vp.flags | vq.flags) & kNoSource) == 0 && (vp.open_edges | vq.open_edges) == 0 &&
+        vp.face_count <= kMaxMovedFaces && vq.face_count <= kMaxMovedFaces) {
+        rate_merge(buffer, queue, h, p, q);
+        return;
+    }
     constexpr uint16_t kNoTarget = kInHash | kNonManifold;
     const bool twin_real = is_half_edge(t);
     // A seam vertex collapses only along its seam (seam_slides).
@@ -38,11 +57,8 @@ void rate_edge(HalfEdgeBuffer& buffer, CollapseQueue& queue, uint32_t h) {
     }
     if (forward && backward && ((vp.flags | vq.flags) & kSeam) == 0 && vp.face_count <= kMaxMovedFaces &&
         vq.face_count <= kMaxMovedFaces) {
-        // Both ends free (collapse_target_free either way): the same merge at the minimum of
-        // Q_p + Q_q. Rated at the exact minimum; collapse_placement() rounds it to floats.
-        const Quadric sum = merged_quadric(buffer, p, q);
-        double x[3];
-        queue.push(buffer, h, false, sum.minimum(x) ? sum.error_at_minimum(x) : collapse_placement(buffer, h).error);
+        // Both ends free (collapse_target_free either way): the same merge.
+        rate_merge(buffer, queue, h, p, q);
         return;
     }
     const double e_forward = forward ? collapse_placement(buffer, h).error : INFINITY;
@@ -56,8 +72,11 @@ void rate_edge(HalfEdgeBuffer& buffer, CollapseQueue& queue, uint32_t h) {
 namespace {
 
 // Rates the edges of v; with `skip_pending`, not those whose other end is still listed for
-// take_pending() (it rates them when its turn comes: each edge once).
+// take_pending() (it rates them when its turn comes: each edge once). Edges to a vertex on P_in
+// are passed over: neither way is eligible, and such an edge was never queued (a vertex is on
+// P_in from its creation only), so rating it would only forget it again.
 void rate_edges_around(HalfEdgeBuffer& buffer, CollapseQueue& queue, uint32_t v, bool skip_pending) {
+    const uint16_t pass_over = kInHash | (skip_pending ? kPending : 0);
     // Every rating reads both ends' vertex records (and attribute records, with channels), far
     // apart in their pools: asked for all at once, their cache misses overlap (a hint only).
     const AttributeStore* attributes = buffer.attributes();
@@ -68,12 +87,12 @@ void rate_edges_around(HalfEdgeBuffer& buffer, CollapseQueue& queue, uint32_t v,
     }
     for (uint32_t c = buffer.vertex(v).first_corner; c != kNoIndex; c = buffer.next_corner(c)) {
         const uint32_t to = buffer.corner_vertex(next_in_face(c));
-        if (!skip_pending || (buffer.vertex(to).flags & kPending) == 0) rate_edge(buffer, queue, c);  // v→next
+        if ((buffer.vertex(to).flags & pass_over) == 0) rate_edge(buffer, queue, c);  // v→next
         // prev→v is also the next one's v→prev, except where v's fan is open.
         const uint32_t in = prev_in_face(c);
         if (is_half_edge(buffer.twin(in))) continue;
         const uint32_t from = buffer.corner_vertex(in);
-        if (!skip_pending || (buffer.vertex(from).flags & kPending) == 0) rate_edge(buffer, queue, in);
+        if ((buffer.vertex(from).flags & pass_over) == 0) rate_edge(buffer, queue, in);
     }
 }
 
