@@ -211,8 +211,26 @@ CollapsePlacement collapse_placement(const HalfEdgeBuffer& buffer, uint32_t h) {
     const Quadric sum = merged_quadric(buffer, p, q);
     out.error = sum.error(out.target);
     if (!collapse_target_free(buffer, h)) return out;
-    // Takes y when its error is below the best so far (round-off can put the rounded optimum
-    // a hair above an end point: the smaller wins).
+    double x[3];
+    if (sum.minimum(x)) {
+        buffer.round_position(x);
+        // Round-off can put the rounded optimum a hair above q: the smaller wins.
+        const double e = sum.error(x);
+        if (e < out.error) {
+            for (int i = 0; i < 3; ++i) out.target[i] = x[i];
+            out.error = e;
+        }
+        return out;
+    }
+    return singular_merge(buffer, sum, p, q);
+}
+
+CollapsePlacement singular_merge(const HalfEdgeBuffer& buffer, const Quadric& sum, uint32_t p, uint32_t q) {
+    // Flat or cylindrical neighbourhood: the best of q, p and the midpoint, as Garland &
+    // Heckbert; a later one is taken only when its error is smaller.
+    CollapsePlacement out;
+    buffer.position(q, out.target);
+    out.error = sum.error(out.target);
     auto consider = [&](const double y[3]) {
         const double e = sum.error(y);
         if (e < out.error) {
@@ -220,14 +238,6 @@ CollapsePlacement collapse_placement(const HalfEdgeBuffer& buffer, uint32_t h) {
             out.error = e;
         }
     };
-    double x[3];
-    if (sum.minimum(x)) {
-        buffer.round_position(x);
-        consider(x);
-        return out;
-    }
-    // Singular (flat or cylindrical neighbourhood): the best of p, q and the midpoint, as
-    // Garland & Heckbert.
     double a[3], mid[3];
     buffer.position(p, a);
     for (int i = 0; i < 3; ++i) mid[i] = 0.5 * (a[i] + out.target[i]);

@@ -83,6 +83,9 @@ struct CollapsePlacement {
     double error;
 };
 CollapsePlacement collapse_placement(const HalfEdgeBuffer& buffer, uint32_t h);
+// collapse_placement() of a merge of free ends p and q whose quadric `sum` (merged_quadric) has
+// no minimum: the best of q, p and their midpoint.
+CollapsePlacement singular_merge(const HalfEdgeBuffer& buffer, const Quadric& sum, uint32_t p, uint32_t q);
 
 // The vetoes: an eligible collapse h = p→q with the merged vertex at `target` (relative
 // coordinates) is refused when

@@ -18,7 +18,7 @@ namespace {
 void rate_merge(HalfEdgeBuffer& buffer, CollapseQueue& queue, uint32_t h, uint32_t p, uint32_t q) {
     const Quadric sum = merged_quadric(buffer, p, q);
     double x[3];
-    queue.push(buffer, h, false, sum.minimum(x) ? sum.error_at_minimum(x) : collapse_placement(buffer, h).error);
+    queue.push(buffer, h, false, sum.minimum(x) ? sum.error_at_minimum(x) : singular_merge(buffer, sum, p, q).error);
 }
 
 }  // namespace

@@ -210,6 +210,51 @@ TEST(Collapse, PlacementTargetsAreStoredFloatPositions) {
     }
 }
 
+// A merge whose quadric has no minimum (a cylinder, a plane) goes to the best of q, p and their
+// midpoint rounded to floats, a later one only when strictly better: singular_merge(), which
+// the rating calls with the quadric it has summed, and collapse_placement() both place it so.
+TEST(Collapse, SingularMergeTakesTheBestOfTheEndsAndTheMidpoint) {
+    for (const float curvature : {0.13f, 0.0f}) {
+        std::vector<std::array<float, 3>> points;
+        for (int y = 0; y < 7; ++y)
+            for (int x = 0; x < 7; ++x) {
+                const float dx = float(x) - 3.1f;
+                points.push_back({1000.25f + 0.7f * float(x), -20.5f + 0.9f * float(y), 5.75f + curvature * dx * dx});
+            }
+        HalfEdgeBuffer buffer(256, 0);
+        add_indexed(buffer, points, grid_faces(7));
+        buffer.finalize_all();
+        int singular = 0, midpoints = 0;
+        for (const uint32_t h : live_half_edges(buffer)) {
+            if (!collapse_eligible(buffer, h) || !collapse_target_free(buffer, h)) continue;
+            const uint32_t p = buffer.corner_vertex(h), q = buffer.corner_vertex(next_in_face(h));
+            const Quadric sum = merged_quadric(buffer, p, q);
+            double x[3];
+            if (sum.minimum(x)) continue;
+            ++singular;
+            double candidate[3][3];
+            buffer.position(q, candidate[0]);
+            buffer.position(p, candidate[1]);
+            for (int axis = 0; axis < 3; ++axis)
+                candidate[2][axis] = 0.5 * (candidate[0][axis] + candidate[1][axis]);
+            buffer.round_position(candidate[2]);
+            int best = 0;
+            for (int i = 1; i < 3; ++i)
+                if (sum.error(candidate[i]) < sum.error(candidate[best])) best = i;
+            midpoints += best == 2;
+            for (const CollapsePlacement& placed : {singular_merge(buffer, sum, p, q), collapse_placement(buffer, h)}) {
+                EXPECT_EQ(placed.error, sum.error(candidate[best])) << "half-edge " << h;
+                for (int axis = 0; axis < 3; ++axis)
+                    EXPECT_EQ(placed.target[axis], candidate[best][axis]) << "half-edge " << h << ", axis " << axis;
+            }
+        }
+        EXPECT_GT(singular, 0) << "curvature " << curvature;
+        if (curvature > 0) {
+            EXPECT_GT(midpoints, 0) << "the bent rows' merges land between their ends";
+        }
+    }
+}
+
 TEST(Collapse, FlipIsRefused) {
     HalfEdgeBuffer buffer(64, 0);
     // A fan around (0,0,0) on the plane z = 0 with one far outlier neighbour: collapsing the
