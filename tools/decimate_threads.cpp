@@ -341,10 +341,7 @@ RangesResult decimate_in_ranges(const RangesJob& job, const decimate::Emit& emit
     if (job.seams_after_ranges)
         for (const auto& r : ranges) r->spool->wait_closed(stop, tick);
     for (unsigned k = 0; k < job.ranges && !stop; ++k) {
-        // The first range borders no range before it: its output is read as it comes.
-        const Piece first_range[] = {Piece::kInterior, Piece::kFirstSeam, Piece::kLastSeam};
-        const Piece later_range[] = {Piece::kFirstSeam, Piece::kInterior, Piece::kLastSeam};
-        for (const Piece piece : k == 0 ? first_range : later_range)
+        for (const Piece piece : {Piece::kInterior, Piece::kFirstSeam, Piece::kLastSeam})
             while (ranges[k]->spool->next(piece, chunk, weight, stop, tick)) {
                 seams->push(chunk, weight, emit);
                 tick();

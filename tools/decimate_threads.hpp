@@ -49,10 +49,12 @@ unsigned range_count(unsigned threads, uint64_t triangles, size_t buffer);
 // but the whole of it up to 65 536 triangles (about 13 MB resident).
 size_t seam_buffer(size_t buffer);
 
-// The pieces of a range's output, in the order the seam pass reads them: the faces on P_in read
-// first (along the seam with the range before), the decimated rest, the faces on P_in read last
-// (along the seam with the range after). Read in this order, each seam's two strips meet in the
-// seam pass at once, and they are joined before the buffer has to hold anything else.
+// The pieces of a range's output: the decimated rest, the faces on P_in read first (along the
+// seam with the range before), the faces on P_in read last (along the seam with the range after).
+// The seam pass reads them in this order: the rest as the range makes it, the seam faces, which
+// the range makes at its end, after it. The strip the range before left along the seam waits
+// open in the seam pass's buffer meanwhile (the rest reaches the seam only through this range's
+// own seam faces), and the two strips are joined when the first seam faces come.
 enum class Piece : uint8_t { kFirstSeam, kInterior, kLastSeam };
 
 // A chunk's triangles as fixed-size records: the positions (36 bytes), then each corner's channels
