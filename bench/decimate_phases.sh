@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Where the decimator's time goes on this machine: a build with MESHSTREAM_PHASE_TIMERS (time-
-# stamp counter scopes around READ, drawing, rating, validation, applying and writing) run on a
+# stamp counter scopes around READ, queue upkeep, rating, validation, applying and writing) run on a
 # generated mesh, in alternation with the normal bench build, so the timers' own cost shows as
 # the difference of the two median wall times. Prints the median share and ticks per call of
 # each phase. bench/decimate_costs.sh counts instructions and cache misses exactly; this shows
@@ -57,9 +57,11 @@ for i in $(seq "$RUNS"); do
   for kind in plain timed; do
     bin=$BUILD_DIR/tools/meshstream
     [ $kind = timed ] && bin=$PHASE_DIR/tools/meshstream
-    echo "== run $i/$RUNS ($kind): decimate $(basename "$mesh") -r $RATIO $DECIMATE_ARGS" >&2
+    echo "== run $i/$RUNS ($kind): decimate --threads 1 $(basename "$mesh") -r $RATIO $DECIMATE_ARGS" >&2
+    # One decimator: the phase timers are one set for the process, which ranges on several
+    # threads would mix.
     # shellcheck disable=SC2086  # DECIMATE_ARGS is a list of options
-    "$bin" decimate "$mesh" "$BENCH_DIR/phases_out.stl" -r "$RATIO" $DECIMATE_ARGS 2>"$logs/$kind.$i" >/dev/null ||
+    "$bin" decimate --threads 1 "$mesh" "$BENCH_DIR/phases_out.stl" -r "$RATIO" $DECIMATE_ARGS 2>"$logs/$kind.$i" >/dev/null ||
       { cat "$logs/$kind.$i" >&2; die "decimate failed"; }
   done
 done
@@ -89,9 +91,9 @@ for path in glob.glob(f"{logs}/timed.*"):
             rows.setdefault("other", []).append((0, 0.0, float(m.group(1))))
 if not rows:
     sys.exit("bench/decimate_phases.sh: the timed build printed no phase report")
-print("== phases of the timed build, medians (draw excludes the ratings it contains)")
+print("== phases of the timed build, medians (queue excludes the rating, validation and applying it contains)")
 print(f"  {'phase':9s} {'calls':>11s} {'ticks/call':>11s} {'share':>7s}")
-for name in ["read", "draw", "rate", "validate", "apply", "write", "other"]:
+for name in ["read", "queue", "rate", "validate", "apply", "write", "other"]:
     r = rows.get(name, [])
     if r:
         print(f"  {name:9s} {st.median(x[0] for x in r):11.0f} {st.median(x[1] for x in r):11.0f} "
