@@ -2,9 +2,9 @@
 // of the error as in meshoptimizer's sortEdgeCollapses).
 #include "decimate/collapse_queue.hpp"
 
+#include <algorithm>
 #include <bit>
 #include <cassert>
-#include <cfloat>
 #include <cstring>
 
 namespace meshstream::decimate {

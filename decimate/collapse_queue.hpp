@@ -61,9 +61,7 @@ public:
         const uint16_t key = static_cast<uint16_t>(bucket | (reverse ? kReverse : 0));
         if (buffer.queue_key(h) == key) return;
         buffer.queue_key(h) = key;
-        if (fill_[bucket] == kChunkEntries || head_[bucket] == kNone) {
-            new_chunk(buffer, bucket);
-        }
+        if (fill_[bucket] == kChunkEntries || head_[bucket] == kNone) new_chunk(buffer, bucket);
         chunks_[head_[bucket]].entry[fill_[bucket]++] = h;
         ++entries_;
     }
