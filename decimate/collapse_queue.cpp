@@ -30,7 +30,11 @@ size_t CollapseQueue::reserved_bytes(size_t face_capacity) {
 void CollapseQueue::new_chunk(HalfEdgeBuffer& buffer, uint32_t bucket) {
     if (free_chunk_count_ == 0 && chunk_high_ == chunk_capacity_) purge(buffer);
     // A purge may have left the bucket a part-filled head chunk.
-    if (head_[bucket] != kNone && fill_[bucket] < kChunkEntries) return;
+    if (head_[bucket] == kNone || fill_[bucket] == kChunkEntries) start_chunk(bucket);
+}
+
+void CollapseQueue::start_chunk(uint32_t bucket) {
+    assert(free_chunk_count_ > 0 || chunk_high_ < chunk_capacity_);
     const uint32_t c = free_chunk_count_ > 0 ? free_chunks_[--free_chunk_count_] : chunk_high_++;
     chunks_[c].next = head_[bucket];
     head_[bucket] = c;
@@ -46,15 +50,7 @@ void CollapseQueue::forget(HalfEdgeBuffer& buffer, uint32_t h) {
 }
 
 void CollapseQueue::append(uint32_t bucket, uint32_t h) {
-    if (head_[bucket] == kNone || fill_[bucket] == kChunkEntries) {
-        assert(free_chunk_count_ > 0 || chunk_high_ < chunk_capacity_);
-        const uint32_t c = free_chunk_count_ > 0 ? free_chunks_[--free_chunk_count_] : chunk_high_++;
-        chunks_[c].next = head_[bucket];
-        head_[bucket] = c;
-        fill_[bucket] = 0;
-        nonempty_[bucket / 64] |= uint64_t{1} << (bucket % 64);
-        nonempty_words_[bucket / 4096] |= uint64_t{1} << (bucket / 64 % 64);
-    }
+    if (head_[bucket] == kNone || fill_[bucket] == kChunkEntries) start_chunk(bucket);
     chunks_[head_[bucket]].entry[fill_[bucket]++] = h;
     ++entries_;
 }

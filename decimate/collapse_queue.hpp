@@ -88,8 +88,11 @@ private:
     };
     bool current(const HalfEdgeBuffer& buffer, uint32_t h, uint32_t bucket) const;
     void append(uint32_t bucket, uint32_t h);
-    // Starts a chunk at the head of `bucket`, purging the queue first when the pool is used up.
+    // Starts a chunk at the head of `bucket` unless a purge, made first when the pool is used
+    // up, left the bucket room.
     void new_chunk(HalfEdgeBuffer& buffer, uint32_t bucket);
+    // Starts a chunk at the head of `bucket` (one is free).
+    void start_chunk(uint32_t bucket);
     void purge(HalfEdgeBuffer& buffer);
     int lowest_bucket() const;
 
