@@ -346,6 +346,42 @@ TEST(Collapse, CheapestFirstReducesAClosedMesh) {
     EXPECT_EQ(buffer.face_count(), 4u);
 }
 
+// An edge with an end on P_in is never queued (rate_edges_around passes such edges over rather
+// than rating them only to forget them): true while a grid streams in row by row, with ratings
+// as fans close and collapses between the rows.
+TEST(Collapse, NoEdgeWithAnEndOnPInIsQueued) {
+    constexpr int n = 12;
+    std::vector<std::array<float, 3>> points;
+    for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x) {
+            const float dx = float(x) - 5.5f, dy = float(y) - 5.5f;
+            points.push_back({float(x), float(y), 0.05f * dx * dx + 0.03f * dy * dy});
+        }
+    const std::vector<std::array<int, 3>> faces = grid_faces(n);
+    HalfEdgeBuffer buffer(512, 0);
+    CollapseQueue queue(512);
+    size_t open_checked = 0, queued = 0, collapses = 0;
+    const size_t per_row = 2 * (n - 1);
+    for (size_t row = 0; row * per_row < faces.size(); ++row) {
+        const std::vector<std::array<int, 3>> band(faces.begin() + long(row * per_row),
+                                                   faces.begin() + long((row + 1) * per_row));
+        add_indexed(buffer, points, band);
+        rate_pending(buffer, queue);
+        for (int i = 0; i < 4 && collapse_cheapest(buffer, queue); ++i) ++collapses;
+        for (const uint32_t h : live_half_edges(buffer)) {
+            const uint32_t a = buffer.corner_vertex(h), b = buffer.corner_vertex(next_in_face(h));
+            if (buffer.queue_key(h) != kNotQueued) ++queued;
+            if (((buffer.vertex(a).flags | buffer.vertex(b).flags) & kInHash) == 0) continue;
+            ++open_checked;
+            EXPECT_EQ(buffer.queue_key(h), kNotQueued) << "row " << row << ", half-edge " << h;
+        }
+    }
+    EXPECT_TRUE(buffer_consistent(buffer));
+    EXPECT_GT(open_checked, 100u);
+    EXPECT_GT(queued, 100u);
+    EXPECT_GT(collapses, 20u);
+}
+
 TEST(Collapse, FreeInteriorCollapsePlacesTheVertexAtTheQuadricOptimum) {
     HalfEdgeBuffer buffer(64, 0);
     add_indexed(buffer, octahedron_points(), octahedron_faces());  // closed: every vertex free
