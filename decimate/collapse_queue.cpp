@@ -98,9 +98,18 @@ uint32_t CollapseQueue::pop(HalfEdgeBuffer& buffer, bool& rerate) {
             }
         }
         if (!current(buffer, h, bucket)) continue;
+        // The entry that probably comes up next (unless this one queues cheaper edges): its
+        // face record was fetched a few pops ago; its two vertex records are fetched now, while
+        // this one is worked on. A hint only.
+        if (fill_[bucket] > 0) {
+            const uint32_t following = chunks_[head_[bucket]].entry[fill_[bucket] - 1];
+            buffer.prefetch_vertex(buffer.corner_vertex(following));
+            buffer.prefetch_vertex(buffer.corner_vertex(next_in_face(following)));
+        }
         const uint16_t key = buffer.queue_key(h);
         buffer.queue_key(h) = kNotQueued;
-        rerate = false;
+        rerate = (key & kStale) != 0;
+        if (rerate) return h;
         if ((key & kReverse) == 0) return h;
         const uint32_t t = buffer.twin(h);
         if (is_half_edge(t)) return t;

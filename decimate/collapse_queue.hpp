@@ -12,9 +12,12 @@
 // Entries are half-edge indices in chunks of 15 from a fixed pool; when the pool runs out, the
 // skipped-to-be entries are dropped (purge()), which frees at least a quarter of it.
 //
-// Edges whose cost changed are queued again at once (Garland & Heckbert): after a collapse p→q
-// the caller rates q's edges while q's fan is still in the cache from checking and applying the
-// collapse; their old entries are skipped when they come up.
+// Edges whose cost changed are queued again (Garland & Heckbert), at once or when they come up:
+// after a collapse p→q the caller rates q's edges while q's fan is still in the cache from
+// checking and applying the collapse, and their old entries are skipped when they come up;
+// except that an edge whose old key is known to be a lower bound on its new rating keeps its
+// entry, marked kStale (keep_as_lower_bound()), and pop() hands it back to be rated when it
+// comes up. The order stays cheapest first as long as the bound holds (greedy.cpp says when).
 //
 // Memory: for a buffer of N triangles, about (4·N / 15 + 16 400) chunks of 64 bytes (8 MB at
 // the default 400 000) plus 80 KB of bucket heads and bitmaps, allocated once.
@@ -34,6 +37,7 @@ public:
     static constexpr uint32_t kBuckets = 1u << 14;
     static constexpr uint16_t kBucketMask = kBuckets - 1;  // in a Face::key: the bucket,
     static constexpr uint16_t kReverse = 1u << 14;         // the twin collapses
+    static constexpr uint16_t kStale = 1u << 15;           // a lower bound: rate again when it comes up
 
     explicit CollapseQueue(size_t face_capacity);
     static size_t reserved_bytes(size_t face_capacity);
@@ -67,10 +71,20 @@ public:
     }
     // Nothing is queued for the edge of h any more.
     static void forget(HalfEdgeBuffer& buffer, uint32_t h);
+    // The edge of h (interior) keeps its entry as a lower bound on its rating: pop() hands it
+    // back to be rated afresh when it comes up. False, changing nothing, unless exactly one of
+    // h and its twin holds a key.
+    static bool keep_as_lower_bound(HalfEdgeBuffer& buffer, uint32_t h) {
+        uint16_t& own = buffer.queue_key(h);
+        uint16_t& twin = buffer.queue_key(buffer.twin(h));
+        if ((own == kNotQueued) == (twin == kNotQueued)) return false;
+        (own != kNotQueued ? own : twin) |= kStale;
+        return true;
+    }
     // Removes the cheapest current entry and returns the half-edge p→q to collapse, or
     // kNoIndex when nothing is queued; `rerate` tells that the edge must be rated afresh
-    // instead (the twin it was queued to collapse is gone). The edge is no longer queued
-    // afterwards.
+    // instead (it was kept as a lower bound, or the twin it was queued to collapse is gone).
+    // The edge is no longer queued afterwards.
     uint32_t pop(HalfEdgeBuffer& buffer, bool& rerate);
     // Empties the queue; every face's keys become kNotQueued.
     void clear(HalfEdgeBuffer& buffer);

@@ -71,12 +71,39 @@ void rate_edge(HalfEdgeBuffer& buffer, CollapseQueue& queue, uint32_t h) {
 
 namespace {
 
-// Rates the edges of v; with `skip_pending`, not those whose other end is still listed for
-// take_pending() (it rates them when its turn comes: each edge once). Edges to a vertex on P_in
-// are passed over: neither way is eligible, and such an edge was never queued (a vertex is on
-// P_in from its creation only), so rating it would only forget it again.
-void rate_edges_around(HalfEdgeBuffer& buffer, CollapseQueue& queue, uint32_t v, bool skip_pending) {
-    const uint16_t pass_over = kInHash | (skip_pending ? kPending : 0);
+// Which edges of a vertex rate_edges_around() rates.
+enum class Rerate {
+    kAll,
+    // Not those whose other end is still listed for take_pending() (it rates them when its turn
+    // comes: each edge once).
+    kSkipPending,
+    // v is the vertex a collapse p→q left (q, moved and holding Q_p + Q_q). An edge between two
+    // free ends (no flag barring either, no open edge, small fans) that is queued keeps its
+    // entry as a lower bound (CollapseQueue::keep_as_lower_bound) and is rated when it comes
+    // up. Its key rated it as a merge of free ends, at the minimum of their summed quadrics
+    // (an edge of q's or of p's before), and v's quadric now holds both ends' old ones: a
+    // quadric is never negative, so the minimum can only have risen. (Not so where a sum had no
+    // minimum and the best of three points stood in for it: rare on scans, and it only
+    // delays that collapse.) Such an edge is rated once when it comes up instead of once per
+    // collapse next to it, and many never come up before they are written.
+    kAfterCollapse,
+};
+
+// Rates the edges of v (as `mode` says). Edges to a vertex on P_in are passed over: neither
+// way is eligible, and such an edge was never queued (a vertex is on P_in from its creation
+// only), so rating it would only forget it again.
+void rate_edges_around(HalfEdgeBuffer& buffer, CollapseQueue& queue, uint32_t v, Rerate mode) {
+    const uint16_t pass_over = kInHash | (mode == Rerate::kSkipPending ? kPending : 0);
+    constexpr uint16_t kNoSource = kInHash | kFrozen | kNonManifold | kManyFans | kSeam;
+    auto free_end = [](const Vertex& x) {
+        return (x.flags & kNoSource) == 0 && x.open_edges == 0 && x.face_count <= kMaxMovedFaces;
+    };
+    const bool lazy = mode == Rerate::kAfterCollapse && free_end(buffer.vertex(v));
+    // Whether the edge of h (from v) is left as it is.
+    auto kept = [&](uint32_t h) {
+        return lazy && is_half_edge(buffer.twin(h)) && free_end(buffer.vertex(buffer.corner_vertex(next_in_face(h)))) &&
+               CollapseQueue::keep_as_lower_bound(buffer, h);
+    };
     // Every rating reads both ends' vertex records (and attribute records, with channels), far
     // apart in their pools: asked for all at once, their cache misses overlap (a hint only).
     const AttributeStore* attributes = buffer.attributes();
@@ -87,7 +114,7 @@ void rate_edges_around(HalfEdgeBuffer& buffer, CollapseQueue& queue, uint32_t v,
     }
     for (uint32_t c = buffer.vertex(v).first_corner; c != kNoIndex; c = buffer.next_corner(c)) {
         const uint32_t to = buffer.corner_vertex(next_in_face(c));
-        if ((buffer.vertex(to).flags & pass_over) == 0) rate_edge(buffer, queue, c);  // v→next
+        if ((buffer.vertex(to).flags & pass_over) == 0 && !kept(c)) rate_edge(buffer, queue, c);  // v→next
         // prev→v is also the next one's v→prev, except where v's fan is open.
         const uint32_t in = prev_in_face(c);
         if (is_half_edge(buffer.twin(in))) continue;
@@ -98,13 +125,9 @@ void rate_edges_around(HalfEdgeBuffer& buffer, CollapseQueue& queue, uint32_t v,
 
 }  // namespace
 
-void rate_vertex_edges(HalfEdgeBuffer& buffer, CollapseQueue& queue, uint32_t v) {
-    rate_edges_around(buffer, queue, v, false);
-}
-
 void rate_pending(HalfEdgeBuffer& buffer, CollapseQueue& queue) {
     const PhaseTimer timer(Phase::kQueue);
-    buffer.take_pending([&](uint32_t v) { rate_edges_around(buffer, queue, v, true); });
+    buffer.take_pending([&](uint32_t v) { rate_edges_around(buffer, queue, v, Rerate::kSkipPending); });
 }
 
 void rate_all(HalfEdgeBuffer& buffer, CollapseQueue& queue) {
@@ -143,19 +166,20 @@ bool collapse_cheapest(HalfEdgeBuffer& buffer, CollapseQueue& queue) {
             continue;
         }
         apply_collapse(buffer, h, placement.target);
-        // q's edges are rated again at once, while its fan is in the cache from validating and
-        // applying the collapse, as are blocked neighbours' (they may have valid collapses now).
-        rate_vertex_edges(buffer, queue, q);
+        // q's edges are rated again (those kept as lower bounds when they come up), while its
+        // fan is in the cache from validating and applying the collapse, as are blocked
+        // neighbours' (they may have valid collapses now).
+        rate_edges_around(buffer, queue, q, Rerate::kAfterCollapse);
         for (uint32_t c = buffer.vertex(q).first_corner; c != kNoIndex; c = buffer.next_corner(c)) {
             for (const uint32_t w : {buffer.corner_vertex(next_in_face(c)), buffer.corner_vertex(prev_in_face(c))}) {
                 Vertex& x = buffer.vertex(w);
                 if ((x.flags & kBlocked) == 0) continue;
                 x.flags &= ~kBlocked;
-                rate_vertex_edges(buffer, queue, w);
+                rate_edges_around(buffer, queue, w, Rerate::kAll);
             }
         }
         buffer.vertex(q).flags &= ~kBlocked;
-        buffer.take_pending([&](uint32_t v) { rate_edges_around(buffer, queue, v, true); });
+        buffer.take_pending([&](uint32_t v) { rate_edges_around(buffer, queue, v, Rerate::kSkipPending); });
         return true;
     }
 }

@@ -1,6 +1,7 @@
 // DECIMATE (Wu & Kobbelt 2003, §4.3) as Garland & Heckbert's greedy order: every eligible edge
 // of the buffer is rated once, when its second end leaves P_in, and again whenever an end
-// changes; the cheapest valid collapse in the buffer comes next. Wu & Kobbelt take the best of
+// changes (after a collapse, an edge between free ends whose rating can only have risen: when
+// it comes up); the cheapest valid collapse in the buffer comes next. Wu & Kobbelt take the best of
 // a few random candidates instead; with cached ratings in a bucketed queue (collapse_queue.hpp)
 // the exact order costs less than the random draws did, and the buffer's cheapest collapses
 // are then always in the part read last, which keeps the work in cache.
@@ -21,8 +22,6 @@ namespace meshstream::decimate {
 // the same merge when both ends are free) placed by collapse_placement() and queued; or
 // forgotten when neither direction is eligible.
 void rate_edge(HalfEdgeBuffer& buffer, CollapseQueue& queue, uint32_t h);
-// Rates every edge of vertex v.
-void rate_vertex_edges(HalfEdgeBuffer& buffer, CollapseQueue& queue, uint32_t v);
 // Rates the edges of the vertices HalfEdgeBuffer::take_pending() lists.
 void rate_pending(HalfEdgeBuffer& buffer, CollapseQueue& queue);
 // Empties the queue and rates every edge of the buffer (refused ones too).

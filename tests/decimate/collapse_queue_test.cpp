@@ -65,6 +65,34 @@ TEST(CollapseQueue, PopsTheCheapestFirstAndTheLastQueuedFirstWithinABucket) {
     for (const uint32_t h : e) EXPECT_EQ(o.buffer.queue_key(h), kNotQueued);
 }
 
+// An edge kept as a lower bound comes up under its old key, to be rated afresh; an edge that is
+// not queued cannot be kept.
+TEST(CollapseQueue, AnEdgeKeptAsALowerBoundComesUpToBeRated) {
+    Octahedron o;
+    CollapseQueue queue(64);
+    const std::vector<uint32_t>& e = o.edges;
+    queue.push(o.buffer, e[0], false, 1.0);
+    queue.push(o.buffer, e[1], true, 2.0);
+    EXPECT_FALSE(CollapseQueue::keep_as_lower_bound(o.buffer, e[2]));
+    EXPECT_EQ(o.buffer.queue_key(e[2]), kNotQueued);
+    EXPECT_EQ(o.buffer.queue_key(o.buffer.twin(e[2])), kNotQueued);
+    // Through either half-edge of the edge: the key stays where it is.
+    EXPECT_TRUE(CollapseQueue::keep_as_lower_bound(o.buffer, e[0]));
+    EXPECT_TRUE(CollapseQueue::keep_as_lower_bound(o.buffer, o.buffer.twin(e[1])));
+    EXPECT_EQ(o.buffer.queue_key(o.buffer.twin(e[1])), kNotQueued);
+    bool rerate = false;
+    EXPECT_EQ(queue.pop(o.buffer, rerate), e[0]);
+    EXPECT_TRUE(rerate);
+    EXPECT_EQ(o.buffer.queue_key(e[0]), kNotQueued);
+    queue.push(o.buffer, e[0], false, 3.0);  // what the caller rates it now
+    // e[1] was queued to collapse its twin; kept, it comes up as itself (the edge is rated
+    // again, both ways).
+    EXPECT_EQ(queue.pop(o.buffer, rerate), e[1]);
+    EXPECT_TRUE(rerate);
+    EXPECT_EQ(pop_all(o.buffer, queue), (std::vector<uint32_t>{e[0]}));
+    EXPECT_EQ(queue.entries(), 0u);
+}
+
 TEST(CollapseQueue, AnEdgeQueuedAgainCountsOnlyUnderItsLastKey) {
     Octahedron o;
     CollapseQueue queue(64);
