@@ -302,10 +302,6 @@ void HalfEdgeBuffer::add_written_stub(uint32_t a, uint32_t b) {
     ++stub_count_;
 }
 
-// Corner lists longer than this are not walked when a triangle is read at their vertex (see
-// add_triangle); shorter ones are, as the faster way for ordinary valences.
-constexpr uint32_t kLongCornerList = 64;
-
 HalfEdgeBuffer::Added HalfEdgeBuffer::add_triangle(const float tri[9], const uint64_t hashes[3]) {
     assert(!full() && free_vertex_count() >= 3);
     Added added;
@@ -335,48 +331,33 @@ HalfEdgeBuffer::Added HalfEdgeBuffer::add_triangle(const float tri[9], const uin
     // b→a already taken) makes the edge non-manifold: the new half-edge stays unconnected and
     // both ends are frozen against collapses.
     //
-    // One walk over each corner's list finds, for every edge, the first existing a→b ("same")
-    // and b→a ("opposite") in list order (the new face is not linked yet, so the lists do not
-    // change during the walks).
+    // Walks over two corners' lists find, for every edge, the first existing a→b ("same") and
+    // b→a ("opposite") they meet, each edge a→b seen from either end: at a a corner followed
+    // by b, at b one preceded by a (the new face is not linked yet, so the lists do not change
+    // during the walks). The corner in the most faces is left out: its list is the
+    // longest walk and its face records the most cache misses, and at a vertex in thousands
+    // of faces (a scanner's invalid points, all written at the origin) walking it for every
+    // triangle read there made reading quadratic.
     uint32_t same[3] = {kNoIndex, kNoIndex, kNoIndex}, opposite[3] = {kNoIndex, kNoIndex, kNoIndex};
     uint32_t longest = 0;
     for (uint32_t k = 1; k < 3; ++k)
         if (slots_[v[k]].vertex.face_count > slots_[v[longest]].vertex.face_count) longest = k;
-    if (slots_[v[longest]].vertex.face_count <= kLongCornerList) {
-        for (uint32_t k = 0; k < 3; ++k) {
-            const uint32_t to_next = v[k == 2 ? 0 : k + 1], to_prev = v[k == 0 ? 2 : k - 1];
-            const uint32_t k_prev = k == 0 ? 2 : k - 1;
-            for (uint32_t c = slots_[v[k]].vertex.first_corner; c != kNoIndex;) {
-                const Face& face = faces_[face_of(c)];
-                const uint32_t j = corner_of(c);
-                const uint32_t w = face.vertex[j == 2 ? 0 : j + 1];
-                if (w == to_next && same[k] == kNoIndex) same[k] = c;                    // v[k]→v[k+1]
-                if (w == to_prev && opposite[k_prev] == kNoIndex) opposite[k_prev] = c;  // v[k]→v[k−1]
-                c = face.next[j];
-            }
-        }
-    } else {
-        // A vertex in thousands of faces (a scanner's invalid points, all written at the
-        // origin) made every triangle read at it walk its whole list: quadratic. The other
-        // two corners' lists cover all three edges, each edge a→b seen from either end: at a
-        // a corner followed by b, at b one preceded by a.
-        for (const uint32_t k : {(longest + 1) % 3, (longest + 2) % 3}) {
-            const uint32_t k_next = (k + 1) % 3, k_prev = (k + 2) % 3;
-            for (uint32_t c = slots_[v[k]].vertex.first_corner; c != kNoIndex;) {
-                const Face& face = faces_[face_of(c)];
-                const uint32_t j = corner_of(c);
-                const uint32_t j_prev = j == 0 ? 2 : j - 1;
-                const uint32_t after = face.vertex[j == 2 ? 0 : j + 1], before = face.vertex[j_prev];
-                const uint32_t into = half_edge(face_of(c), j_prev);  // before→v[k]
-                auto first = [](uint32_t& found, uint32_t h) {
-                    if (found == kNoIndex) found = h;
-                };
-                if (after == v[k_next]) first(same[k], c);           // v[k]→v[k+1]
-                if (after == v[k_prev]) first(opposite[k_prev], c);  // v[k]→v[k−1]
-                if (before == v[k_next]) first(opposite[k], into);   // v[k+1]→v[k]
-                if (before == v[k_prev]) first(same[k_prev], into);  // v[k−1]→v[k]
-                c = face.next[j];
-            }
+    for (const uint32_t k : {(longest + 1) % 3, (longest + 2) % 3}) {
+        const uint32_t k_next = (k + 1) % 3, k_prev = (k + 2) % 3;
+        for (uint32_t c = slots_[v[k]].vertex.first_corner; c != kNoIndex;) {
+            const Face& face = faces_[face_of(c)];
+            const uint32_t j = corner_of(c);
+            const uint32_t j_prev = j == 0 ? 2 : j - 1;
+            const uint32_t after = face.vertex[j == 2 ? 0 : j + 1], before = face.vertex[j_prev];
+            const uint32_t into = half_edge(face_of(c), j_prev);  // before→v[k]
+            auto first = [](uint32_t& found, uint32_t h) {
+                if (found == kNoIndex) found = h;
+            };
+            if (after == v[k_next]) first(same[k], c);           // v[k]→v[k+1]
+            if (after == v[k_prev]) first(opposite[k_prev], c);  // v[k]→v[k−1]
+            if (before == v[k_next]) first(opposite[k], into);   // v[k+1]→v[k]
+            if (before == v[k_prev]) first(same[k_prev], into);  // v[k−1]→v[k]
+            c = face.next[j];
         }
     }
     for (uint32_t k = 0; k < 3; ++k) {

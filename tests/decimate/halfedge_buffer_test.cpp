@@ -85,8 +85,8 @@ TEST(HalfEdgeBuffer, DuplicateAndMisorientedFacesAreFrozen) {
     EXPECT_EQ(buffer.nonmanifold_edges(), 3u);
 }
 
-// Vertices in more faces than kLongCornerList have their edges found from the other corners'
-// lists (a hub of thousands of faces made reading quadratic). A closed double cone with two
+// A triangle's edges are found from the lists of its two corners in the fewest faces (a hub of
+// thousands of faces made reading quadratic when its list was walked). A closed double cone with two
 // hubs of 300 faces each, the hub at every corner position in turn, connects like any mesh;
 // a third face on a spoke and a duplicate face at a hub are non-manifold as elsewhere.
 TEST(HalfEdgeBuffer, EdgesAtVerticesInHundredsOfFacesConnectAsElsewhere) {
