@@ -36,6 +36,19 @@ std::vector<std::array<int, 3>> grid_faces(int n) {
     return faces;
 }
 
+// The points of an n×n vertex grid (unit spacing, row by row) on the surface
+// z = a·dx² + b·dy² + c·dx·dy about its centre (dx, dy from the middle of the grid).
+std::vector<std::array<float, 3>> curved_grid(int n, float a, float b, float c) {
+    std::vector<std::array<float, 3>> points;
+    const float mid = 0.5f * float(n - 1);
+    for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x) {
+            const float dx = float(x) - mid, dy = float(y) - mid;
+            points.push_back({float(x), float(y), a * dx * dx + b * dy * dy + c * dx * dy});
+        }
+    return points;
+}
+
 // A 5×5 vertex grid (32 triangles) on the bowl z = bump·((x−2)² + (y−2)²) (0: flat).
 void add_grid(HalfEdgeBuffer& buffer, float bump = 0.1f) {
     std::vector<std::array<float, 3>> points;
@@ -351,12 +364,7 @@ TEST(Collapse, CheapestFirstReducesAClosedMesh) {
 // as fans close and collapses between the rows.
 TEST(Collapse, NoEdgeWithAnEndOnPInIsQueued) {
     constexpr int n = 12;
-    std::vector<std::array<float, 3>> points;
-    for (int y = 0; y < n; ++y)
-        for (int x = 0; x < n; ++x) {
-            const float dx = float(x) - 5.5f, dy = float(y) - 5.5f;
-            points.push_back({float(x), float(y), 0.05f * dx * dx + 0.03f * dy * dy});
-        }
+    const std::vector<std::array<float, 3>> points = curved_grid(n, 0.05f, 0.03f, 0);
     const std::vector<std::array<int, 3>> faces = grid_faces(n);
     HalfEdgeBuffer buffer(512, 0);
     CollapseQueue queue(512);
@@ -389,12 +397,7 @@ TEST(Collapse, NoEdgeWithAnEndOnPInIsQueued) {
 // edge's rating now.
 TEST(Collapse, EdgesKeptAfterACollapseAreRatedNoLowerThanTheirKeys) {
     constexpr int n = 14;
-    std::vector<std::array<float, 3>> points;
-    for (int y = 0; y < n; ++y)
-        for (int x = 0; x < n; ++x) {
-            const float dx = float(x) - 6.5f, dy = float(y) - 6.5f;
-            points.push_back({float(x), float(y), 0.05f * dx * dx - 0.03f * dy * dy + 0.01f * dx * dy});
-        }
+    const std::vector<std::array<float, 3>> points = curved_grid(n, 0.05f, -0.03f, 0.01f);
     HalfEdgeBuffer buffer(1024, 0);
     CollapseQueue queue(1024);
     add_indexed(buffer, points, grid_faces(n));
