@@ -13,6 +13,15 @@ namespace meshstream::decimate {
 
 namespace {
 
+// Flags of a vertex that may not be the source of a collapse (collapse_eligible).
+constexpr uint16_t kNoSource = kInHash | kFrozen | kNonManifold | kManyFans | kSeam;
+
+// A free end: none of those flags, no open edge, a small fan. An interior edge between two free
+// ends is eligible both ways, as the same merge (collapse_target_free).
+bool free_end(const Vertex& x) {
+    return (x.flags & kNoSource) == 0 && x.open_edges == 0 && x.face_count <= kMaxMovedFaces;
+}
+
 // Queues the merge of both free ends p and q of h at the minimum of Q_p + Q_q, rated at the
 // exact minimum (collapse_placement() rounds it to floats).
 void rate_merge(HalfEdgeBuffer& buffer, CollapseQueue& queue, uint32_t h, uint32_t p, uint32_t q) {
@@ -29,9 +38,7 @@ void rate_edge(HalfEdgeBuffer& buffer, CollapseQueue& queue, uint32_t h) {
     const uint32_t p = buffer.corner_vertex(h), q = buffer.corner_vertex(next_in_face(h));
     const Vertex& vp = buffer.vertex(p);
     const Vertex& vq = buffer.vertex(q);
-    constexpr uint16_t kNoSource = kInHash | kFrozen | kNonManifold | kManyFans | kSeam;
-    // Most edges first: an interior edge whose ends carry none of those flags, have no open
-    // edge and small fans is eligible both ways, as the same merge (collapse_target_free).
+    // Most edges first: an interior edge between free ends (free_end() of both, in one test).
     if (is_half_edge(t) && ((vp.flags | vq.flags) & kNoSource) == 0 && (vp.open_edges | vq.open_edges) == 0 &&
         vp.face_count <= kMaxMovedFaces && vq.face_count <= kMaxMovedFaces) {
         rate_merge(buffer, queue, h, p, q);
@@ -77,15 +84,15 @@ enum class Rerate {
     // Not those whose other end is still listed for take_pending() (it rates them when its turn
     // comes: each edge once).
     kSkipPending,
-    // v is the vertex a collapse p→q left (q, moved and holding Q_p + Q_q). An edge between two
-    // free ends (no flag barring either, no open edge, small fans) that is queued keeps its
-    // entry as a lower bound (CollapseQueue::keep_as_lower_bound) and is rated when it comes
-    // up. Its key rated it as a merge of free ends, at the minimum of their summed quadrics
-    // (an edge of q's or of p's before), and v's quadric now holds both ends' old ones: a
-    // quadric is never negative, so the minimum can only have risen. (Not so where a sum had no
-    // minimum and the best of three points stood in for it: rare on scans, and it only
+    // v is the vertex a collapse p→q left (q, moved and holding Q_p + Q_q). A queued edge
+    // between two free ends (free_end) keeps its entry as a lower bound
+    // (CollapseQueue::keep_as_lower_bound) and is rated when it comes up. Its key rated it as a
+    // merge of free ends, at the minimum of their summed quadrics (an edge of q's or of p's
+    // before), and v's quadric now holds both ends' old ones: a quadric is never negative, so
+    // the minimum can only have risen. (Not always where a sum had no minimum and the best of
+    // three points stood in for it, as on flat stretches: a key above the new rating only
     // delays that collapse.) Such an edge is rated once when it comes up instead of once per
-    // collapse next to it, and many never come up before they are written.
+    // collapse next to it, or never, when a collapse nearby removes it or it is written first.
     kAfterCollapse,
 };
 
@@ -94,10 +101,6 @@ enum class Rerate {
 // only), so rating it would only forget it again.
 void rate_edges_around(HalfEdgeBuffer& buffer, CollapseQueue& queue, uint32_t v, Rerate mode) {
     const uint16_t pass_over = kInHash | (mode == Rerate::kSkipPending ? kPending : 0);
-    constexpr uint16_t kNoSource = kInHash | kFrozen | kNonManifold | kManyFans | kSeam;
-    auto free_end = [](const Vertex& x) {
-        return (x.flags & kNoSource) == 0 && x.open_edges == 0 && x.face_count <= kMaxMovedFaces;
-    };
     const bool lazy = mode == Rerate::kAfterCollapse && free_end(buffer.vertex(v));
     // Whether the edge of h (from v) is left as it is.
     auto kept = [&](uint32_t h) {
