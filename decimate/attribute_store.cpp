@@ -12,7 +12,7 @@ namespace {
 
 // Re-expresses a quadric given in y = x − a in y' = x − a' with t = a' − a: Q(y' + t) has
 // b + A t and c + 2 bᵀt + tᵀA t.
-Quadric translated(Quadric a, const double t[3]) {
+inline Quadric translated(Quadric a, const double t[3]) {
     const double at[3] = {a.a00 * t[0] + a.a01 * t[1] + a.a02 * t[2], a.a01 * t[0] + a.a11 * t[1] + a.a12 * t[2],
                           a.a02 * t[0] + a.a12 * t[1] + a.a22 * t[2]};
     a.c += 2 * (a.b0 * t[0] + a.b1 * t[1] + a.b2 * t[2]) + (at[0] * t[0] + at[1] * t[1] + at[2] * t[2]);
@@ -22,12 +22,20 @@ Quadric translated(Quadric a, const double t[3]) {
     return a;
 }
 
-// The same for a whole attribute quadric: its values G·(y' + t) + D have D + G·t.
-void translate(double* q, int m, const double t[3]) {
-    AttributeQuadric::set_part(q, translated(AttributeQuadric::part(q), t));
+// Adds a whole attribute quadric q (doubles, or another stored one), re-expressed with t as above
+// (its values G·(y' + t) + D have D + G·t), to one stored in float.
+template <typename T>
+void add_translated(float* stored, const T* q, int m, const double t[3]) {
+    const Quadric a = translated(AttributeQuadric::part(q), t);
+    const double part[10] = {a.a00, a.a01, a.a02, a.a11, a.a12, a.a22, a.b0, a.b1, a.b2, a.c};
+    for (int i = 0; i < 10; ++i) stored[i] = float(double(stored[i]) + part[i]);
+    stored[10] = float(double(stored[10]) + double(q[10]));
     for (int j = 0; j < m; ++j) {
-        double* g = q + 11 + 4 * j;
-        g[3] += g[0] * t[0] + g[1] * t[1] + g[2] * t[2];
+        const T* g = q + 11 + 4 * j;
+        float* out = stored + 11 + 4 * j;
+        for (int i = 0; i < 3; ++i) out[i] = float(double(out[i]) + double(g[i]));
+        out[3] = float(double(out[3]) + (double(g[3]) + (double(g[0]) * t[0] + double(g[1]) * t[1] +
+                                                         double(g[2]) * t[2])));
     }
 }
 
@@ -75,15 +83,10 @@ void AttributeStore::reference(const HalfEdgeBuffer& buffer, uint32_t v, double 
     for (int i = 0; i < 3; ++i) r[i] = double(ref[i]) - buffer.origin(i);
 }
 
-void AttributeStore::add_quadric(const HalfEdgeBuffer& buffer, uint32_t v, const double* q, const double at[3]) {
-    double r[3], local[AttributeQuadric::size(kMaxAttributeComponents)];
-    reference(buffer, v, r);
-    const size_t n = AttributeQuadric::size(m_);
-    std::copy_n(q, n, local);
-    const double t[3] = {r[0] - at[0], r[1] - at[1], r[2] - at[2]};  // from x − at to x − r
-    translate(local, m_, t);
-    float* stored = record(v);
-    for (size_t i = 0; i < n; ++i) stored[i] = float(double(stored[i]) + local[i]);
+void AttributeStore::add_quadric(const HalfEdgeBuffer& buffer, uint32_t v, const double* q) {
+    double r[3];
+    reference(buffer, v, r);  // from x to x − r
+    add_translated(record(v), q, m_, r);
 }
 
 void AttributeStore::init_vertex(HalfEdgeBuffer& buffer, uint32_t v, const float* value, uint32_t material) {
@@ -135,8 +138,7 @@ void AttributeStore::add_face(HalfEdgeBuffer& buffer, uint32_t f, const float* c
     if (m == 0) return;
     double q[AttributeQuadric::size(kMaxAttributeComponents)];
     AttributeQuadric::from_triangle(q, p[0], p[1], p[2], corners, corners + m, corners + 2 * m, m_, omega());
-    const double origin[3] = {0, 0, 0};
-    for (uint32_t k = 0; k < 3; ++k) add_quadric(buffer, v[k], q, origin);
+    for (uint32_t k = 0; k < 3; ++k) add_quadric(buffer, v[k], q);
 }
 
 bool AttributeStore::seam_allows(const HalfEdgeBuffer& buffer, uint32_t h) const {
@@ -245,10 +247,11 @@ void AttributeStore::merge(HalfEdgeBuffer& buffer, uint32_t h) {
         }
     }
     // p's quadric, relative to p's reference point, into q's.
-    double from_p[AttributeQuadric::size(kMaxAttributeComponents)], rp[3];
-    local_quadric(p, from_p);
+    double rp[3], rq[3];
     reference(buffer, p, rp);
-    add_quadric(buffer, q, from_p, rp);
+    reference(buffer, q, rq);
+    const double t[3] = {rq[0] - rp[0], rq[1] - rp[1], rq[2] - rp[2]};
+    add_translated(record(q), record(p), m_, t);
     float* lo = range_lo(q);
     float* hi = range_hi(q);
     for (int j = 0; j < m_; ++j) lo[j] = std::min(lo[j], range_lo(p)[j]), hi[j] = std::max(hi[j], range_hi(p)[j]);
@@ -282,19 +285,43 @@ Quadric AttributeStore::reduced(const HalfEdgeBuffer& buffer, uint32_t v) const 
 }
 
 Quadric AttributeStore::merged_reduced(const HalfEdgeBuffer& buffer, uint32_t p, uint32_t q) const {
-    // Summed in q's frame (p's translated by the short way between the two reference points),
-    // reduced there, and only the reduced quadric taken to the origin's frame.
-    double a[AttributeQuadric::size(kMaxAttributeComponents)], b[AttributeQuadric::size(kMaxAttributeComponents)];
+    // Summed in q's frame (p's translated by the short way t between the two reference points),
+    // reduced there, and only the reduced quadric taken to the origin's frame; in one pass over
+    // the two records (AttributeQuadric::add() and AttributeQuadric::reduced() written out).
+    const float* a = record(q);
+    const float* b = record(p);
     double rp[3], rq[3];
-    local_quadric(q, a);
-    local_quadric(p, b);
     reference(buffer, p, rp);
     reference(buffer, q, rq);
-    const double to_q[3] = {rq[0] - rp[0], rq[1] - rp[1], rq[2] - rp[2]};
-    translate(b, m_, to_q);
-    AttributeQuadric::add(a, b, m_);
-    const double t[3] = {-rq[0], -rq[1], -rq[2]};
-    return translated(AttributeQuadric::reduced(a, m_, omega()), t);
+    const double t[3] = {rq[0] - rp[0], rq[1] - rp[1], rq[2] - rp[2]};
+    Quadric sum = AttributeQuadric::part(a);
+    sum += translated(AttributeQuadric::part(b), t);
+    const double area = double(a[10]) + double(b[10]);
+    if (area > 0) {
+        const double* omega = this->omega();
+        for (int j = 0; j < m_; ++j) {
+            if (omega[j] == 0) continue;
+            const float* ga = a + 11 + 4 * j;
+            const float* gb = b + 11 + 4 * j;
+            const double g[4] = {double(ga[0]) + double(gb[0]), double(ga[1]) + double(gb[1]),
+                                 double(ga[2]) + double(gb[2]),
+                                 double(ga[3]) + (double(gb[3]) + (double(gb[0]) * t[0] + double(gb[1]) * t[1] +
+                                                                   double(gb[2]) * t[2]))};
+            const double w = omega[j] / area;
+            sum.a00 -= w * g[0] * g[0];
+            sum.a01 -= w * g[0] * g[1];
+            sum.a02 -= w * g[0] * g[2];
+            sum.a11 -= w * g[1] * g[1];
+            sum.a12 -= w * g[1] * g[2];
+            sum.a22 -= w * g[2] * g[2];
+            sum.b0 -= w * g[0] * g[3];
+            sum.b1 -= w * g[1] * g[3];
+            sum.b2 -= w * g[2] * g[3];
+            sum.c -= w * g[3] * g[3];
+        }
+    }
+    const double to_origin[3] = {-rq[0], -rq[1], -rq[2]};
+    return translated(sum, to_origin);
 }
 
 double AttributeStore::error(const HalfEdgeBuffer& buffer, uint32_t v, const double x[3], const float* values) const {
@@ -303,23 +330,6 @@ double AttributeStore::error(const HalfEdgeBuffer& buffer, uint32_t v, const dou
     reference(buffer, v, r);
     const double y[3] = {x[0] - r[0], x[1] - r[1], x[2] - r[2]};
     return AttributeQuadric::error(local, m_, omega(), y, values);
-}
-
-Quadric AttributeStore::combined(const Quadric& g, const Quadric& r) {
-    const double w = g.a00 + g.a11 + g.a22;
-    const double s = w > 0 ? 1 / w : 0;
-    Quadric out = r;
-    out.a00 += s * g.a00;
-    out.a01 += s * g.a01;
-    out.a02 += s * g.a02;
-    out.a11 += s * g.a11;
-    out.a12 += s * g.a12;
-    out.a22 += s * g.a22;
-    out.b0 += s * g.b0;
-    out.b1 += s * g.b1;
-    out.b2 += s * g.b2;
-    out.c += s * g.c;
-    return out;
 }
 
 double AttributeStore::combined_error(const Quadric& g, double geometric_error, double attribute_error) {

@@ -108,7 +108,22 @@ public:
     // and reduced attribute quadric `r` is rated and placed by: g / W + r, W = trace of g (the
     // sum of its planes' weights), so the geometric part is a mean squared distance, as
     // meshoptimizer 1.2 rates collapses with attributes (attributes.hpp).
-    static Quadric combined(const Quadric& g, const Quadric& r);
+    static Quadric combined(const Quadric& g, const Quadric& r) {
+        const double w = g.a00 + g.a11 + g.a22;
+        const double s = w > 0 ? 1 / w : 0;
+        Quadric out = r;
+        out.a00 += s * g.a00;
+        out.a01 += s * g.a01;
+        out.a02 += s * g.a02;
+        out.a11 += s * g.a11;
+        out.a12 += s * g.a12;
+        out.a22 += s * g.a22;
+        out.b0 += s * g.b0;
+        out.b1 += s * g.b1;
+        out.b2 += s * g.b2;
+        out.c += s * g.c;
+        return out;
+    }
     // The same rating from a geometric error of `g` and an attribute error.
     static double combined_error(const Quadric& g, double geometric_error, double attribute_error);
 
@@ -131,8 +146,8 @@ private:
     const float* record(uint32_t v) const { return &records_[v * stride_]; }
     // The reference point of v's quadric, relative to the buffer's origin.
     void reference(const HalfEdgeBuffer& buffer, uint32_t v, double r[3]) const;
-    // Adds `q` (relative to the point `at`, itself relative to the buffer's origin) to v's quadric.
-    void add_quadric(const HalfEdgeBuffer& buffer, uint32_t v, const double* q, const double at[3]);
+    // Adds `q` (relative to the buffer's origin) to v's quadric.
+    void add_quadric(const HalfEdgeBuffer& buffer, uint32_t v, const double* q);
     // v's record's quadric as doubles, relative to v's reference point.
     void local_quadric(uint32_t v, double* out) const {
         const float* q = record(v);

@@ -107,8 +107,9 @@ struct AttributeQuadric {
     static void values(const double* q, int m, const double x[3], const float* fallback, float* out);
     // Σ A: the weight the attribute error carries.
     static double area(const double* q) { return q[10]; }
-    // The Quadric in the first 10 numbers, and back.
-    static Quadric part(const double* q) {
+    // The Quadric in the first 10 numbers (of a quadric, or of one stored in float), and back.
+    template <typename T>
+    static Quadric part(const T* q) {
         Quadric a;
         a.a00 = q[0], a.a01 = q[1], a.a02 = q[2], a.a11 = q[3], a.a12 = q[4], a.a22 = q[5];
         a.b0 = q[6], a.b1 = q[7], a.b2 = q[8], a.c = q[9];

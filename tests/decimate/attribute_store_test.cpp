@@ -190,6 +190,35 @@ TEST(AttributeStore, NoCollapseAlongASeamEdgeIntoASeamVertex) {
     EXPECT_FALSE(collapse_eligible(s.buffer, h));
 }
 
+TEST(AttributeStore, AMergeIsRatedByTheReducedSumOfBothQuadrics) {
+    // Triangles away from the buffer's origin, with a uv field that is not linear across them:
+    // p = (11, 5, 0.2) and q = (10.5, 6, 0.1) share the edge of the first two; q has a third.
+    Strip s;
+    const auto a = s.add({10, 5, 0, 11, 5, 0.2f, 10.5f, 6, 0.1f}, {0, 0, 1, 0.3f, 0.2f, 1});
+    s.add({11, 5, 0.2f, 11.5f, 6, 0, 10.5f, 6, 0.1f}, {1, 0.3f, 0.9f, 1.1f, 0.2f, 1});
+    s.add({10.5f, 6, 0.1f, 11.5f, 6, 0, 10.8f, 7, 0.3f}, {0.2f, 1, 0.9f, 1.1f, 0.1f, 2.5f});  // q's only
+    const uint32_t p = a.vertex[1], q = a.vertex[2];
+    const uint32_t h = half_edge(a.face, 1);  // p→q
+    ASSERT_EQ(s.buffer.corner_vertex(h), p);
+    const Quadric merged = s.store.merged_reduced(s.buffer, p, q);
+    const Quadric alone_p = s.store.reduced(s.buffer, p), alone_q = s.store.reduced(s.buffer, q);
+    std::vector<std::array<double, 3>> at(3);
+    s.buffer.position(p, at[0].data());
+    s.buffer.position(q, at[1].data());
+    for (int i = 0; i < 3; ++i) at[2][i] = 0.5 * (at[0][i] + at[1][i]) + 0.1;
+    // One value for both vertices costs at least their own best values each, and more here.
+    double excess = 0;
+    for (const auto& x : at) {
+        EXPECT_GE(merged.error(x.data()), alone_p.error(x.data()) + alone_q.error(x.data()) - 1e-9);
+        excess += merged.error(x.data()) - alone_p.error(x.data()) - alone_q.error(x.data());
+    }
+    EXPECT_GT(excess, 1e-4);
+    // The quadric q holds once p merged into it is the same, reduced by the one-vertex path.
+    s.store.merge(s.buffer, h);
+    const Quadric after = s.store.reduced(s.buffer, q);
+    for (const auto& x : at) EXPECT_NEAR(after.error(x.data()), merged.error(x.data()), 1e-5);
+}
+
 TEST(AttributeStore, AVertexThatAbsorbedCollapsesSettlesAtItsQuadricsValuesWithinItsInputsRange) {
     // Face (0,0) (1,0) (1,1) with uv = xy; (0,0) merges into (1,0), which then stands for inputs
     // with u in [0, 1] and v = 0.
