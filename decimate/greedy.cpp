@@ -160,6 +160,7 @@ bool collapse_cheapest(HalfEdgeBuffer& buffer, CollapseQueue& queue) {
         if (!collapse_eligible(buffer, h)) continue;
         prefetch_neighbourhood(buffer, h);
         const uint32_t p = buffer.corner_vertex(h), q = buffer.corner_vertex(next_in_face(h));
+        if (const AttributeStore* attributes = buffer.attributes()) attributes->prefetch_merge(p, q);
         const CollapsePlacement placement = collapse_placement(buffer, h);
         if (!collapse_valid(buffer, h, placement.target)) {
             // Its neighbourhood's shape or topology refuses it: that changes only when a

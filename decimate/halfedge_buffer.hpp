@@ -238,12 +238,23 @@ public:
             if (stage == 0) {
                 __builtin_prefetch(&hash_[hashes[k] & hash_mask_]);
             } else {
-                // An empty slot prefetches vertex 0 instead of branching: whether a corner is
-                // new is a coin toss to the branch predictor.
-                const uint32_t v = hash_[hashes[k] & hash_mask_];
-                prefetch_vertex(v != kNoIndex ? v : 0);
+                prefetch_vertex(welded_hint(hashes[k]));
             }
         }
+    }
+    // The slot a new vertex gets `ahead` allocations from now if no vertex is freed meanwhile,
+    // for a prefetch hint: a new vertex's records are written at once, and a freed slot has
+    // mostly left the cache since it was written out.
+    uint32_t allocation_hint(size_t ahead) const {
+        if (ahead < free_vertex_stack_) return free_vertices_[free_vertex_stack_ - 1 - ahead];
+        return uint32_t(std::min<size_t>(vertex_high_ + (ahead - free_vertex_stack_), vertex_capacity_ - 1));
+    }
+    // The vertex a corner of weld hash `hash` would probably weld to, for a prefetch hint (the
+    // first of its probe sequence); an empty slot gives vertex 0 instead of a branch: whether a
+    // corner is new is a coin toss to the branch predictor.
+    uint32_t welded_hint(uint64_t hash) const {
+        const uint32_t v = hash_[hash & hash_mask_];
+        return v != kNoIndex ? v : 0;
     }
     void set_twin(uint32_t h, uint32_t t) { faces_[face_of(h)].twin[corner_of(h)] = t; }
     uint32_t next_corner(uint32_t c) const { return faces_[face_of(c)].next[corner_of(c)]; }

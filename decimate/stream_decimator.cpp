@@ -114,7 +114,18 @@ void StreamDecimator::push(const io::TriangleChunk& in, double weight, const Emi
             buffer_.weld_hashes(&xyz[9 * (i + kSlotsAhead)], hashes);
             buffer_.prefetch_triangle(hashes, 0);
         }
-        if (i + kVerticesAhead < n) buffer_.prefetch_triangle(ring[(i + kVerticesAhead) % kRing], 1);
+        if (i + kVerticesAhead < n) {
+            const uint64_t* hashes = ring[(i + kVerticesAhead) % kRing];
+            buffer_.prefetch_triangle(hashes, 1);
+            // With channels, a welded corner also compares its values with its vertex's and adds
+            // to its attribute quadric, in a record of its own pool.
+            if (attributes_)
+                for (int k = 0; k < 3; ++k) attributes_->prefetch(buffer_.welded_hint(hashes[k]));
+            // About every other triangle brings a new vertex: the slot of the one after next.
+            const uint32_t fresh = buffer_.allocation_hint(1);
+            buffer_.prefetch_vertex(fresh);
+            if (attributes_) attributes_->prefetch(fresh);
+        }
         read_triangle(in, i, ring[i % kRing], out);
     }
 }
