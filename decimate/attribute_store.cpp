@@ -3,7 +3,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <stdexcept>
 #include <string>
 
@@ -130,7 +129,7 @@ void AttributeStore::add_face(HalfEdgeBuffer& buffer, uint32_t f, const float* c
         if ((flags & kHasValues) == 0) {
             init_vertex(buffer, v[k], value, material);
         } else if ((flags & kSeam) == 0 && ((vertex_material_ && vertex_material_[v[k]] != material) ||
-                                            std::memcmp(vertex_value(v[k]), value, 4 * m) != 0)) {
+                                            !same_values(vertex_value(v[k]), value))) {
             make_seam(buffer, v[k]);  // this face's corner is linked already: overwritten below
         }
         if (buffer.vertex(v[k]).flags & kSeam) std::copy_n(value, m, corner_value(half_edge(f, k)));
@@ -149,7 +148,7 @@ bool AttributeStore::seam_allows(const HalfEdgeBuffer& buffer, uint32_t h) const
     if (!is_half_edge(t)) return true;  // one face on the edge: one side
     // t runs q→p: its corner is q's on the other face.
     return material(face_of(h)) == material(face_of(t)) &&
-           std::memcmp(corner_value(q_corner), corner_value(t), 4 * size_t(m_)) == 0;
+           same_values(corner_value(q_corner), corner_value(t));
 }
 
 bool AttributeStore::slides(const HalfEdgeBuffer& buffer, uint32_t h) const {
@@ -242,7 +241,7 @@ void AttributeStore::merge(HalfEdgeBuffer& buffer, uint32_t h) {
         const uint32_t material_a = material(face_of(h));
         for (uint32_t c = buffer.vertex(p).first_corner; c != kNoIndex; c = buffer.next_corner(c)) {
             const bool on_a = !slide || (material(face_of(c)) == material_a &&
-                                         std::memcmp(corner_value(c), wedge_a, 4 * size_t(m_)) == 0);
+                                         same_values(corner_value(c), wedge_a));
             std::copy_n(on_a ? side_a : side_b, m_, corner_value(c));
         }
     }
