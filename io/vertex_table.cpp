@@ -163,6 +163,8 @@ void VertexTable::get(uint64_t i, float* xyz, std::byte* attributes) {
         rec = tail_.data() + (i - file_records_) * stride_;
     } else {
         at = file_offset_ % kPageBytes + i * stride_;
+        // Most records lie within one cached page: found once for all their fields.
+        if (at / kPageBytes == (at + stride_ - 1) / kPageBytes) rec = cached_page(at / kPageBytes) + at % kPageBytes;
     }
     // Copies n bytes of the record from `offset` on; from a file, out of the one or two cached
     // pages they span.
