@@ -306,17 +306,7 @@ Quadric AttributeStore::merged_reduced(const HalfEdgeBuffer& buffer, uint32_t p,
                                  double(ga[2]) + double(gb[2]),
                                  double(ga[3]) + (double(gb[3]) + (double(gb[0]) * t[0] + double(gb[1]) * t[1] +
                                                                    double(gb[2]) * t[2]))};
-            const double w = omega[j] / area;
-            sum.a00 -= w * g[0] * g[0];
-            sum.a01 -= w * g[0] * g[1];
-            sum.a02 -= w * g[0] * g[2];
-            sum.a11 -= w * g[1] * g[1];
-            sum.a12 -= w * g[1] * g[2];
-            sum.a22 -= w * g[2] * g[2];
-            sum.b0 -= w * g[0] * g[3];
-            sum.b1 -= w * g[1] * g[3];
-            sum.b2 -= w * g[2] * g[3];
-            sum.c -= w * g[3] * g[3];
+            AttributeQuadric::subtract_square(sum, omega[j] / area, g);
         }
     }
     const double to_origin[3] = {-rq[0], -rq[1], -rq[2]};

@@ -145,18 +145,7 @@ Quadric AttributeQuadric::reduced(const double* q, int m, const double* omega) {
     // Minimized over value s_j: Σ A (g·x + d − s)² = (that at s = 0) − (G·x + D)² / ΣA.
     for (int j = 0; j < m; ++j) {
         if (omega[j] == 0) continue;
-        const double* g = q + 11 + 4 * j;
-        const double w = omega[j] / area;
-        out.a00 -= w * g[0] * g[0];
-        out.a01 -= w * g[0] * g[1];
-        out.a02 -= w * g[0] * g[2];
-        out.a11 -= w * g[1] * g[1];
-        out.a12 -= w * g[1] * g[2];
-        out.a22 -= w * g[2] * g[2];
-        out.b0 -= w * g[0] * g[3];
-        out.b1 -= w * g[1] * g[3];
-        out.b2 -= w * g[2] * g[3];
-        out.c -= w * g[3] * g[3];
+        subtract_square(out, omega[j] / area, q + 11 + 4 * j);
     }
     return out;
 }

@@ -115,6 +115,20 @@ struct AttributeQuadric {
         a.b0 = q[6], a.b1 = q[7], a.b2 = q[8], a.c = q[9];
         return a;
     }
+    // Subtracts w·(g·x + d)² from `out`, with g = (g[0], g[1], g[2]) and d = g[3]: what the best
+    // value of a component of weight² ω takes off the error, w = ω / ΣA (reduced()).
+    static void subtract_square(Quadric& out, double w, const double g[4]) {
+        out.a00 -= w * g[0] * g[0];
+        out.a01 -= w * g[0] * g[1];
+        out.a02 -= w * g[0] * g[2];
+        out.a11 -= w * g[1] * g[1];
+        out.a12 -= w * g[1] * g[2];
+        out.a22 -= w * g[2] * g[2];
+        out.b0 -= w * g[0] * g[3];
+        out.b1 -= w * g[1] * g[3];
+        out.b2 -= w * g[2] * g[3];
+        out.c -= w * g[3] * g[3];
+    }
     static void set_part(double* q, const Quadric& a) {
         q[0] = a.a00, q[1] = a.a01, q[2] = a.a02, q[3] = a.a11, q[4] = a.a12, q[5] = a.a22;
         q[6] = a.b0, q[7] = a.b1, q[8] = a.b2, q[9] = a.c;
