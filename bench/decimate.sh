@@ -4,16 +4,22 @@
 # the compare error against the input. Medians of RUNS runs (compare runs once: it is
 # deterministic).
 #
-#   bench/decimate.sh                  # 1 M, 10 M, 50 M generated meshes + the bunny
-#   SIZES="1000000" RUNS=1 bench/decimate.sh
+#   bench/decimate.sh                  # 1 M, 10 M, 50 M generated meshes, the bunny, the corpus rows
+#   SIZES="1000000" RUNS=1 CORPUS=0 bench/decimate.sh
 #
 # Environment:
 #   BENCH_DIR  work dir for meshes and outputs (default /tmp/meshstream-bench; about 4 GB with 50 M)
 #   BUILD_DIR  build dir, configured here with -DMESHSTREAM_BUILD_BENCH=ON (default $BENCH_DIR/build)
-#   SIZES      generated mesh sizes in triangles (default "1000000 10000000 50000000")
+#   SIZES      generated mesh sizes in triangles (default "1000000 10000000 50000000"; "" for none)
 #   RATIOS     decimation ratios (default "0.1 0.01")
 #   RUNS       runs per measurement, median reported (default 3)
 #   CGAL_MAX   largest input given to the (slow) CGAL reference (default 1500000: the 1 M mesh)
+#   THREADS    meshstream's --threads (default 1: the references run on one core)
+#   CORPUS     1 (default) adds, at 10 %, the low-poly models of $SHARED/corpus (Spider,
+#              gearwheel, elephant, WusonOBJ; positions only: their normals and uvs dropped by
+#              meshstream, not read by the references), and the generated 1 M mesh with 40
+#              holes (meshstream-gen --holes) at 1 % through `--buffer 50000`; 0 leaves them out
+#   SHARED     the shared directory with corpus/ (default ../shared)
 #   COMPARE    0 to skip the error columns (default 1)
 #   DECIMATE_ARGS  extra options for `meshstream decimate` (e.g. "--buffer 200000")
 # Needs: cmake, g++, libmeshoptimizer-dev, libcgal-dev + libeigen3-dev (else no CGAL rows),
@@ -24,10 +30,13 @@ src=$(pwd)
 
 BENCH_DIR=${BENCH_DIR:-/tmp/meshstream-bench}
 BUILD_DIR=${BUILD_DIR:-$BENCH_DIR/build}
-SIZES=${SIZES:-"1000000 10000000 50000000"}
+SIZES=${SIZES-"1000000 10000000 50000000"}
 RATIOS=${RATIOS:-"0.1 0.01"}
 RUNS=${RUNS:-3}
 CGAL_MAX=${CGAL_MAX:-1500000}
+THREADS=${THREADS:-1}
+CORPUS=${CORPUS:-1}
+SHARED=${SHARED:-$src/../shared}
 COMPARE=${COMPARE:-1}
 DECIMATE_ARGS=${DECIMATE_ARGS:-}
 
@@ -45,17 +54,28 @@ ref_cgal=$BUILD_DIR/bench/ref_cgal
 "$ms" decimate --help >/dev/null 2>&1 || die "'meshstream decimate' does not exist in this build: nothing to benchmark"
 [ -x "$ref_cgal" ] || echo "bench/decimate.sh: no ref_cgal (apt-get install libcgal-dev libeigen3-dev): CGAL rows skipped" >&2
 
-# Inputs: generated meshes (made once, kept in BENCH_DIR) and the bunny fixture.
-inputs=()
-for n in $SIZES; do
-  f=$BENCH_DIR/gen_$n.stl
+# Cases, one a line: input, its ratios (comma-separated), meshstream's extra options. Generated
+# meshes are made once and kept in BENCH_DIR.
+generated() {  # N [--holes]: prints the path of a generated mesh of about N triangles
+  local f=$BENCH_DIR/gen_$1${2:+_holes}.stl
   if [ ! -s "$f" ]; then
     echo "== generating $f" >&2
-    "$gen" --triangles "$n" "$f"
+    "$gen" --triangles "$1" ${2:-} "$f" >&2
   fi
-  inputs+=("$f")
-done
-inputs+=("$src/fixtures/bunny_from_draco.bin.stl")
+  echo "$f"
+}
+all_ratios=$(echo "$RATIOS" | tr ' ' ',')
+cases=()
+for n in $SIZES; do cases+=("$(generated "$n")|$all_ratios|"); done
+cases+=("$src/fixtures/bunny_from_draco.bin.stl|$all_ratios|")
+if [ "$CORPUS" = 1 ]; then
+  positions_only="--drop normals,colors,uvs,extra,materials"
+  for f in stl/Spider_binary.stl stl/gearwheel.bin.stl ply/elephant_normals.binary_be.ply obj/WusonOBJ.obj; do
+    [ -s "$SHARED/corpus/$f" ] || die "no $SHARED/corpus/$f (set SHARED)"
+    cases+=("$SHARED/corpus/$f|0.1|$positions_only")
+  done
+  cases+=("$(generated 1000000 --holes)|0.01|--buffer 50000")
+fi
 
 results=$BENCH_DIR/results.tsv
 : >"$results"
@@ -82,10 +102,12 @@ print("%.5f\t%.4f\t%.6g\t%.6g" % (s["rms_pct"], s["max_pct"], s["rms"], s["max"]
 EOF
 }
 
-for in in "${inputs[@]}"; do
+for case in "${cases[@]}"; do
+  IFS='|' read -r in ratios extra <<<"$case"
   n=$("$ms" -q info --json "$in" | python3 -c 'import json,sys; print(json.load(sys.stdin)["triangles"])')
-  name=$(basename "$in" .stl)
-  for ratio in $RATIOS; do
+  name=$(basename "$in")
+  name=${name%.*}
+  for ratio in ${ratios//,/ }; do
     target=$(python3 -c "print(round($ratio * $n))")
     tools="meshstream meshopt"
     if [ -x "$ref_cgal" ] && [ "$n" -le "$CGAL_MAX" ]; then tools="$tools cgal"; fi
@@ -93,7 +115,8 @@ for in in "${inputs[@]}"; do
       out=$BENCH_DIR/out_${name}_${ratio}_$tool.stl
       echo "== $tool $name ratio $ratio ($RUNS runs)" >&2
       case $tool in
-        meshstream) m=$(median_of_runs "$ms" -q decimate $DECIMATE_ARGS "$in" "$out" --ratio "$ratio") ;;
+        # shellcheck disable=SC2086  # option lists
+        meshstream) m=$(median_of_runs "$ms" -q decimate --threads "$THREADS" $extra $DECIMATE_ARGS "$in" "$out" --ratio "$ratio") ;;
         meshopt) m=$(median_of_runs "$ref_meshopt" "$in" "$out" --target "$target") ;;
         cgal) m=$(median_of_runs "$ref_cgal" "$in" "$out" --target "$target") ;;
       esac

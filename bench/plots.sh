@@ -40,8 +40,8 @@ mkdir -p "$BENCH_DIR" "$OUT_DIR"
 # 1. Error against triangle count: one run each (the error is deterministic, time is not plotted).
 error_rows=$BENCH_DIR/error/results.tsv
 if [ "$REUSE" != 1 ] || [ ! -s "$error_rows" ]; then
-  BUILD_DIR=$BENCH_DIR/build BENCH_DIR=$BENCH_DIR/error SIZES=1000000 RATIOS=$RATIOS RUNS=1 \
-    DECIMATE_ARGS="--threads $THREADS" bash bench/decimate.sh >"$BENCH_DIR/error.txt"
+  BUILD_DIR=$BENCH_DIR/build BENCH_DIR=$BENCH_DIR/error SIZES=1000000 RATIOS=$RATIOS RUNS=1 CORPUS=0 \
+    THREADS=$THREADS bash bench/decimate.sh >"$BENCH_DIR/error.txt"
 fi
 
 # 2. Decimate to 1 % against input size, medians of RUNS (LARGE_RUNS), no compare (speed and
@@ -51,7 +51,7 @@ scaling_rows=$BENCH_DIR/scaling.tsv
 for n in $SIZES; do
   grep -q "^gen_$n	" "$scaling_rows" && continue
   BUILD_DIR=$BENCH_DIR/build BENCH_DIR=$BENCH_DIR/scaling SIZES=$n RATIOS=0.01 RUNS=$(runs_for "$n") CGAL_MAX=0 \
-    COMPARE=0 DECIMATE_ARGS="--threads $THREADS" bash bench/decimate.sh >>"$BENCH_DIR/scaling.txt"
+    COMPARE=0 CORPUS=0 THREADS=$THREADS bash bench/decimate.sh >>"$BENCH_DIR/scaling.txt"
   grep "^gen_" "$BENCH_DIR/scaling/results.tsv" >>"$scaling_rows"
 done
 
