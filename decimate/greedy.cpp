@@ -90,8 +90,9 @@ enum class Rerate {
     // merge of free ends, at the minimum of their summed quadrics (an edge of q's or of p's
     // before), and v's quadric now holds both ends' old ones: a quadric is never negative, so
     // the minimum can only have risen. (Not always where a sum had no minimum and the best of
-    // three points stood in for it, as on flat stretches: a key above the new rating only
-    // delays that collapse.) Such an edge is rated once when it comes up instead of once per
+    // three points stood in for it, as on flat stretches; nor with channels, whose rating
+    // divides the geometric error by the planes' weight, which grows too
+    // (AttributeStore::combined): a key above the new rating only delays that collapse.) Such an edge is rated once when it comes up instead of once per
     // collapse next to it, or never, when a collapse nearby removes it or it is written first.
     kAfterCollapse,
 };

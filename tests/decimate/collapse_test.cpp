@@ -51,11 +51,7 @@ std::vector<std::array<float, 3>> curved_grid(int n, float a, float b, float c) 
 
 // A 5×5 vertex grid (32 triangles) on the bowl z = bump·((x−2)² + (y−2)²) (0: flat).
 void add_grid(HalfEdgeBuffer& buffer, float bump = 0.1f) {
-    std::vector<std::array<float, 3>> points;
-    for (int y = 0; y < 5; ++y)
-        for (int x = 0; x < 5; ++x)
-            points.push_back({float(x), float(y), bump * float((x - 2) * (x - 2) + (y - 2) * (y - 2))});
-    add_indexed(buffer, points, grid_faces(5));
+    add_indexed(buffer, curved_grid(5, bump, bump, 0), grid_faces(5));
 }
 
 // Whether the placement puts the merged vertex elsewhere than q, the target of h = p→q.
