@@ -163,8 +163,7 @@ private:
 };
 
 size_t ExternalSorter::record_bytes_for(const io::Channels& channels) {
-    return 9 * sizeof(float) + 3 * io::CornerLayout(channels).bytes() + io::FaceLayout(channels).bytes() +
-           (channels.vertex_id ? 3 * sizeof(uint64_t) : 0);
+    return io::TriangleRecords(channels).bytes();
 }
 
 uint64_t ExternalSorter::run_capacity_for(uint64_t memory_budget_bytes, size_t record_bytes) {
@@ -176,37 +175,13 @@ uint64_t ExternalSorter::run_capacity_for(uint64_t memory_budget_bytes, size_t r
 ExternalSorter::ExternalSorter(SorterOptions options)
     : options_(std::move(options)),
       record_bytes_(record_bytes_for(options_.channels)),
-      corner_layout_(options_.channels),
-      face_layout_(options_.channels) {
+      codec_(options_.channels) {
     assert(options_.axis >= 0 && options_.axis <= 2);
     stats_.record_bytes = record_bytes_;
     stats_.run_capacity = run_capacity_for(options_.memory_budget_bytes, record_bytes_);
 }
 
 ExternalSorter::~ExternalSorter() = default;
-
-void ExternalSorter::encode(const io::TriangleChunk& chunk, size_t i, std::byte* dst) const {
-    std::memcpy(dst, &chunk.xyz()[9 * i], 9 * sizeof(float));
-    dst += 9 * sizeof(float);
-    if (const size_t n = corner_layout_.bytes()) {
-        for (int k = 0; k < 3; ++k, dst += n) corner_layout_.pack(chunk, i, k, dst);
-    }
-    face_layout_.pack(chunk, i, dst);
-    dst += face_layout_.bytes();
-    if (options_.channels.vertex_id) std::memcpy(dst, &chunk.vertex_ids()[3 * i], 3 * sizeof(uint64_t));
-}
-
-void ExternalSorter::decode(const std::byte* src, io::TriangleChunk& chunk) const {
-    std::memcpy(chunk.push_slot(), src, 9 * sizeof(float));
-    size_t i = chunk.size() - 1;
-    src += 9 * sizeof(float);
-    if (const size_t n = corner_layout_.bytes()) {
-        for (int k = 0; k < 3; ++k, src += n) corner_layout_.unpack(src, chunk, i, k);
-    }
-    face_layout_.unpack(src, chunk, i);
-    src += face_layout_.bytes();
-    if (options_.channels.vertex_id) std::memcpy(chunk.id_at(i), src, 3 * sizeof(uint64_t));
-}
 
 void ExternalSorter::add(const io::TriangleChunk& chunk) {
     assert(!input_done_);
@@ -222,7 +197,7 @@ void ExternalSorter::add(const io::TriangleChunk& chunk) {
     auto xyz = chunk.xyz();
     for (size_t i = 0; i < chunk.size(); ++i) {
         if (run_size_ == capacity) spill_run();
-        encode(chunk, i, records_.get() + run_size_ * record_bytes_);
+        codec_.encode(chunk, i, records_.get() + run_size_ * record_bytes_);
         items_[run_size_] = uint64_t{triangle_key(&xyz[9 * i], options_.axis)} << 32 | run_size_;
         ++run_size_;
     }
@@ -364,7 +339,7 @@ bool ExternalSorter::next(io::TriangleChunk& chunk) {
         while (!chunk.full() && emit_pos_ < sorted_.size()) {
             prefetch_record(records_.get(), record_bytes_, sorted_, emit_pos_);
             uint64_t item = sorted_[emit_pos_++];
-            decode(records_.get() + (item & 0xFFFFFFFFu) * record_bytes_, chunk);
+            codec_.decode(records_.get() + (item & 0xFFFFFFFFu) * record_bytes_, chunk);
         }
         if (emit_pos_ == sorted_.size() && records_ && chunk.empty()) {
             records_.reset();
@@ -377,7 +352,7 @@ bool ExternalSorter::next(io::TriangleChunk& chunk) {
     while (!chunk.full()) {
         const std::byte* rec = final_->top();
         if (!rec) break;
-        decode(rec, chunk);
+        codec_.decode(rec, chunk);
         final_->pop();
     }
     if (chunk.empty()) {

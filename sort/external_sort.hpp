@@ -20,6 +20,7 @@
 
 #include "io/byte_stream.hpp"
 #include "io/chunk.hpp"
+#include "io/triangle_records.hpp"
 
 #include <cstddef>
 #include <cstdint>
@@ -77,7 +78,7 @@ public:
 
     // Triangles per in-memory run for a budget and record size (at least 1024).
     static uint64_t run_capacity_for(uint64_t memory_budget_bytes, size_t record_bytes);
-    // Bytes per record for the given channels (36 for positions only).
+    // Bytes per record for the given channels (io::TriangleRecords: 36 for positions only).
     static size_t record_bytes_for(const io::Channels& channels);
 
 private:
@@ -92,8 +93,6 @@ private:
     void sort_run();
     void merge_pass(int pass, int pass_count, size_t fan_in);
     void start_final_merge();
-    void encode(const io::TriangleChunk& chunk, size_t i, std::byte* dst) const;
-    void decode(const std::byte* src, io::TriangleChunk& chunk) const;
     void write_temp(io::TempFile& file, const void* data, size_t n);
     // Punches [begin, end) out of the file; `consumed` bytes of run data are then gone.
     void release_temp_range(io::TempFile& file, uint64_t begin, uint64_t end, uint64_t consumed);
@@ -101,8 +100,7 @@ private:
     SorterOptions options_;
     SortStats stats_;
     size_t record_bytes_;
-    io::CornerLayout corner_layout_;  // per-corner attributes in a record
-    io::FaceLayout face_layout_;      // per-triangle attributes
+    io::TriangleRecords codec_;  // a triangle's record in the runs
     bool input_done_ = false;
 
     // Run generation.
