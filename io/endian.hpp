@@ -1,12 +1,14 @@
 // Byte order for the binary formats: loads and stores of little-endian values whatever the
 // host (binary STL, binary PLY, meshstream's triangle stream), and the byte swap for
-// big-endian PLY. On a little-endian host the array forms are one memcpy.
+// big-endian PLY. On a little-endian host the array forms are one memcpy. ByteWriter and
+// ByteReader put and get a record's fields one after another (part files, MPI messages).
 #pragma once
 
 #include <bit>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <string>
 #include <type_traits>
 #include <vector>
 
@@ -75,5 +77,90 @@ std::byte* store_le_array(std::byte* dst, const T* src, size_t n) {
     }
     return dst + n * sizeof(T);
 }
+
+// Appends fields to a byte string: numbers in little-endian order, texts as a u32 length and
+// their bytes, and whole trivially copyable structs as their bytes (native layout: for records
+// read back by the same build only).
+class ByteWriter {
+public:
+    template <class T>
+    void value(T v) {
+        static_assert(std::is_arithmetic_v<T> || std::is_enum_v<T>);
+        if constexpr (std::is_enum_v<T>)
+            value(static_cast<std::underlying_type_t<T>>(v));
+        else
+            append_le(bytes_, v);
+    }
+    void text(const std::string& s) {
+        value(uint32_t(s.size()));
+        raw_bytes(s.data(), s.size());
+    }
+    template <class T>
+    void raw(const T& v) {
+        static_assert(std::is_trivially_copyable_v<T>);
+        raw_bytes(&v, sizeof v);
+    }
+    void raw_bytes(const void* data, size_t n) {
+        if (n == 0) return;
+        const size_t at = bytes_.size();
+        bytes_.resize(at + n);
+        std::memcpy(bytes_.data() + at, data, n);
+    }
+    const std::vector<std::byte>& bytes() const { return bytes_; }
+    const std::byte* data() const { return bytes_.data(); }
+    size_t size() const { return bytes_.size(); }
+    void clear() { bytes_.clear(); }
+
+private:
+    std::vector<std::byte> bytes_;
+};
+
+// Reads what ByteWriter wrote, in the same order. Past the end nothing is read: the value is
+// T{} and ok() turns false for good, so a reader checks once after a group of fields.
+class ByteReader {
+public:
+    ByteReader(const void* data, size_t n) : p_(static_cast<const std::byte*>(data)), n_(n) {}
+    template <class T>
+    T value() {
+        static_assert(std::is_arithmetic_v<T> || std::is_enum_v<T>);
+        if constexpr (std::is_enum_v<T>) {
+            return static_cast<T>(value<std::underlying_type_t<T>>());
+        } else {
+            if (!take(sizeof(T))) return T{};
+            return load_le<T>(p_ + at_ - sizeof(T));
+        }
+    }
+    std::string text() {
+        const auto n = value<uint32_t>();
+        if (!take(n)) return {};
+        return std::string(reinterpret_cast<const char*>(p_ + at_ - n), n);
+    }
+    template <class T>
+    T raw() {
+        static_assert(std::is_trivially_copyable_v<T>);
+        T v{};
+        if (take(sizeof v)) std::memcpy(&v, p_ + at_ - sizeof v, sizeof v);
+        return v;
+    }
+    bool ok() const { return ok_; }
+    // Bytes read so far, and left.
+    size_t offset() const { return at_; }
+    size_t left() const { return n_ - at_; }
+    // Marks the record bad (a field out of its range).
+    void fail() { ok_ = false; }
+
+private:
+    bool take(size_t n) {
+        if (!ok_ || n > n_ - at_) {
+            ok_ = false;
+            return false;
+        }
+        at_ += n;
+        return true;
+    }
+    const std::byte* p_;
+    size_t n_, at_ = 0;
+    bool ok_ = true;
+};
 
 }  // namespace meshstream::io
