@@ -44,6 +44,9 @@ enum class Part : uint8_t {
     kSeams,
 };
 
+// TEMPORARY until the decimate constants land.
+inline constexpr size_t kDefaultBufferTriangles = 400000;
+
 struct Options {
     double ratio = 0.1;                // p in (0, 1]: output = round(p · input)
     std::optional<uint64_t> target;    // exact output triangle count instead of ratio

@@ -7,6 +7,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "io/shim_option_error.hpp"
+
 namespace meshstream::io {
 
 class Error : public std::runtime_error {

@@ -51,6 +51,9 @@ int run_command_line(CLI::App& app, const std::string& program, int argc, char**
     } catch (const UsageError& e) {
         say(program + ": " + command + ": " + e.what());
         return 2;
+    } catch (const io::OptionError& e) {  // a setting the libraries cannot work with: a bad command line
+        say(program + ": " + command + ": " + e.what());
+        return 2;
     } catch (const io::Error& e) {
         say(program + ": error: " + e.what());
         return 1;

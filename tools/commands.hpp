@@ -4,9 +4,13 @@
 
 #include <CLI/CLI.hpp>
 
+namespace meshstream::engine {
+class RangeProcesses;
+}
+
 namespace meshstream::tools {
 
-class RangeProcesses;
+using engine::RangeProcesses;
 
 void add_info(CLI::App& app);
 void add_convert(CLI::App& app);

@@ -66,25 +66,6 @@ CLI::Validator format_name(bool for_writing) {
 
 }  // namespace
 
-std::string dropped_channels_text(const std::string& dropped, const io::Format& output, const io::Channels& kept) {
-    const bool one = dropped.find(',') == std::string::npos;
-    return dropped + " dropped: " + std::string(output.name) + " output " +
-           (kept.has_attributes() ? std::string(one ? "does not carry it" : "does not carry them")
-                                  : std::string("carries positions only"));
-}
-
-void note_input_changes(const io::MeshHeader& header, const std::string& input_name, Warnings& warnings) {
-    for (const auto& [key, text] : header.notes)
-        if (key == io::kLastLineNote)
-            warnings.note("input_last_line_unterminated", input_name + ": the last line " + text +
-                                                              " (a truncated download or pipe?): check its last face");
-        else if (key == io::kPrecisionNote && header.coordinate_rounding.value_or(0) > 0)
-            warnings.note("input_coordinates_rounded",
-                          input_name + ": coordinates are " + text + "; meshstream works in float (32-bit)");
-    for (const io::ReaderWarning& w : header.warnings)
-        warnings.add("reader_warning", io::describe_warning(input_name, w), w.count);
-}
-
 void note_unused_write_flags(const WriteFlags& flags, const io::Format& output, const std::string& output_path,
                              Warnings& warnings) {
     if (flags.gzip_level != WriteFlags{}.gzip_level && (output_path == "-" || !io::wants_gzip(output_path)))
@@ -150,57 +131,6 @@ const io::Format& resolve_output_format(const std::string& output, const WriteFl
     throw UsageError(output + ": cannot tell the output format from the name (use --to, one of: " + format_names(true) +
                      ")");
 }
-
-namespace {
-
-// The file a path names, by device and inode, when it is an existing regular file ("-" is
-// the descriptor: stdin for an input, stdout for an output). Symbolic links are followed.
-std::optional<std::pair<dev_t, ino_t>> regular_file_id(const std::string& path, bool output) {
-    struct stat st;
-    const int rc = path == "-" ? ::fstat(output ? 1 : 0, &st) : ::stat(path.c_str(), &st);
-    if (rc != 0 || !S_ISREG(st.st_mode)) return std::nullopt;
-    return std::pair{st.st_dev, st.st_ino};
-}
-
-std::string shown(const std::string& path, bool output) { return path != "-" ? path : output ? "<stdout>" : "<stdin>"; }
-
-}  // namespace
-
-void refuse_output_over_inputs(const std::string& output, const std::vector<std::string>& output_side_files,
-                               const std::vector<InputFiles>& inputs) {
-    struct Target {
-        std::string path;
-        bool side;
-    };
-    std::vector<Target> targets{{output, false}};
-    for (const std::string& side : output_side_files) targets.push_back({side, true});
-    for (const Target& target : targets) {
-        const auto id = regular_file_id(target.path, true);
-        if (!id) continue;
-        for (const InputFiles& in : inputs) {
-            std::string why;
-            if (regular_file_id(in.path, false) == id) why = "the input " + shown(in.path, false);
-            for (const std::string& side : in.side_files)
-                if (why.empty() && regular_file_id(side, false) == id)
-                    why = side + ", which the input " + shown(in.path, false) + " reads";
-            if (why.empty()) continue;
-            const bool same_name = !target.side && target.path == in.path;
-            throw UsageError(shown(output, true) + ": " +
-                             (target.side ? "its side file " + target.path + " would overwrite " + why
-                                          : std::string("would overwrite ") + why +
-                                                (same_name ? "" : " (the same file, through a link)")) +
-                             "; write the output to another file");
-        }
-    }
-}
-
-void refuse_output_over_inputs(const std::string& output, const io::Format& format, const io::WriteOptions& options,
-                               const std::vector<InputFiles>& inputs) {
-    refuse_output_over_inputs(
-        output, format.side_files ? format.side_files(output, options) : std::vector<std::string>{}, inputs);
-}
-
-InputFiles input_files(const std::string& path, const io::MeshHeader& header) { return {path, header.side_files}; }
 
 double physical_memory_bytes() {
     const long pages = ::sysconf(_SC_PHYS_PAGES), page_bytes = ::sysconf(_SC_PAGESIZE);
@@ -532,96 +462,14 @@ void Progress::done() {
     drawn_ = false;
 }
 
-std::vector<Warnings::Line> Warnings::all() const {
-    std::vector<Line> out;
-    for (const auto& [text, entry] : entries_) out.push_back({entry.code, text, entry.count});
-    return out;
-}
-
-std::vector<std::string> Warnings::lines() const {
-    std::vector<std::string> out;
-    for (const auto& [text, entry] : entries_)
-        out.push_back(entry.count == 0 ? text : text + " (" + std::to_string(entry.count) + ")");
-    return out;
-}
-
-void Warnings::print() const {
-    for (const std::string& line : lines())
+void print_warnings(const Warnings& warnings) {
+    for (const std::string& line : warnings.lines())
         std::fprintf(stderr, "%s: warning: %s\n", global().program.c_str(), line.c_str());
 }
 
-std::string human_count(double n, int significant_digits) {
-    const char* unit = nullptr;
-    double scaled = n;
-    int decimals = 0;
-    if (n >= 1e9)
-        unit = "G", scaled = n / 1e9, decimals = 2;
-    else if (n >= 1e6)
-        unit = "M", scaled = n / 1e6, decimals = 2;
-    else if (n >= 1e4)
-        unit = "k", scaled = n / 1e3, decimals = 1;
-    char buf[32];
-    if (!unit)
-        std::snprintf(buf, sizeof buf, "%.0f", n);
-    else if (significant_digits > 0)
-        std::snprintf(buf, sizeof buf, "%.*g %s", significant_digits, scaled, unit);
-    else
-        std::snprintf(buf, sizeof buf, "%.*f %s", decimals, scaled, unit);
-    return buf;
-}
-
-std::string human_bytes(double bytes) {
-    char buf[32];
-    if (bytes >= 1e9)
-        std::snprintf(buf, sizeof buf, "%.2f GB", bytes / 1e9);
-    else if (bytes >= 1e6)
-        std::snprintf(buf, sizeof buf, "%.1f MB", bytes / 1e6);
-    else if (bytes >= 1e3)
-        std::snprintf(buf, sizeof buf, "%.1f kB", bytes / 1e3);
-    else
-        std::snprintf(buf, sizeof buf, "%.0f B", bytes);
-    return buf;
-}
-
-bool is_regular_file(const std::string& path) {
-    struct stat st;
-    return path != "-" && ::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
-}
-
 io::Bounds input_bounds(const std::string& path, std::string_view from, const io::ReadOptions& options) {
-    io::ReadOptions positions = options;  // nothing but positions is looked at
-    positions.channels = io::ChannelKinds::none();
-    io::Input in = io::open_input(path, from, positions);
-    io::Bounds box;
-    box.min.fill(std::numeric_limits<float>::infinity());
-    box.max.fill(-std::numeric_limits<float>::infinity());
-    io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity);
-    Progress progress("bounding box", in.reader->triangle_count());
-    uint64_t done = 0;
-    while (in.reader->next(chunk)) {
-        auto xyz = chunk.xyz();
-        for (size_t i = 0; i < xyz.size(); i += 3)
-            for (int a = 0; a < 3; ++a)
-                if (std::isfinite(xyz[i + a])) {  // a NaN or inf corner would decide nothing
-                    box.min[a] = std::min(box.min[a], xyz[i + a]);
-                    box.max[a] = std::max(box.max[a], xyz[i + a]);
-                }
-        progress.update(done += chunk.size(), *in.source);
-    }
-    return box;
-}
-
-int longest_axis(const io::Bounds& box) {
-    int best = 2;
-    double best_extent = 0;
-    for (int a = 0; a < 3; ++a) {
-        const double extent = double(box.max[a]) - double(box.min[a]);
-        if (extent > best_extent) {
-            best_extent = extent;
-            best = a;
-        }
-    }
-    return best;
+    Progress progress("bounding box", std::nullopt);
+    return engine::input_bounds(path, from, options, progress);
 }
 
 uint64_t peak_rss_bytes() {

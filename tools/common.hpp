@@ -3,6 +3,10 @@
 // prints; the libraries report through return values and io::Error.
 #pragma once
 
+#include "engine/files.hpp"
+#include "engine/progress.hpp"
+#include "engine/units.hpp"
+#include "engine/warnings.hpp"
 #include "io/byte_stream.hpp"
 #include "io/draco.hpp"
 #include "io/format.hpp"
@@ -20,6 +24,11 @@
 #include <vector>
 
 namespace meshstream::tools {
+
+// Counted warnings (engine::Warnings, with a stable code for --json: docs/cli.md lists them),
+// printed once at the end of a command on stderr ("PROGRAM: warning: ...").
+using engine::Warnings;
+void print_warnings(const Warnings& warnings);
 
 // A command line that cannot work, found after parsing (an option that needs a file given a
 // stream, '-' without --to): exit code 2, like CLI11's own errors, before any work.
@@ -91,23 +100,9 @@ const io::Format& resolve_output_format(const std::string& output, const WriteFl
 // True when `output` ("-" = stdout) is a pipe or a socket.
 bool names_a_pipe(const std::string& output);
 
-// An input for refuse_output_over_inputs: its path ("-" = stdin) and the other files its
-// reader read (MeshHeader::side_files).
-struct InputFiles {
-    std::string path;
-    std::vector<std::string> side_files;
-};
-// Refuses with UsageError (exit 2), before anything is written, an output that would overwrite
-// an input: the same regular file by device and inode (so also a symbolic or hard link to it,
-// and stdout redirected into it), or a side file of either: one the output's format writes
-// beside it (`output_side_files`, from Format::side_files) or one an input's reader read.
-void refuse_output_over_inputs(const std::string& output, const std::vector<std::string>& output_side_files,
-                               const std::vector<InputFiles>& inputs);
-// The same with the side files `format` names for `output`.
-void refuse_output_over_inputs(const std::string& output, const io::Format& format, const io::WriteOptions& options,
-                               const std::vector<InputFiles>& inputs);
-// The InputFiles of an opened input.
-InputFiles input_files(const std::string& path, const io::MeshHeader& header);
+using engine::input_files;
+using engine::InputFiles;
+using engine::refuse_output_over_inputs;
 // This machine's memory (0 when the system does not say).
 double physical_memory_bytes();
 
@@ -122,17 +117,12 @@ uint64_t whole_mesh_memory(std::string_view meminfo);
 // The same for this machine, from /proc/meminfo, or from the file that the environment variable
 // MESHSTREAM_MEMINFO names (for tests).
 uint64_t whole_mesh_memory();
-class Warnings;
 // Notes Draco/glTF options given for an output of another format, and --gzip-level for an
 // output not named *.gz (they do nothing there).
 void note_unused_write_flags(const WriteFlags& flags, const io::Format& output, const std::string& output_path,
                              Warnings& warnings);
-// The warning for channels an output cannot hold: "`dropped` dropped: <format> output carries
-// positions only" (or "does not carry them" when it keeps some others, `kept`).
-std::string dropped_channels_text(const std::string& dropped, const io::Format& output, const io::Channels& kept);
-// Repeats as warnings what the reader noted that changes the data (double coordinates rounded,
-// a last line without its end) and the reader's counted warnings (MeshHeader::warnings).
-void note_input_changes(const io::MeshHeader& header, const std::string& input_name, Warnings& warnings);
+using engine::dropped_channels_text;
+using engine::note_input_changes;
 
 // Global flags (set by main before a subcommand runs).
 struct Global {
@@ -145,23 +135,23 @@ Global& global();
 // given: phase label, count, rate, and percent + ETA when the total is known: the bytes read
 // of the input file's size when the phase reads a file (any format, gzip too), else the count
 // of its total. Redraws at most 5 times a second, so calling update() per chunk costs nothing.
-class Progress {
+class Progress final : public engine::ProgressSink {
 public:
     Progress(std::string label, std::optional<uint64_t> total, std::string unit = "triangles");
-    ~Progress();
-    void update(uint64_t done);
+    ~Progress() override;
+    void update(uint64_t done) override;
     // The same while reading a file of `file_bytes` bytes as stored (nullopt: not a regular
     // file), of which `bytes_read` are read: percent and ETA come from the bytes.
-    void update(uint64_t done, uint64_t bytes_read, std::optional<uint64_t> file_bytes);
+    void update(uint64_t done, uint64_t bytes_read, std::optional<uint64_t> file_bytes) override;
     // update(done, ...) with the count read and the position of `source` in its file.
     void update(uint64_t done, const io::ByteSource& source) {
         update(done, source.stored_offset(), source.stored_size());
     }
     // Starts a new phase (keeps the bar); total may change.
-    void phase(std::string label, std::optional<uint64_t> total);
+    void phase(std::string label, std::optional<uint64_t> total) override;
     // Replaces the bar with one line of text until done() or the next update (a last step
     // that reports no counts, such as a writer assembling its file).
-    void status(const std::string& text);
+    void status(const std::string& text) override;
     void done();  // clears the line
 
 private:
@@ -177,51 +167,13 @@ private:
     std::chrono::steady_clock::time_point start_, last_;
 };
 
-// Counted warnings, summarised once at the end of a command on stderr ("warning: ..."). Each
-// has a stable code for --json (docs/cli.md lists them): the text may change, the code not.
-class Warnings {
-public:
-    // A kind of event that can happen many times: printed with its count.
-    void add(std::string_view code, const std::string& kind, uint64_t count = 1) {
-        Entry& e = entries_[kind];
-        e.code = code;
-        e.count += count;
-    }
-    // A one-off finding: printed as it is.
-    void note(std::string_view code, const std::string& text) { entries_.emplace(text, Entry{std::string(code), 0}); }
-    bool empty() const { return entries_.empty(); }
-    struct Line {
-        std::string code, text;
-        uint64_t count = 0;  // 0 for a one-off finding
-    };
-    // In the order print() writes them; text without the count.
-    std::vector<Line> all() const;
-    // The lines print() writes, without the "PROGRAM: warning: " prefix (Global::program).
-    std::vector<std::string> lines() const;
-    void print() const;
-
-private:
-    struct Entry {
-        std::string code;
-        uint64_t count = 0;
-    };
-    std::map<std::string, Entry> entries_;
-};
-
-// "1.23 M" style numbers and "12.3 MB" sizes for summaries. human_count prints n below 10^4
-// as an integer, above it scaled to k, M or G with a fixed number of decimals ("12.3 k",
-// "1.23 M"), or, when `significant_digits` > 0, with that many significant digits ("500 k").
-std::string human_count(double n, int significant_digits = 0);
-std::string human_bytes(double bytes);
-// True for an existing regular file (not "-", a pipe or a device): one that can be read twice.
-bool is_regular_file(const std::string& path);
+using engine::human_bytes;
+using engine::human_count;
+using engine::is_regular_file;
 using io::is_stream;  // "-", pipes, devices: read or written once only
-// The input's bounding box: from its header when the format states it, else from a first pass
-// over the file (finite coordinates only; a progress bar on stderr). An input without finite
-// coordinates gives min = +inf, max = -inf. Throws io::Error like open_input.
+// engine::input_bounds with the command's progress bar.
 io::Bounds input_bounds(const std::string& path, std::string_view from, const io::ReadOptions& options);
-// The axis along which `box` is longest (z for an empty or flat box, the usual scan axis).
-int longest_axis(const io::Bounds& box);
+using engine::longest_axis;
 // Peak resident set size of this process in bytes (from /proc/self/status VmHWM).
 uint64_t peak_rss_bytes();
 

@@ -219,7 +219,7 @@ void run_compare(const CompareCliOptions& opt) {
     };
     if (r.a_to_b.samples == 0) unsampled(r.a, "A -> B");
     if (r.b_to_a.samples == 0) unsampled(r.b, "B -> A");
-    warnings.print();
+    print_warnings(warnings);
     if (opt.json) {
         nlohmann::ordered_json j;
         j["a"] = mesh_json(r.a);

@@ -93,7 +93,7 @@ void run_convert(const ConvertOptions& opt) {
     if (!dropped.empty()) warnings.note("channels_dropped", dropped_channels_text(dropped, *out.format, wo.channels));
     note_dropped_triangles(dropped_triangles(in), "removed (--clean)", warnings);
     note_input_changes(in.header(), in.name(), warnings);
-    warnings.print();
+    print_warnings(warnings);
     if (opt.json) {
         RunReport report;
         report.command = "convert";

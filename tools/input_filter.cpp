@@ -26,19 +26,6 @@ io::TriangleInput open_triangle_input(const std::string& path, const ReadFlags& 
     return open_triangle_input(path, read, read.options(), command, clean);
 }
 
-DroppedTriangles dropped_triangles(const io::TriangleInput& in) {
-    return {in.count().read, in.non_finite(), in.degenerate()};
-}
-
-void note_dropped_triangles(const DroppedTriangles& dropped, const std::string& verb, Warnings& warnings) {
-    if (dropped.read == 0) warnings.note("no_triangles", "the input holds no triangles");
-    if (dropped.non_finite > 0)
-        warnings.add("non_finite_triangles", "triangles with a NaN or infinite coordinate " + verb, dropped.non_finite);
-    if (dropped.degenerate > 0)
-        warnings.add("degenerate_triangles", "degenerate triangles (two corners at the same position) " + verb,
-                     dropped.degenerate);
-}
-
 void add_clean_flag(CLI::App* cmd, bool& clean) {
     cmd->add_flag("--clean", clean,
                   "drop NaN/inf and degenerate triangles (default: every triangle is kept)\n"

@@ -24,14 +24,10 @@ io::TriangleInput open_triangle_input(const std::string& path, const ReadFlags& 
 io::TriangleInput open_triangle_input(const std::string& path, const ReadFlags& read, const io::ReadOptions& options,
                                       Command command, bool clean = false);
 
-// The warnings about the triangles a finished read loop dropped, one counted line per kind
-// (`verb`: "skipped" for decimate, "removed (--clean)" for --clean), and a note when the
-// input held no triangles at all.
-struct DroppedTriangles {
-    uint64_t read = 0, non_finite = 0, degenerate = 0;
-};
-DroppedTriangles dropped_triangles(const io::TriangleInput& in);
-void note_dropped_triangles(const DroppedTriangles& dropped, const std::string& verb, Warnings& warnings);
+// The warnings about the triangles a finished read loop dropped (engine/warnings.hpp).
+using engine::dropped_triangles;
+using engine::DroppedTriangles;
+using engine::note_dropped_triangles;
 
 // --clean for convert and sort.
 void add_clean_flag(CLI::App* cmd, bool& clean);

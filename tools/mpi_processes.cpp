@@ -1,11 +1,14 @@
 // The messages of a job spread over MPI ranks: see mpi_processes.hpp.
 //
 // Rank r > 0 sends rank 0, in this order: kChunk messages (a ChunkHeader, then the chunk's
-// triangles as TriangleRecords: 36 bytes of positions each, and the channels carried) and kProgress messages (the
+// triangles as io::TriangleRecords: 36 bytes of positions each, and the channels carried) and kProgress messages (the
 // range's triangles decimated so far), then one kClose (a CloseHeader, then the exception's message when it failed).
 // Rank 0 may send it kStop at any time (its range is to stop between chunks), and sends every rank it received from one
 // kDone once it has everything: a rank leaves only then, with no message of it in flight.
 #include "tools/mpi_processes.hpp"
+
+#include "io/endian.hpp"
+#include "io/triangle_records.hpp"
 
 #include <chrono>
 #include <cstdio>
@@ -19,6 +22,11 @@
 
 namespace meshstream::tools {
 namespace {
+
+using engine::Piece;
+using engine::RangeOutcome;
+using engine::RangePlan;
+using engine::RangeSink;
 
 enum Tag : int { kChunk = 1, kProgress, kClose, kStop, kDone };
 
@@ -55,22 +63,17 @@ void check(int status, const char* what) {
     if (status != MPI_SUCCESS) abort_job(std::string(what) + " failed");
 }
 
+// A message's header, as the sending rank wrote it (io::ByteWriter::raw).
 template <typename T>
-void append_bytes(std::vector<char>& out, const T& value) {
-    const auto* p = reinterpret_cast<const char*>(&value);
-    out.insert(out.end(), p, p + sizeof(T));
-}
-
-template <typename T>
-T read_bytes(const std::vector<char>& in, size_t at = 0) {
-    if (in.size() < at + sizeof(T)) abort_job("a rank's message is shorter than its header");
-    T value;
-    std::memcpy(&value, in.data() + at, sizeof(T));
+T read_header(const std::vector<char>& in) {
+    io::ByteReader reader(in.data(), in.size());
+    const T value = reader.raw<T>();
+    if (!reader.ok()) abort_job("a rank's message is shorter than its header");
     return value;
 }
 
-void send_bytes(const std::vector<char>& bytes, int to, Tag tag) {
-    check(MPI_Send(bytes.data(), int(bytes.size()), MPI_BYTE, to, tag, MPI_COMM_WORLD), "MPI_Send");
+void send_bytes(const void* bytes, size_t n, int to, Tag tag) {
+    check(MPI_Send(bytes, int(n), MPI_BYTE, to, tag, MPI_COMM_WORLD), "MPI_Send");
 }
 
 // Waits for `request` without spinning: a rank that waits (for the plan, for rank 0's kDone)
@@ -98,28 +101,30 @@ std::string message_of(const std::exception_ptr& error) {
 // Rank r's sink: every call a message to rank 0. Between chunks it looks for rank 0's kStop.
 class SendingSink final : public RangeSink {
 public:
-    SendingSink(std::atomic<bool>& stop, const io::Channels& channels) : stop_(stop), records_(channels) {}
+    SendingSink(std::atomic<bool>& stop, const io::Channels& channels) : stop_(stop), codec_(channels) {}
     void append(const io::TriangleChunk& chunk, double weight, Piece piece) override {
-        bytes_.clear();
-        append_bytes(bytes_, ChunkHeader{weight, chunk.size(), piece});
-        records_.encode(chunk, bytes_);
-        send_bytes(bytes_, 0, kChunk);
+        io::ByteWriter message;
+        message.raw(ChunkHeader{weight, chunk.size(), piece});
+        records_.clear();
+        codec_.encode(chunk, records_);
+        message.raw_bytes(records_.data(), records_.size());
+        send_bytes(message.data(), message.size(), 0, kChunk);
         look_for_stop();
     }
     void progress(uint64_t decimated) override {
-        bytes_.clear();
-        append_bytes(bytes_, decimated);
-        send_bytes(bytes_, 0, kProgress);
+        io::ByteWriter message;
+        message.raw(decimated);
+        send_bytes(message.data(), message.size(), 0, kProgress);
         look_for_stop();
     }
     void close(const RangeOutcome& outcome, std::exception_ptr error) override {
-        bytes_.clear();
-        append_bytes(bytes_, CloseHeader{outcome, error != nullptr});
+        io::ByteWriter message;
+        message.raw(CloseHeader{outcome, error != nullptr});
         if (error) {
             const std::string text = message_of(error);
-            bytes_.insert(bytes_.end(), text.begin(), text.end());
+            message.raw_bytes(text.data(), text.size());
         }
-        send_bytes(bytes_, 0, kClose);
+        send_bytes(message.data(), message.size(), 0, kClose);
     }
 
 private:
@@ -129,8 +134,8 @@ private:
         if (flag) stop_ = true;
     }
     std::atomic<bool>& stop_;
-    TriangleRecords records_;
-    std::vector<char> bytes_;
+    io::TriangleRecords codec_;
+    std::vector<char> records_;
 };
 
 }  // namespace
@@ -166,7 +171,7 @@ std::optional<RangePlan> MpiProcesses::receive_plan() {
 }
 
 void MpiProcesses::receive(std::span<RangeSink* const> sinks, std::atomic<bool>& stop, const io::Channels& channels) {
-    const TriangleRecords records(channels);
+    const io::TriangleRecords records(channels);
     std::vector<bool> open(sinks.size(), true);
     size_t still_open = sinks.size();
     bool stop_sent = false;
@@ -210,7 +215,7 @@ void MpiProcesses::receive(std::span<RangeSink* const> sinks, std::atomic<bool>&
         RangeSink& sink = *sinks[from - 1];
         switch (status.MPI_TAG) {
             case kChunk: {
-                const auto header = read_bytes<ChunkHeader>(bytes);
+                const auto header = read_header<ChunkHeader>(bytes);
                 if (bytes.size() != sizeof header + header.triangles * records.bytes())
                     abort_job("rank " + std::to_string(from) + " sent a chunk of the wrong size");
                 if (chunk.capacity() < header.triangles) chunk = io::TriangleChunk(size_t(header.triangles), channels);
@@ -218,9 +223,9 @@ void MpiProcesses::receive(std::span<RangeSink* const> sinks, std::atomic<bool>&
                 deliver([&] { sink.append(chunk, header.weight, header.piece); });
                 break;
             }
-            case kProgress: sink.progress(read_bytes<uint64_t>(bytes)); break;
+            case kProgress: sink.progress(read_header<uint64_t>(bytes)); break;
             case kClose: {
-                const auto header = read_bytes<CloseHeader>(bytes);
+                const auto header = read_header<CloseHeader>(bytes);
                 std::exception_ptr error;
                 if (header.failed)
                     error = std::make_exception_ptr(

@@ -222,7 +222,7 @@ void run_sort(const SortOptions& opt) {
                                                       ", or sort to STL, PLY or OBJ, which record it");
     note_dropped_triangles(dropped_triangles(in), "removed (--clean)", warnings);
     note_input_changes(end_header, input_name, warnings);
-    warnings.print();
+    print_warnings(warnings);
 
     if (opt.stats)
         std::fprintf(

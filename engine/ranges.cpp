@@ -1,5 +1,5 @@
-// Parallel decimation in ranges with a seam pass: see decimate_threads.hpp.
-#include "tools/decimate_threads.hpp"
+// Parallel decimation in ranges with a seam pass: see ranges.hpp.
+#include "engine/ranges.hpp"
 
 #include "io/byte_stream.hpp"
 #include "io/error.hpp"
@@ -22,35 +22,7 @@
 #include <utility>
 #include <vector>
 
-namespace meshstream::tools {
-
-TriangleRecords::TriangleRecords(const io::Channels& channels)
-    : corner_(channels), face_(channels), bytes_(36 + 3 * corner_.bytes() + face_.bytes()) {}
-
-void TriangleRecords::encode(const io::TriangleChunk& chunk, std::vector<char>& out) const {
-    const size_t at = out.size(), n = chunk.size();
-    out.resize(at + n * bytes_);
-    auto* dst = reinterpret_cast<std::byte*>(out.data() + at);
-    const float* xyz = chunk.xyz().data();
-    for (size_t i = 0; i < n; ++i, dst += bytes_) {
-        std::memcpy(dst, xyz + 9 * i, 36);
-        std::byte* p = dst + 36;
-        for (int k = 0; k < 3; ++k, p += corner_.bytes()) corner_.pack(chunk, i, k, p);
-        face_.pack(chunk, i, p);
-    }
-}
-
-void TriangleRecords::decode(const char* src, size_t triangles, io::TriangleChunk& chunk) const {
-    chunk.clear();
-    const auto* from = reinterpret_cast<const std::byte*>(src);
-    for (size_t i = 0; i < triangles; ++i, from += bytes_) {
-        float* xyz = chunk.push_slot();
-        std::memcpy(xyz, from, 36);
-        const std::byte* p = from + 36;
-        for (int k = 0; k < 3; ++k, p += corner_.bytes()) corner_.unpack(p, chunk, i, k);
-        face_.unpack(p, chunk, i);
-    }
-}
+namespace meshstream::engine {
 
 namespace {
 
@@ -146,7 +118,7 @@ private:
         Piece piece = Piece::kInterior;
     };
     io::TempFile file_;
-    TriangleRecords records_;
+    io::TriangleRecords records_;
     std::vector<char> encoded_;  // the range's thread's
     std::vector<char> read_;     // the seam pass's
     std::mutex mutex_;
@@ -277,10 +249,9 @@ unsigned range_count(unsigned threads, uint64_t triangles, size_t buffer) {
     return unsigned(std::max<uint64_t>(1, std::min<uint64_t>(threads, triangles / buffer)));
 }
 
-size_t seam_buffer(size_t buffer) { return std::max(buffer / 4, std::min<size_t>(buffer, 65536)); }
+size_t seam_buffer(size_t buffer) { return std::max(buffer / 4, std::min(buffer, kSeamBufferFloor)); }
 
-RangesResult decimate_in_ranges(const RangesJob& job, const decimate::Emit& emit,
-                                const std::function<void(uint64_t)>& progress) {
+RangesResult decimate_in_ranges(const RangesJob& job, const decimate::Emit& emit, ProgressSink& progress) {
     if (job.remote_ranges >= job.ranges || (job.remote_ranges > 0 && !job.receive_remote))
         throw std::logic_error("decimate_in_ranges: the last range runs here, and remote ranges need receive_remote");
     std::vector<std::unique_ptr<Range>> ranges;
@@ -331,10 +302,12 @@ RangesResult decimate_in_ranges(const RangesJob& job, const decimate::Emit& emit
             [&job, k, &stop, last, sink = ranges[k]->spool.get()] { run_range(job, k, *sink, stop, last); });
     }
 
+    bool cancelled = false;
     auto tick = [&] {
         uint64_t n = 0;
         for (const auto& r : ranges) n += r->spool->decimated();
-        progress(n);
+        progress.update(n);
+        if (progress.cancelled()) cancelled = stop = true;
     };
     io::TriangleChunk chunk(job.options.output_chunk_triangles, job.channels);
     double weight = 1;
@@ -348,6 +321,7 @@ RangesResult decimate_in_ranges(const RangesJob& job, const decimate::Emit& emit
             }
     }
     for (std::thread& t : threads) t.join();
+    if (cancelled) throw Cancelled();
     for (const auto& r : ranges)
         if (std::exception_ptr error = r->spool->error()) std::rethrow_exception(error);
 
@@ -402,4 +376,4 @@ RangesResult decimate_in_ranges(const RangesJob& job, const decimate::Emit& emit
     return result;
 }
 
-}  // namespace meshstream::tools
+}  // namespace meshstream::engine

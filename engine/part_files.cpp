@@ -1,7 +1,8 @@
-// Part files of `decimate --part k/K`: see decimate_parts.hpp.
-#include "tools/decimate_parts.hpp"
+// Part files of `decimate --part k/K`: see part_files.hpp.
+#include "engine/part_files.hpp"
 
 #include "io/byte_stream.hpp"
+#include "io/endian.hpp"
 #include "io/error.hpp"
 #include "io/hash.hpp"
 
@@ -20,7 +21,7 @@
 #include <functional>
 #include <type_traits>
 
-namespace meshstream::tools {
+namespace meshstream::engine {
 namespace {
 
 static_assert(std::endian::native == std::endian::little, "part files are written in little-endian byte order");
@@ -38,53 +39,8 @@ constexpr size_t kEndBytes = 1 + sizeof(decimate::Stats) + 1 + 8 + 8 + 8 + 8 + 4
 constexpr uint64_t kMaxPieceTriangles = uint64_t{1} << 24;
 constexpr uint64_t kHashSeed = 0x9e3779b97f4a7c15ull;
 
-// Appends plain values to a byte string.
-class Put {
-public:
-    template <typename T>
-    void value(const T& v) {
-        static_assert(std::is_arithmetic_v<T>);
-        const auto* p = reinterpret_cast<const char*>(&v);
-        bytes.insert(bytes.end(), p, p + sizeof v);
-    }
-    void text(const std::string& s) {
-        value(uint32_t(s.size()));
-        bytes.insert(bytes.end(), s.begin(), s.end());
-    }
-    std::vector<char> bytes;
-};
-
-// Reads plain values from a byte string; `ok` turns false past its end.
-class Get {
-public:
-    Get(const char* p, size_t n) : p_(p), n_(n) {}
-    template <typename T>
-    T value() {
-        T v{};
-        if (at_ + sizeof v > n_) {
-            ok = false;
-            return v;
-        }
-        std::memcpy(&v, p_ + at_, sizeof v);
-        at_ += sizeof v;
-        return v;
-    }
-    std::string text() {
-        const auto n = value<uint32_t>();
-        if (!ok || n > n_ - at_) {
-            ok = false;
-            return {};
-        }
-        std::string s(p_ + at_, n);
-        at_ += n;
-        return s;
-    }
-    bool ok = true;
-
-private:
-    const char* p_;
-    size_t n_, at_ = 0;
-};
+using Put = io::ByteWriter;
+using Get = io::ByteReader;
 
 void put_scalars(Put& put, const std::vector<io::ScalarChannel>& scalars) {
     put.value(uint32_t(scalars.size()));
@@ -97,13 +53,13 @@ void put_scalars(Put& put, const std::vector<io::ScalarChannel>& scalars) {
 std::vector<io::ScalarChannel> get_scalars(Get& get) {
     std::vector<io::ScalarChannel> scalars;
     const auto n = get.value<uint32_t>();
-    for (uint32_t i = 0; i < n && get.ok && i < 4096; ++i) {
+    for (uint32_t i = 0; i < n && get.ok() && i < 4096; ++i) {
         io::ScalarChannel s;
         s.name = get.text();
         s.type = io::ScalarType(get.value<uint8_t>());
         scalars.push_back(std::move(s));
     }
-    if (n > 4096) get.ok = false;
+    if (n > 4096) get.fail();
     return scalars;
 }
 
@@ -149,8 +105,8 @@ PartPlan get_plan(Get& get) {
     plan.cut_triangles = get.value<uint64_t>();
     plan.ranges = get.value<uint32_t>();
     const auto weights = get.value<uint32_t>();
-    for (uint32_t i = 0; i < weights && get.ok && i < 4096; ++i) plan.omega.push_back(get.value<double>());
-    if (weights > 4096) get.ok = false;
+    for (uint32_t i = 0; i < weights && get.ok() && i < 4096; ++i) plan.omega.push_back(get.value<double>());
+    if (weights > 4096) get.fail();
     io::Channels& c = plan.channels;
     c.normal = get.value<uint8_t>() != 0;
     const bool has_color = get.value<uint8_t>() != 0;
@@ -311,11 +267,11 @@ PartFileSink::PartFileSink(const std::string& path, PartIndex index, const Input
     body.value(uint32_t(records_.bytes()));
     body.value(uint32_t(sizeof(decimate::Stats)));
     Put head;
-    head.bytes.insert(head.bytes.end(), kMagic, kMagic + sizeof kMagic);
+    head.raw_bytes(kMagic, sizeof kMagic);
     head.value(kVersion);
-    head.value(uint32_t(body.bytes.size()));
-    sink_->write(head.bytes.data(), head.bytes.size());
-    sink_->write(body.bytes.data(), body.bytes.size());
+    head.value(uint32_t(body.size()));
+    sink_->write(head.data(), head.size());
+    sink_->write(body.data(), body.size());
 }
 
 PartFileSink::~PartFileSink() = default;
@@ -331,7 +287,7 @@ void PartFileSink::append(const io::TriangleChunk& chunk, double weight, Piece p
     head.value(uint8_t(piece));
     head.value(weight);
     head.value(uint64_t(chunk.size()));
-    put(head.bytes.data(), head.bytes.size());
+    put(head.data(), head.size());
     bytes_.clear();
     records_.encode(chunk, bytes_);
     put(bytes_.data(), bytes_.size());
@@ -345,18 +301,16 @@ void PartFileSink::close(const RangeOutcome& outcome, std::exception_ptr error) 
     try {
         Put end;
         end.value(kEndTag);
-        const auto* stats = reinterpret_cast<const char*>(&outcome.stats);
-        end.bytes.insert(end.bytes.end(), stats, stats + sizeof outcome.stats);
+        end.raw(outcome.stats);
         end.value(uint8_t(outcome.forced));
         end.value(outcome.forced_at);
         end.value(pieces_);
         end.value(triangles_);
         // The hash covers the end's figures too: a damaged one is refused, not summed.
-        const uint64_t hash =
-            io::hash_bytes(reinterpret_cast<const std::byte*>(end.bytes.data()), end.bytes.size(), hash_);
+        const uint64_t hash = io::hash_bytes(end.data(), end.size(), hash_);
         end.value(hash);
-        end.bytes.insert(end.bytes.end(), kEndMagic, kEndMagic + sizeof kEndMagic);
-        sink_->write(end.bytes.data(), end.bytes.size());
+        end.raw_bytes(kEndMagic, sizeof kEndMagic);
+        sink_->write(end.data(), end.size());
         sink_->commit();
     } catch (...) {
         error_ = std::current_exception();
@@ -375,9 +329,9 @@ PartFileReader::PartFileReader(const std::string& path, unsigned parts, const In
     if (!read_at(fd.get(), 0, head, sizeof head, path)) throw bad("shorter than a part file's header");
     if (std::memcmp(head, kMagic, sizeof kMagic) != 0)
         throw io::Error(path, "not a part file (meshstream decimate --part k/K writes them)");
-    uint32_t version = 0, body_bytes = 0;
-    std::memcpy(&version, head + 8, 4);
-    std::memcpy(&body_bytes, head + 12, 4);
+    Get head_fields(head + sizeof kMagic, sizeof head - sizeof kMagic);
+    const auto version = head_fields.value<uint32_t>();
+    const auto body_bytes = head_fields.value<uint32_t>();
     if (version != kVersion)
         throw io::Error(path, "part file of version " + std::to_string(version) + ", this build reads version " +
                                   std::to_string(kVersion));
@@ -389,7 +343,7 @@ PartFileReader::PartFileReader(const std::string& path, unsigned parts, const In
     header_bytes_ = sizeof head + body_bytes;
     Get get(body.data(), body.size());
     const std::string build = get.text();
-    if (get.ok && build != build_text())
+    if (get.ok() && build != build_text())
         throw io::Error(path,
                         "was made by " + build + ", this is " + build_text() + ": make every part with one build");
     k_ = get.value<uint32_t>();
@@ -400,7 +354,7 @@ PartFileReader::PartFileReader(const std::string& path, unsigned parts, const In
     const PartPlan file_plan = get_plan(get);
     const auto record_bytes = get.value<uint32_t>();
     const auto stats_bytes = get.value<uint32_t>();
-    if (!get.ok) throw bad("its header is cut short");
+    if (!get.ok()) throw bad("its header is cut short");
     if (stats_bytes != sizeof(decimate::Stats))
         throw io::Error(path, "was made by another build of " + build_text() + " (its statistics take " +
                                   std::to_string(stats_bytes) + " bytes, this build's " +
@@ -417,7 +371,7 @@ PartFileReader::PartFileReader(const std::string& path, unsigned parts, const In
         throw io::Error(path, name + " was made from another input of the same size (or this one changed since)");
     if (const std::string difference = plan_difference(file_plan, plan); !difference.empty())
         throw io::Error(path, name + " " + difference);
-    record_bytes_ = TriangleRecords(plan.channels).bytes();
+    record_bytes_ = io::TriangleRecords(plan.channels).bytes();
     if (record_bytes != record_bytes_)
         throw io::Error(path, name + " has records of " + std::to_string(record_bytes) + " bytes, this build writes " +
                                   std::to_string(record_bytes_));
@@ -429,14 +383,13 @@ PartFileReader::PartFileReader(const std::string& path, unsigned parts, const In
     if (!read_at(fd.get(), file_bytes_ - kEndBytes, end.data(), end.size(), path)) throw bad("cut short");
     if (end[0] != char(kEndTag) || std::memcmp(end.data() + kEndBytes - 4, kEndMagic, 4) != 0)
         throw bad("cut short or damaged (its last bytes are not a part file's end)");
-    std::memcpy(&outcome_.stats, end.data() + 1, sizeof outcome_.stats);
-    size_t at = 1 + sizeof(decimate::Stats);
-    outcome_.forced = end[at] != 0;
-    at += 1;
-    std::memcpy(&outcome_.forced_at, end.data() + at, 8);
-    std::memcpy(&pieces_, end.data() + at + 8, 8);
-    std::memcpy(&triangles_, end.data() + at + 16, 8);
-    std::memcpy(&hash_, end.data() + at + 24, 8);
+    Get end_fields(end.data() + 1, end.size() - 1);
+    outcome_.stats = end_fields.raw<decimate::Stats>();
+    outcome_.forced = end_fields.value<uint8_t>() != 0;
+    outcome_.forced_at = end_fields.value<uint64_t>();
+    pieces_ = end_fields.value<uint64_t>();
+    triangles_ = end_fields.value<uint64_t>();
+    hash_ = end_fields.value<uint64_t>();
     const uint64_t expected = header_bytes_ + pieces_ * kPieceHeaderBytes + triangles_ * record_bytes_ + kEndBytes;
     if (pieces_ > file_bytes_ || triangles_ > file_bytes_ || expected != file_bytes_)
         throw bad("its end counts " + std::to_string(pieces_) + " pieces of " + std::to_string(triangles_) +
@@ -456,11 +409,10 @@ bool PartFileReader::read_pieces(
         char head[kPieceHeaderBytes];
         if (!read_at(fd.get(), offset, head, sizeof head, path_))
             throw io::Error(path_, offset, 0, "part file cut short while it was read");
-        const auto piece = uint8_t(head[1]);
-        double weight = 0;
-        uint64_t n = 0;
-        std::memcpy(&weight, head + 2, 8);
-        std::memcpy(&n, head + 10, 8);
+        Get fields(head + 1, sizeof head - 1);
+        const auto piece = fields.value<uint8_t>();
+        const auto weight = fields.value<double>();
+        const auto n = fields.value<uint64_t>();
         if (head[0] != char(kPieceTag) || piece > uint8_t(Piece::kLastSeam) || !(weight >= 1) ||
             !std::isfinite(weight) || n > kMaxPieceTriangles || n > triangles_ - triangles)
             throw io::Error(path_, offset, 0, "damaged part file: expected a piece's header, found other bytes");
@@ -487,7 +439,7 @@ bool PartFileReader::read_pieces(
 
 void PartFileReader::feed(RangeSink& sink, const std::atomic<bool>& stop, const io::Channels& channels) const {
     io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, channels);
-    const TriangleRecords records(channels);
+    const io::TriangleRecords records(channels);
     const bool whole = read_pieces([&](Piece piece, double weight, size_t n, const char* bytes) {
         if (stop) return false;
         if (chunk.capacity() < n) chunk = io::TriangleChunk(n, channels);
@@ -500,4 +452,4 @@ void PartFileReader::feed(RangeSink& sink, const std::atomic<bool>& stop, const 
     sink.close(outcome_, nullptr);
 }
 
-}  // namespace meshstream::tools
+}  // namespace meshstream::engine

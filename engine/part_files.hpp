@@ -1,4 +1,4 @@
-// `meshstream decimate --part k/K`: the ranges of `--threads K` (decimate_threads.hpp) run as K
+// `meshstream decimate --part k/K`: the ranges of `--threads K` (ranges.hpp) run as K
 // separate jobs, for batch schedulers without MPI (Slurm arrays, Kubernetes indexed jobs). Job k
 // (1 .. K-1) decimates range k-1 (run_range) into a part file instead of sending it to rank 0;
 // job K/K, the merge, decimates the last range itself, reads the part files' pieces into the
@@ -25,7 +25,7 @@
 #pragma once
 
 #include "decimate/stream_decimator.hpp"
-#include "tools/decimate_threads.hpp"
+#include "engine/ranges.hpp"
 
 #include <atomic>
 #include <cstdint>
@@ -39,7 +39,7 @@ namespace meshstream::io {
 class ByteSink;
 }
 
-namespace meshstream::tools {
+namespace meshstream::engine {
 
 // --part k/K.
 struct PartIndex {
@@ -91,7 +91,7 @@ public:
 private:
     void put(const void* data, size_t n);
     std::unique_ptr<io::ByteSink> sink_;
-    TriangleRecords records_;
+    io::TriangleRecords records_;
     std::vector<char> bytes_;
     uint64_t hash_;
     uint64_t pieces_ = 0, triangles_ = 0;
@@ -130,4 +130,4 @@ private:
     size_t record_bytes_ = 0;
 };
 
-}  // namespace meshstream::tools
+}  // namespace meshstream::engine

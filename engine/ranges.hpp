@@ -1,4 +1,5 @@
-// `meshstream decimate --threads N`: one input file decimated by N stream decimators at once.
+// `meshstream decimate --threads N` (engine::decimate_file with DecimateSettings::threads): one
+// input file decimated by N stream decimators at once.
 // The input's triangles are cut into N contiguous ranges; each range is decimated by a stream
 // decimator of its own (decimate::Part::kRange: the vertices still open at the end of a range may
 // be shared with another range, so they stay where they were read), and its output spooled to a
@@ -14,14 +15,15 @@
 // Each range re-opens the input and reads its way to its range (no format has to seek): the
 // reading before a range is the serial part besides the seam pass. Memory: N decimators of
 // --buffer triangles, N readers, the seam pass's decimator of a quarter of --buffer; the ranges'
-// outputs wait on disk (36 bytes a triangle, plus the channels carried: TriangleRecords), not in
-// memory.
+// outputs wait on disk (36 bytes a triangle, plus the channels carried: io::TriangleRecords), not
+// in memory.
 #pragma once
 
 #include "decimate/stream_decimator.hpp"
+#include "engine/progress.hpp"
+#include "engine/warnings.hpp"
 #include "io/triangle_input.hpp"
-#include "tools/common.hpp"
-#include "tools/input_filter.hpp"
+#include "io/triangle_records.hpp"
 
 #include <atomic>
 #include <cstdint>
@@ -33,7 +35,7 @@
 #include <string>
 #include <vector>
 
-namespace meshstream::tools {
+namespace meshstream::engine {
 
 // The smallest --buffer that is cut into ranges. A smaller buffer asks for little memory, which
 // ranges would multiply, and its seam pass would hold two seams at full resolution in less room
@@ -46,7 +48,8 @@ inline constexpr size_t kMinRangeBuffer = 16384;
 unsigned range_count(unsigned threads, uint64_t triangles, size_t buffer);
 
 // The seam pass's buffer for ranges decimated through `buffer` triangles each: a quarter of it,
-// but the whole of it up to 65 536 triangles (about 13 MB resident).
+// but the whole of it up to kSeamBufferFloor triangles (about 13 MB resident).
+inline constexpr size_t kSeamBufferFloor = 65536;
 size_t seam_buffer(size_t buffer);
 
 // The pieces of a range's output: the decimated rest, the faces on P_in read first (along the
@@ -56,24 +59,6 @@ size_t seam_buffer(size_t buffer);
 // open in the seam pass's buffer meanwhile (the rest reaches the seam only through this range's
 // own seam faces), and the two strips are joined when the first seam faces come.
 enum class Piece : uint8_t { kFirstSeam, kInterior, kLastSeam };
-
-// A chunk's triangles as fixed-size records: the positions (36 bytes), then each corner's channels
-// (io::CornerLayout, in the source's types) and the triangle's (io::FaceLayout); vertex ids are
-// not kept (the seam pass welds by position). What ranges spool and send.
-class TriangleRecords {
-public:
-    explicit TriangleRecords(const io::Channels& channels);
-    size_t bytes() const { return bytes_; }  // per triangle
-    // Appends the records of every triangle of `chunk` (which has at least the channels).
-    void encode(const io::TriangleChunk& chunk, std::vector<char>& out) const;
-    // Fills `chunk` (the channels, capacity ≥ triangles) with `triangles` records from `src`.
-    void decode(const char* src, size_t triangles, io::TriangleChunk& chunk) const;
-
-private:
-    io::CornerLayout corner_;
-    io::FaceLayout face_;
-    size_t bytes_;
-};
 
 // How a range ended (besides an exception).
 struct RangeOutcome {
@@ -170,10 +155,9 @@ struct RangesResult {
 void run_range(const RangesJob& job, unsigned k, RangeSink& sink, std::atomic<bool>& stop);
 
 // Runs the job: ranges on their threads (or elsewhere: RangesJob::remote_ranges), the seam pass on this one writing to
-// `emit`, calling `progress` with the input triangles decimated so far. An exception on any thread (the first bad input
+// `emit`, updating `progress` with the input triangles decimated so far. An exception on any thread (the first bad input
 // in the file's order, whichever range met it) is rethrown here once every thread has stopped; nothing is written after
-// it.
-RangesResult decimate_in_ranges(const RangesJob& job, const decimate::Emit& emit,
-                                const std::function<void(uint64_t)>& progress);
+// it. Once `progress` says cancelled(), every range stops between chunks and Cancelled is thrown.
+RangesResult decimate_in_ranges(const RangesJob& job, const decimate::Emit& emit, ProgressSink& progress);
 
-}  // namespace meshstream::tools
+}  // namespace meshstream::engine

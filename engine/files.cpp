@@ -1,0 +1,110 @@
+// The job's files: see files.hpp.
+#include "engine/files.hpp"
+
+#include "io/error.hpp"
+
+#include <sys/stat.h>
+
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <utility>
+
+namespace meshstream::engine {
+
+bool is_regular_file(const std::string& path) {
+    struct stat st;
+    return path != "-" && ::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
+}
+
+io::Bounds input_bounds(const std::string& path, std::string_view from, const io::ReadOptions& options,
+                        ProgressSink& progress) {
+    io::ReadOptions positions = options;  // nothing but positions is looked at
+    positions.channels = io::ChannelKinds::none();
+    io::Input in = io::open_input(path, from, positions);
+    io::Bounds box;
+    box.min.fill(std::numeric_limits<float>::infinity());
+    box.max.fill(-std::numeric_limits<float>::infinity());
+    io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity);
+    progress.phase("bounding box", in.reader->triangle_count());
+    uint64_t done = 0;
+    while (in.reader->next(chunk)) {
+        auto xyz = chunk.xyz();
+        for (size_t i = 0; i < xyz.size(); i += 3)
+            for (int a = 0; a < 3; ++a)
+                if (std::isfinite(xyz[i + a])) {  // a NaN or inf corner would decide nothing
+                    box.min[a] = std::min(box.min[a], xyz[i + a]);
+                    box.max[a] = std::max(box.max[a], xyz[i + a]);
+                }
+        progress.update(done += chunk.size(), in.source->stored_offset(), in.source->stored_size());
+        if (progress.cancelled()) throw Cancelled();
+    }
+    return box;
+}
+
+int longest_axis(const io::Bounds& box) {
+    int best = 2;
+    double best_extent = 0;
+    for (int a = 0; a < 3; ++a) {
+        const double extent = double(box.max[a]) - double(box.min[a]);
+        if (extent > best_extent) {
+            best_extent = extent;
+            best = a;
+        }
+    }
+    return best;
+}
+
+namespace {
+
+// The file a path names, by device and inode, when it is an existing regular file ("-" is
+// the descriptor: stdin for an input, stdout for an output). Symbolic links are followed.
+std::optional<std::pair<dev_t, ino_t>> regular_file_id(const std::string& path, bool output) {
+    struct stat st;
+    const int rc = path == "-" ? ::fstat(output ? 1 : 0, &st) : ::stat(path.c_str(), &st);
+    if (rc != 0 || !S_ISREG(st.st_mode)) return std::nullopt;
+    return std::pair{st.st_dev, st.st_ino};
+}
+
+std::string shown(const std::string& path, bool output) { return path != "-" ? path : output ? "<stdout>" : "<stdin>"; }
+
+}  // namespace
+
+InputFiles input_files(const std::string& path, const io::MeshHeader& header) { return {path, header.side_files}; }
+
+void refuse_output_over_inputs(const std::string& output, const std::vector<std::string>& output_side_files,
+                               const std::vector<InputFiles>& inputs) {
+    struct Target {
+        std::string path;
+        bool side;
+    };
+    std::vector<Target> targets{{output, false}};
+    for (const std::string& side : output_side_files) targets.push_back({side, true});
+    for (const Target& target : targets) {
+        const auto id = regular_file_id(target.path, true);
+        if (!id) continue;
+        for (const InputFiles& in : inputs) {
+            std::string why;
+            if (regular_file_id(in.path, false) == id) why = "the input " + shown(in.path, false);
+            for (const std::string& side : in.side_files)
+                if (why.empty() && regular_file_id(side, false) == id)
+                    why = side + ", which the input " + shown(in.path, false) + " reads";
+            if (why.empty()) continue;
+            const bool same_name = !target.side && target.path == in.path;
+            throw io::OptionError(io::Setting::kOutput,
+                                  shown(output, true) + ": " +
+                                      (target.side ? "its side file " + target.path + " would overwrite " + why
+                                                   : std::string("would overwrite ") + why +
+                                                         (same_name ? "" : " (the same file, through a link)")) +
+                                      "; write the output to another file");
+        }
+    }
+}
+
+void refuse_output_over_inputs(const std::string& output, const io::Format& format, const io::WriteOptions& options,
+                               const std::vector<InputFiles>& inputs) {
+    refuse_output_over_inputs(
+        output, format.side_files ? format.side_files(output, options) : std::vector<std::string>{}, inputs);
+}
+
+}  // namespace meshstream::engine

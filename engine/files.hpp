@@ -1,0 +1,45 @@
+// The files a job reads and writes, as the engine looks at them before any work: whether an
+// input can be read twice, its bounding box, and an output that would overwrite an input.
+#pragma once
+
+#include "engine/progress.hpp"
+#include "io/format.hpp"
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace meshstream::engine {
+
+// True for an existing regular file (not "-", a pipe or a device): one that can be read twice.
+bool is_regular_file(const std::string& path);
+
+// The input's bounding box: from its header when the format states it, else from a first pass
+// over the file (finite coordinates only; reported to `progress` as the phase "bounding box").
+// An input without finite coordinates gives min = +inf, max = -inf. Throws io::Error like
+// io::open_input.
+io::Bounds input_bounds(const std::string& path, std::string_view from, const io::ReadOptions& options,
+                        ProgressSink& progress);
+// The axis along which `box` is longest (z for an empty or flat box, the usual scan axis).
+int longest_axis(const io::Bounds& box);
+
+// An input for refuse_output_over_inputs: its path ("-" = stdin) and the other files its
+// reader read (MeshHeader::side_files).
+struct InputFiles {
+    std::string path;
+    std::vector<std::string> side_files;
+};
+// The InputFiles of an opened input.
+InputFiles input_files(const std::string& path, const io::MeshHeader& header);
+// Refuses with io::OptionError (the output's setting), before anything is written, an output
+// that would overwrite an input: the same regular file by device and inode (so also a symbolic
+// or hard link to it, and stdout redirected into it), or a side file of either: one the output's
+// format writes beside it (`output_side_files`, from Format::side_files) or one an input's reader
+// read.
+void refuse_output_over_inputs(const std::string& output, const std::vector<std::string>& output_side_files,
+                               const std::vector<InputFiles>& inputs);
+// The same with the side files `format` names for `output`.
+void refuse_output_over_inputs(const std::string& output, const io::Format& format, const io::WriteOptions& options,
+                               const std::vector<InputFiles>& inputs);
+
+}  // namespace meshstream::engine
