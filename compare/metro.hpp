@@ -61,7 +61,7 @@ struct CompareOptions {
     // Samples per direction; nullopt: default_sample_count(triangles of the sampled mesh).
     std::optional<uint64_t> samples;
     uint64_t seed = 1;
-    uint64_t memory_budget_bytes = uint64_t{256} << 20;  // edge counting spills past this
+    uint64_t memory_budget_bytes = io::kDefaultMemoryBudget;  // edge counting spills past this
     std::string tmpdir;                                  // for edge spills (empty: $TMPDIR or /tmp)
     // Also measure colour and normal error (the channels both meshes have; see the top of this
     // file). The sources are read with those channels, so their readers must keep them (a

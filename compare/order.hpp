@@ -74,7 +74,7 @@ BufferVerdict buffer_verdict(const OrderReport& report, uint64_t buffer_triangle
 // (at least 1 MiB is used as the floor).
 class OrderMeter {
 public:
-    explicit OrderMeter(uint64_t memory_budget_bytes = uint64_t{256} << 20);
+    explicit OrderMeter(uint64_t memory_budget_bytes = io::kDefaultMemoryBudget);
     ~OrderMeter();
     OrderMeter(const OrderMeter&) = delete;
     OrderMeter& operator=(const OrderMeter&) = delete;

@@ -13,6 +13,7 @@
 #pragma once
 
 #include "io/chunk.hpp"
+#include "io/format.hpp"
 #include "io/position_key.hpp"
 
 #include <cstdint>
@@ -33,7 +34,7 @@ struct EdgeCounts {
 class EdgeCounter {
 public:
     // `budget_bytes` bounds the sort buffer; runs go to `tmpdir` (empty: $TMPDIR or /tmp).
-    explicit EdgeCounter(uint64_t budget_bytes = uint64_t{256} << 20, std::string tmpdir = {});
+    explicit EdgeCounter(uint64_t budget_bytes = io::kDefaultMemoryBudget, std::string tmpdir = {});
     ~EdgeCounter();
     EdgeCounter(const EdgeCounter&) = delete;
     EdgeCounter& operator=(const EdgeCounter&) = delete;

@@ -161,8 +161,12 @@ private:
     bool finished_ = false;
 };
 
+// The memory budget of streaming work when the caller gives none (256 MiB): the tables of the
+// indexed formats, sort runs, spills, edge counting.
+inline constexpr uint64_t kDefaultMemoryBudget = uint64_t{256} << 20;
+
 struct ReadOptions {
-    uint64_t memory_budget_bytes = uint64_t{256} << 20;  // --memory: spill indexed tables past this
+    uint64_t memory_budget_bytes = kDefaultMemoryBudget;  // spill indexed tables past this
     std::string tmpdir;                                  // empty: system temp dir
     bool strict = false;                                 // --strict: skip-with-warning becomes error
     // The kinds of channel the caller's chunks will have. Readers that keep vertices (PLY)
@@ -201,7 +205,7 @@ private:
 };
 
 struct WriteOptions {
-    uint64_t memory_budget_bytes = uint64_t{256} << 20;  // for writers that weld or spool
+    uint64_t memory_budget_bytes = kDefaultMemoryBudget;  // for writers that weld or spool
     // The budget is --memory divided by this (sort gives its writer a quarter): the --memory a
     // budget error asks for is the bytes needed times this.
     uint32_t memory_budget_divisor = 1;

@@ -9,9 +9,9 @@ public:
 };
 }  // namespace meshstream
 namespace meshstream::io {
-enum class Setting : uint8_t { kMemory, kTmpdir, kStrict, kFrom, kTo, kDrop, kCompress, kBuffer, kWeld, kWeights, kTarget, kRatio, kSortedAxis, kSeed, kThreads, kPart, kMerge, kSort, kInput, kOutput };
+enum class Setting : uint8_t { kMemory, kTmpdir, kStrict, kFrom, kTo, kDrop, kCompress, kBuffer, kWeld, kWeights, kTarget, kRatio, kSortedAxis, kSeed, kThreads, kPart, kMerge, kSort, kInput, kOutput, kAxis, kClean };
 inline std::string mention(Setting s) {
-    static const char* const names[] = {"--memory", "--tmpdir", "--strict", "--from", "--to", "--drop", "--compress", "--buffer", "--weld", "--weights", "--target", "--ratio", "--sorted-axis", "--seed", "--threads", "--part", "--merge", "--sort", "IN", "OUT"};
+    static const char* const names[] = {"--memory", "--tmpdir", "--strict", "--from", "--to", "--drop", "--compress", "--buffer", "--weld", "--weights", "--target", "--ratio", "--sorted-axis", "--seed", "--threads", "--part", "--merge", "--sort", "IN", "OUT", "--axis", "--clean"};
     return names[int(s)];
 }
 class OptionError : public meshstream::Error {

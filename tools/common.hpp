@@ -107,7 +107,7 @@ using engine::refuse_output_over_inputs;
 double physical_memory_bytes();
 
 // --memory's default for streaming work: the tables of indexed formats, sort runs, spills.
-inline constexpr uint64_t kStreamingMemory = uint64_t{256} << 20;
+inline constexpr uint64_t kStreamingMemory = io::kDefaultMemoryBudget;
 // --memory's default for the writers that hold the whole mesh (Draco, glTF): half of the memory
 // available (the MemAvailable line of `meminfo`, the text of /proc/meminfo), at least
 // kStreamingMemory and at most kWholeMeshMemoryCeiling; kStreamingMemory when the text has no

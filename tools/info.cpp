@@ -4,6 +4,7 @@
 // positions; attribute values are not read), as plain text or --json.
 #include "compare/order.hpp"
 #include "compare/topology.hpp"
+#include "decimate/stream_decimator.hpp"
 #include "io/error.hpp"
 #include "tools/cli_checks.hpp"
 #include "tools/commands.hpp"
@@ -36,7 +37,7 @@ struct InfoOptions {
     bool json = false;
     bool topology = false;     // --topology: vertex and edge counts (tools/topology.hpp)
     bool order = false;        // --order: measure the stream's width (compare/order.hpp)
-    uint64_t buffer = 400000;  // --buffer: decimation buffer to judge against the width
+    uint64_t buffer = decimate::kDefaultBufferTriangles;  // --buffer: decimation buffer to judge against the width
     double ratio = 0.1;        // --ratio: the decimation ratio it is judged for
     ReadFlags read;
 };
@@ -307,7 +308,8 @@ void add_info(CLI::App& app) {
                   "The stream's width: triangles held at once until all their vertices' uses were read (exact "
                   "within --memory, else sampled; see docs/cli.md)");
     // The same ranges as decimate's: settings it cannot run are not judged.
-    cmd->add_option("--buffer", opt->buffer, "with --order: the decimate --buffer to judge (default 400000)")
+    cmd->add_option("--buffer", opt->buffer, "with --order: the decimate --buffer to judge (default " +
+                                                  std::to_string(decimate::kDefaultBufferTriangles) + ")")
         ->type_name("N")
         ->check(CLI::Range(size_t{16}, size_t{1} << 29));
     cmd->add_option("--ratio", opt->ratio,
