@@ -1,0 +1,179 @@
+// engine::decimate_file, decimate_part, convert_file and sort_file as a library user calls them:
+// exact counts, ranges on two threads, part files merged to the bytes two threads write, the
+// progress a sink sees, cancellation that leaves nothing behind, and settings refused as
+// io::OptionError naming the setting.
+#include "engine/convert.hpp"
+#include "engine/decimate.hpp"
+#include "io/error.hpp"
+#include "io/format.hpp"
+#include "test_util.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <atomic>
+#include <string>
+#include <vector>
+
+namespace meshstream {
+namespace {
+
+using test::slurp;
+using test::TempDir;
+
+const std::string kBunny = std::string(MESHSTREAM_FIXTURES_DIR) + "/bunny_from_draco.bin.stl";  // 69 451 triangles
+constexpr uint64_t kBunnyTriangles = 69451;
+
+// Records what the engine reports; cancels at the `cancel_at`-th update when asked to.
+class Recorder final : public engine::ProgressSink {
+public:
+    explicit Recorder(int cancel_at = -1) : cancel_at_(cancel_at) {}
+    void phase(std::string label, std::optional<uint64_t>) override { phases.push_back(std::move(label)); }
+    void update(uint64_t done) override { count(done); }
+    void update(uint64_t done, uint64_t, std::optional<uint64_t>) override { count(done); }
+    void status(const std::string&) override {}
+    bool cancelled() const override { return cancel_at_ >= 0 && updates >= cancel_at_; }
+    std::vector<std::string> phases;
+    int updates = 0;
+    uint64_t last = 0;
+
+private:
+    void count(uint64_t done) {
+        ++updates;
+        last = done;
+    }
+    int cancel_at_;
+};
+
+engine::DecimateSettings bunny_settings(const std::string& output) {
+    engine::DecimateSettings s;
+    s.input = kBunny;
+    s.output = output;
+    s.ratio = 0.1;
+    s.buffer = engine::kMinRangeBuffer;  // small enough for the bunny to make two ranges
+    return s;
+}
+
+TEST(EngineDecimate, OneThreadLandsOnTheTarget) {
+    TempDir dir;
+    Recorder progress;
+    const engine::DecimateResult r = engine::decimate_file(bunny_settings(dir / "out.stl"), progress);
+    EXPECT_EQ(r.triangles_in, kBunnyTriangles);
+    EXPECT_EQ(r.triangles_out, 6945u);  // round(0.1 * 69451)
+    EXPECT_EQ(r.facts.stats.triangles_out, 6945u);
+    EXPECT_EQ(r.facts.threads, 1u);
+    EXPECT_EQ(r.input_format, "stl");
+    EXPECT_EQ(r.output_format, "stl");
+    EXPECT_TRUE(r.warnings.empty());
+    // Binary STL: 84 bytes of header and count, 50 a triangle.
+    EXPECT_EQ(slurp(dir / "out.stl").size(), 84u + 50u * 6945u);
+    EXPECT_NE(std::find(progress.phases.begin(), progress.phases.end(), "decimating"), progress.phases.end());
+    EXPECT_GT(progress.updates, 0);
+}
+
+TEST(EngineDecimate, TwoThreadsCutTwoRangesDeterministically) {
+    TempDir dir;
+    engine::DecimateSettings s = bunny_settings(dir / "a.ply");
+    s.threads = 2;
+    engine::QuietProgress quiet;
+    const engine::DecimateResult a = engine::decimate_file(s, quiet);
+    EXPECT_EQ(a.facts.threads, 2u);
+    EXPECT_EQ(a.triangles_out, 6945u);
+    EXPECT_EQ(a.facts.seam_buffer, engine::seam_buffer(s.buffer));
+    s.output = dir / "b.ply";
+    engine::decimate_file(s, quiet);
+    EXPECT_EQ(slurp(dir / "a.ply"), slurp(dir / "b.ply"));
+}
+
+TEST(EngineDecimate, PartJobsMergeToTheBytesOfTwoThreads) {
+    TempDir dir;
+    engine::QuietProgress quiet;
+    engine::DecimateSettings threads = bunny_settings(dir / "threads.stl");
+    threads.threads = 2;
+    engine::decimate_file(threads, quiet);
+
+    engine::DecimateSettings part = bunny_settings(dir / "1.part");
+    part.output_format = "stl";  // the merge's output format: the channels carried
+    part.part = engine::PartIndex{1, 2};
+    const engine::PartResult p = engine::decimate_part(part, quiet);
+    EXPECT_EQ(p.range_first, 0u);
+    EXPECT_EQ(p.range_end, kBunnyTriangles / 2);
+    EXPECT_EQ(p.triangles_in, kBunnyTriangles / 2);
+
+    engine::DecimateSettings merge = bunny_settings(dir / "merged.stl");
+    merge.part = engine::PartIndex{2, 2};
+    merge.merge = {dir / "1.part"};
+    const engine::DecimateResult m = engine::decimate_file(merge, quiet);
+    EXPECT_EQ(m.facts.parts, 2u);
+    ASSERT_EQ(m.part_files.size(), 1u);
+    EXPECT_EQ(m.part_files[0].k, 1u);
+    EXPECT_EQ(slurp(dir / "merged.stl"), slurp(dir / "threads.stl"));
+}
+
+TEST(EngineDecimate, CancelledLeavesNoOutputBehind) {
+    for (const unsigned threads : {1u, 2u}) {
+        TempDir dir;
+        engine::DecimateSettings s = bunny_settings(dir / "out.glb");
+        s.threads = threads;
+        Recorder progress(/*cancel_at=*/1);
+        EXPECT_THROW(engine::decimate_file(s, progress), engine::Cancelled) << threads << " threads";
+        EXPECT_EQ(dir.file_count(), 0u) << threads << " threads";
+    }
+}
+
+TEST(EngineDecimate, SettingsThatCannotWorkAreOptionErrors) {
+    TempDir dir;
+    engine::QuietProgress quiet;
+    engine::DecimateSettings s = bunny_settings(dir / "out.stl");
+    s.ratio.reset();
+    s.target = kBunnyTriangles + 1;
+    try {
+        engine::decimate_file(s, quiet);
+        FAIL() << "a target above the input was taken";
+    } catch (const io::OptionError& e) {
+        EXPECT_EQ(e.setting(), io::Setting::kTarget);
+        EXPECT_NE(std::string(e.what()).find("is more than the 69451 triangles of the input"), std::string::npos)
+            << e.what();
+    }
+    // The output over the input.
+    s = bunny_settings(kBunny);
+    try {
+        engine::decimate_file(s, quiet);
+        FAIL() << "the input was overwritten";
+    } catch (const io::OptionError& e) {
+        EXPECT_EQ(e.setting(), io::Setting::kOutput);
+    }
+    EXPECT_EQ(dir.file_count(), 0u);
+}
+
+TEST(EngineConvert, ConvertAndSortKeepEveryTriangle) {
+    TempDir dir;
+    Recorder progress;
+    engine::ConvertSettings c;
+    c.input = kBunny;
+    c.output = dir / "bunny.ply";
+    c.threads = 2;
+    const engine::ConvertResult converted = engine::convert_file(c, progress);
+    EXPECT_EQ(converted.triangles_in, kBunnyTriangles);
+    EXPECT_EQ(converted.triangles_out, kBunnyTriangles);
+    EXPECT_EQ(converted.output_format, "ply");
+
+    engine::SortSettings s;
+    s.input = dir / "bunny.ply";
+    s.output = dir / "sorted.stl";
+    s.axis = 1;
+    const engine::SortResult sorted = engine::sort_file(s, progress);
+    EXPECT_EQ(sorted.axis, 1);
+    EXPECT_EQ(sorted.triangles_out, kBunnyTriangles);
+    // The sorted file says so, and the decimator takes its word.
+    const io::Input in = io::open_input(dir / "sorted.stl");
+    EXPECT_EQ(in.reader->header().sorted_axis, std::optional<int>(1));
+
+    Recorder cancel(/*cancel_at=*/1);
+    s.output = dir / "cancelled.stl";
+    EXPECT_THROW(engine::sort_file(s, cancel), engine::Cancelled);
+    EXPECT_FALSE(std::filesystem::exists(dir / "cancelled.stl"));
+}
+
+}  // namespace
+}  // namespace meshstream
