@@ -1,5 +1,6 @@
 // meshstream's API in one header, installed as <meshstream/meshstream.hpp>: whole jobs
-// (engine::decimate_file: a file decimated on every core, sorted on demand), the formats
+// (engine::decimate_file: a file decimated on every core, sorted on demand; engine::convert_file,
+// engine::sort_file), the formats
 // (io::open_input, io::open_output, io::TriangleInput, io::read_indexed), the stream decimator
 // itself (decimate::StreamDecimator), the external sort (sort::ExternalSorter) and the measures
 // (compare::compare_meshes, topology and order). Every library throws meshstream::Error's family
@@ -10,6 +11,7 @@
 #include "compare/order.hpp"
 #include "compare/topology.hpp"
 #include "decimate/stream_decimator.hpp"
+#include "engine/convert.hpp"
 #include "engine/decimate.hpp"
 #include "engine/files.hpp"
 #include "engine/progress.hpp"

@@ -1,0 +1,21 @@
+# ctest script: README's library program is tests/install/decimate_file.cpp, the program the
+# install test builds and runs, line for line. Variables: README, PROGRAM.
+file(READ "${README}" readme)
+string(FIND "${readme}" "A complete program that decimates a file" at)
+if(at EQUAL -1)
+  message(FATAL_ERROR "README has no library program")
+endif()
+string(SUBSTRING "${readme}" ${at} -1 readme)
+string(FIND "${readme}" "```cpp\n" begin)
+string(SUBSTRING "${readme}" ${begin} -1 readme)
+string(LENGTH "```cpp\n" skip)
+string(SUBSTRING "${readme}" ${skip} -1 readme)
+string(FIND "${readme}" "```" end)
+string(SUBSTRING "${readme}" 0 ${end} shown)
+file(READ "${PROGRAM}" program)
+# The file's head comment is not shown in README.
+string(FIND "${program}" "#include <meshstream/meshstream.hpp>" first)
+string(SUBSTRING "${program}" ${first} -1 program)
+if(NOT shown STREQUAL program)
+  message(FATAL_ERROR "README's library program differs from ${PROGRAM}:\n--- README\n${shown}\n--- file\n${program}")
+endif()
