@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Sets up a Debian 12 machine for meshstream and builds it, then runs one job:
-#   tools/bootstrap.sh demo   install what is missing, build, decimate the bunny fixture to 10 % as .glb
+#   tools/bootstrap.sh demo   install what is missing, build the command, decimate the bunny fixture to 10 % as .glb
 #   tools/bootstrap.sh test   install what is missing, build, run the whole test suite (ctest)
 #   tools/bootstrap.sh build  install what is missing and build only
 # Idempotent: packages already installed and an up-to-date build are not redone.
@@ -9,6 +9,10 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 mode=${1:-build}
+case "$mode" in
+  demo | test | build) ;;
+  *) echo "usage: $0 demo|test|build" >&2; exit 2 ;;
+esac
 build_dir=${MESHSTREAM_BUILD_DIR:-build}
 tools_dir=${MESHSTREAM_TOOLS_DIR:-/opt/meshstream-tools}   # npm tools used by the tests
 jobs=$(nproc 2>/dev/null || echo 2)
@@ -49,7 +53,11 @@ if [ ! -f "$build_dir/CMakeCache.txt" ]; then
   cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release -DMESHSTREAM_TOOLS_DIR="$tools_dir" \
     ${MESHSTREAM_CMAKE_ARGS:-} >/dev/null
 fi
-cmake --build "$build_dir" -j"$jobs"
+# The demo builds the one program it runs; the test suite and `build` build everything.
+case "$mode" in
+  demo) cmake --build "$build_dir" -j"$jobs" --target meshstream ;;
+  build | test) cmake --build "$build_dir" -j"$jobs" ;;
+esac
 
 case "$mode" in
   build) ;;
@@ -60,5 +68,4 @@ case "$mode" in
   test)
     ctest --test-dir "$build_dir" --output-on-failure -j"$jobs"
     ;;
-  *) echo "usage: $0 demo|test|build" >&2; exit 2 ;;
 esac
