@@ -13,7 +13,7 @@
 //            fingerprint (u64 each), the plan (PartPlan: the decimator's options that change its
 //            output, the count the ranges are cut from, the ranges, the attribute weights, the
 //            channels carried), u32 bytes of a triangle record, u32 bytes of decimate::Stats
-//   pieces:  u8 1, u8 piece (Piece), f64 weight, u64 n, then n TriangleRecords (as the MPI
+//   pieces:  u8 1, u8 piece (Piece), f64 weight, u64 n, then n io::TriangleRecords (as the MPI
 //            ranks send them)
 //   end:     u8 2, decimate::Stats (the range's), u8 forced, u64 forced_at, u64 pieces,
 //            u64 triangles, u64 hash of every byte from the first piece to here, 'M' 'S' 'P' 'E'

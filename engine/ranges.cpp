@@ -26,7 +26,7 @@ namespace meshstream::engine {
 
 namespace {
 
-// One range's output on its way to the seam pass: its triangles' records (TriangleRecords) in a
+// One range's output on its way to the seam pass: its triangles' records (io::TriangleRecords) in a
 // temporary file, and for each chunk its piece, triangle count and the input triangles each of
 // them stands for. Appended to by the range's thread (or the thread receiving a remote range),
 // read by the seam pass's.

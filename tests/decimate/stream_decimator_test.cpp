@@ -497,7 +497,7 @@ TEST(StreamDecimator, TargetFollowsTheTrianglesTheReadLoopDropped) {
     EXPECT_NEAR(decimator.ratio(), 6945.0 / double(n), 1e-12);
 }
 
-// Parallel decimation's parts (tools/decimate_threads.hpp runs them on threads): the bunny cut
+// Parallel decimation's parts (engine/ranges.hpp runs them on threads): the bunny cut
 // into two ranges, each decimated by a Part::kRange decimator, and their outputs joined in
 // range order by a Part::kSeams decimator with the weights the ranges give.
 TEST(StreamDecimator, RangesKeepTheirSeamsAndTheSeamPassJoinsThem) {

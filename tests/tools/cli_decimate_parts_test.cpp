@@ -1,6 +1,6 @@
 // `meshstream decimate --part k/K` through the binaries (MESHSTREAM_BINARY,
 // MESHSTREAM_GEN_BINARY): the ranges of `--threads K` as K separate jobs, parts 1 .. K-1 into
-// part files and the merge K/K (tools/decimate_parts.hpp). The merge writes the bytes --threads K
+// part files and the merge K/K (engine/part_files.hpp). The merge writes the bytes --threads K
 // writes; a part file that is missing, cut short, damaged or made from another input or with
 // other options is refused with the file and what is wrong, and nothing is written.
 #include "tools/cli_util.hpp"

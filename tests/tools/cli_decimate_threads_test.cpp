@@ -1,6 +1,6 @@
 // `meshstream decimate --threads N` through the binaries (MESHSTREAM_BINARY,
 // MESHSTREAM_GEN_BINARY): the input cut into ranges decimated at once and joined by a seam pass
-// (tools/decimate_threads.hpp). A generated mesh with a --buffer small enough that it really is
+// (engine/ranges.hpp). A generated mesh with a --buffer small enough that it really is
 // cut, checked for what one thread guarantees: exact counts, a closed mesh kept closed, the
 // same bytes every time, errors that name the file and position, and an error close to one
 // thread's.
