@@ -279,8 +279,9 @@ std::unique_ptr<decimate::StreamDecimator> make_decimator(const decimate::Option
     } catch (const std::bad_alloc&) {
         // Per triangle: about 580 bytes for positions, more with the channels carried.
         const size_t bytes = decimate::StreamDecimator::reserved_bytes(options.buffer_triangles, attributes);
-        throw io::OptionError(
-            Setting::kBuffer,
+        // Not a setting that cannot work but memory this system will not give: the failure of
+        // the run (meshstream::Error), naming the buffer that asked for it.
+        throw meshstream::Error(
             mention(Setting::kBuffer) + " " + std::to_string(options.buffer_triangles) + " reserves " +
                 human_bytes(double(bytes)) + " of memory (about " +
                 std::to_string(bytes / std::max<size_t>(options.buffer_triangles, 1)) +

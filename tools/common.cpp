@@ -404,6 +404,7 @@ void Progress::phase(std::string label, std::optional<uint64_t> total) {
     file_bytes_.reset();
     start_ = std::chrono::steady_clock::now();
     draw(true);
+    fresh_phase_ = true;
 }
 
 void Progress::status(const std::string& text) {
@@ -412,18 +413,20 @@ void Progress::status(const std::string& text) {
     drawn_ = true;
 }
 
-// The first update draws at once (a phase shows from its first chunk), the others at most
-// 5 times a second.
+// The first update of a phase draws at once (a phase shows its counts from its first chunk),
+// the others at most 5 times a second.
 void Progress::update(uint64_t done) {
     done_ = done;
-    if (enabled_) draw(!drawn_);
+    if (enabled_) draw(fresh_phase_ || !drawn_);
+    fresh_phase_ = false;
 }
 
 void Progress::update(uint64_t done, uint64_t bytes_read, std::optional<uint64_t> file_bytes) {
     done_ = done;
     bytes_read_ = bytes_read;
     file_bytes_ = file_bytes;
-    if (enabled_) draw(!drawn_);
+    if (enabled_) draw(fresh_phase_ || !drawn_);
+    fresh_phase_ = false;
 }
 
 void Progress::draw(bool force) {

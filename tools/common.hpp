@@ -164,6 +164,7 @@ private:
     std::optional<uint64_t> file_bytes_;  // set by update(done, bytes, size) until phase()
     bool enabled_;
     bool drawn_ = false;
+    bool fresh_phase_ = true;  // the first update of a phase draws at once
     std::chrono::steady_clock::time_point start_, last_;
 };
 
