@@ -20,31 +20,7 @@ namespace {
 using io::mention;
 using io::Setting;
 
-double seconds_since(std::chrono::steady_clock::time_point t) {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
-}
-
 std::string shown(const std::string& path, bool output) { return path != "-" ? path : output ? "<stdout>" : "<stdin>"; }
-
-void check_cancel(const ProgressSink& progress) {
-    if (progress.cancelled()) throw Cancelled();
-}
-
-// The output's format: the one named, else the output name's extension's.
-const io::Format& output_format(const ConvertSettings& s) {
-    if (!s.output_format.empty()) {
-        const io::Format* f = io::find_format(s.output_format);
-        if (f == nullptr || f->open_writer == nullptr)
-            throw io::OptionError(Setting::kTo, "unknown output format '" + s.output_format +
-                                                    "' (one of: " + io::format_names(true) + ")");
-        return *f;
-    }
-    if (const io::Format* f = io::format_for_extension(s.output, true)) return *f;
-    throw io::OptionError(Setting::kTo, shown(s.output, true) +
-                                            ": cannot tell the output format from the name (give its format, one "
-                                            "of: " +
-                                            io::format_names(true) + ")");
-}
 
 // The read loop: every triangle kept, or the bad ones dropped and counted (clean).
 io::TriangleInput open_input(const ConvertSettings& s, const io::ReadOptions& options) {
@@ -58,7 +34,7 @@ std::string removed() { return "removed (" + mention(Setting::kClean) + ")"; }
 }  // namespace
 
 ConvertResult convert_file(const ConvertSettings& s, ProgressSink& progress) {
-    const io::Format& out_format = output_format(s);
+    const io::Format& out_format = output_format(s.output, s.output_format);
     io::TriangleInput in = open_input(s, s.read);
     const io::MeshHeader& header = in.header();
     io::WriteOptions wo = s.write;
@@ -85,7 +61,7 @@ ConvertResult convert_file(const ConvertSettings& s, ProgressSink& progress) {
         while (in.next(chunk)) {
             out.write(chunk);
             progress.update(in.count().read, in.source().stored_offset(), in.source().stored_size());
-            check_cancel(progress);
+            throw_if_cancelled(progress);
         }
     } else {
         // Reading (inflating, parsing) on one thread, writing (formatting, welding, encoding,
@@ -96,7 +72,7 @@ ConvertResult convert_file(const ConvertSettings& s, ProgressSink& progress) {
         while (true) {
             try {
                 if (!reader.next(chunk)) break;
-                check_cancel(progress);
+                throw_if_cancelled(progress);
             } catch (...) {
                 // Without threads the writes before a read error come first: one of them may
                 // fail instead, and that error is the run's.
@@ -134,7 +110,7 @@ ConvertResult convert_file(const ConvertSettings& s, ProgressSink& progress) {
 
 SortResult sort_file(const SortSettings& s, ProgressSink& progress) {
     const auto t0 = std::chrono::steady_clock::now();
-    const io::Format& out_format = output_format(s);
+    const io::Format& out_format = output_format(s.output, s.output_format);
     // A writer that puts the triangles in an order of its own (Draco's connectivity coder)
     // would lose the sorted order.
     if (out_format.reorders_triangles != nullptr)
@@ -224,14 +200,14 @@ SortResult sort_file(const SortSettings& s, ProgressSink& progress) {
             while (in.next(chunk)) {
                 sorter.add(chunk);
                 progress.update(in.count().read, in.source().stored_offset(), file_bytes);
-                check_cancel(progress);
+                throw_if_cancelled(progress);
             }
         } else {
             io::ReadAhead reader(in, chunk_capacity, so.channels);
             while (reader.next(chunk)) {
                 sorter.add(chunk);
                 progress.update(reader.count().read, reader.stored_offset(), file_bytes);
-                check_cancel(progress);
+                throw_if_cancelled(progress);
             }
         }
     }
@@ -267,7 +243,7 @@ SortResult sort_file(const SortSettings& s, ProgressSink& progress) {
             while (sorter.next(chunk)) {
                 out.write(chunk);
                 progress.update(done += chunk.size());
-                check_cancel(progress);
+                throw_if_cancelled(progress);
             }
         } else {
             io::WriteBehind writer(out, chunk_capacity, so.channels);

@@ -25,10 +25,6 @@ namespace {
 using io::mention;
 using io::Setting;
 
-double seconds_since(std::chrono::steady_clock::time_point t) {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
-}
-
 // The shortest text that reads back as `v`.
 std::string number_text(double v) {
     char text[32];
@@ -37,11 +33,6 @@ std::string number_text(double v) {
 }
 
 std::string shown_input(const std::string& path) { return path == "-" ? std::string("<stdin>") : path; }
-
-// Throws Cancelled once the caller asked for it.
-void check_cancel(const ProgressSink& progress) {
-    if (progress.cancelled()) throw Cancelled();
-}
 
 // The read loop decimate reads through: the file as settings say, its bad triangles dropped (the
 // decimator cannot use them), or refused with strict reading.
@@ -264,7 +255,7 @@ CountPass count_usable_triangles(const DecimateSettings& s, const io::ReadOption
     progress.phase("counting triangles", std::nullopt);
     while (in.next(chunk)) {
         progress.update(in.count().read, in.source().stored_offset(), in.source().stored_size());
-        check_cancel(progress);
+        throw_if_cancelled(progress);
     }
     CountPass pass;
     pass.count.promised = in.count().passed();
@@ -303,7 +294,7 @@ bool decimate_pass(const ChunkSource& next, const io::Channels& channels, decima
     while (next(chunk)) {
         decimator.push(chunk, emit);
         show_progress();
-        check_cancel(progress);
+        throw_if_cancelled(progress);
         if (stop && stop()) return false;
     }
     return true;
@@ -346,7 +337,7 @@ SortedInput sort_file(const DecimateSettings& s, uint64_t sort_budget, const io:
     while (in.next(chunk)) {
         sorted.sorter->add(chunk);
         progress.update(in.count().read, in.source().stored_offset(), in.source().stored_size());
-        check_cancel(progress);
+        throw_if_cancelled(progress);
     }
     sorted.count = in.count();
     sorted.dropped = dropped_triangles(in);
@@ -365,7 +356,7 @@ SortedInput sort_spooled(io::TriangleInput& in, InputSpool& spool, uint64_t sort
     while (in.next(chunk)) {
         spool.add(chunk);
         progress.update(in.count().read, in.source().stored_offset(), in.source().stored_size());
-        check_cancel(progress);
+        throw_if_cancelled(progress);
     }
     if (!spool.ok()) throw io::Error(in.name(), "cannot spool the input to sort it: " + spool.error());
     SortedInput sorted;
@@ -379,7 +370,7 @@ SortedInput sort_spooled(io::TriangleInput& in, InputSpool& spool, uint64_t sort
     while (spool.next(chunk)) {
         sorted.sorter->add(chunk);
         progress.update(done += chunk.size());
-        check_cancel(progress);
+        throw_if_cancelled(progress);
     }
     sorted.sorter->finish_input();
     sorted.temp_bytes = spool.bytes() + sorted.sorter->stats().peak_temp_bytes;
@@ -402,22 +393,6 @@ io::ReadOptions decimate_read_options(const DecimateSettings& s, const io::Forma
     every.face_scalars = {io::ScalarChannel{"f"}};
     if (!io::writable_channels(out_format, every, wo).has_attributes()) read.channels = io::ChannelKinds::none();
     return read;
-}
-
-// The output's format: the one named, else the output name's extension's.
-const io::Format& output_format(const DecimateSettings& s) {
-    if (!s.output_format.empty()) {
-        const io::Format* f = io::find_format(s.output_format);
-        if (f == nullptr || f->open_writer == nullptr)
-            throw io::OptionError(Setting::kTo, "unknown output format '" + s.output_format +
-                                                    "' (one of: " + io::format_names(true) + ")");
-        return *f;
-    }
-    if (const io::Format* f = io::format_for_extension(s.output, true)) return *f;
-    throw io::OptionError(Setting::kTo, (s.output == "-" ? std::string("<stdout>") : s.output) +
-                                            ": cannot tell the output format from the name (give its format, one "
-                                            "of: " +
-                                            io::format_names(true) + ")");
 }
 
 // The ranges of `ranges` of an input of `cut_triangles` triangles (threads, MPI, parts): every
@@ -536,7 +511,7 @@ PartResult decimate_part(const DecimateSettings& s, ProgressSink& progress) {
         throw io::OptionError(Setting::kPart, "decimate_part makes a part job's part file: give a part k < K");
     check_part_settings(s);
     const PartIndex part = *s.part;
-    const io::Format& out_format = s.output_format.empty() ? io::kTriangleStreamFormat : output_format(s);
+    const io::Format& out_format = s.output_format.empty() ? io::kTriangleStreamFormat : output_format(s.output, s.output_format);
     const io::WriteOptions& wo = s.write;
     const io::ReadOptions read = decimate_read_options(s, out_format, wo);
     io::TriangleInput in = open_decimate_input(s, read);
@@ -611,7 +586,7 @@ void run_remote_range(const DecimateSettings& s, RangeProcesses& processes) {
     const std::optional<RangePlan> plan = processes.receive_plan();
     if (!plan || processes.rank() >= plan->ranges) return;
     // The channels carried, found as process 0 found them (same file, same settings).
-    const io::Format& out_format = output_format(s);
+    const io::Format& out_format = output_format(s.output, s.output_format);
     const io::WriteOptions& wo = s.write;
     const io::ReadOptions read = decimate_read_options(s, out_format, wo);
     const Carried carried = [&] {
@@ -659,7 +634,7 @@ DecimateResult decimate_file(const DecimateSettings& s, ProgressSink& progress) 
                                                       ": a sorted stream is decimated by one process; sort first "
                                                       "(meshstream sort IN SORTED.stl), then decimate the sorted file");
     }
-    const io::Format& out_format = output_format(s);
+    const io::Format& out_format = output_format(s.output, s.output_format);
     io::WriteOptions wo = s.write;
     const io::ReadOptions read = decimate_read_options(s, out_format, wo);
     io::TriangleInput in = open_decimate_input(s, read);

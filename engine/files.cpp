@@ -70,6 +70,21 @@ std::string shown(const std::string& path, bool output) { return path != "-" ? p
 
 }  // namespace
 
+const io::Format& output_format(const std::string& output, const std::string& format_name) {
+    if (!format_name.empty()) {
+        const io::Format* f = io::find_format(format_name);
+        if (f == nullptr || f->open_writer == nullptr)
+            throw io::OptionError(io::Setting::kTo, "unknown output format '" + format_name +
+                                                        "' (one of: " + io::format_names(true) + ")");
+        return *f;
+    }
+    if (const io::Format* f = io::format_for_extension(output, true)) return *f;
+    throw io::OptionError(io::Setting::kTo, shown(output, true) +
+                                                ": cannot tell the output format from the name (give its format, "
+                                                "one of: " +
+                                                io::format_names(true) + ")");
+}
+
 InputFiles input_files(const std::string& path, const io::MeshHeader& header) { return {path, header.side_files}; }
 
 void refuse_output_over_inputs(const std::string& output, const std::vector<std::string>& output_side_files,

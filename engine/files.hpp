@@ -23,6 +23,11 @@ io::Bounds input_bounds(const std::string& path, std::string_view from, const io
 // The axis along which `box` is longest (z for an empty or flat box, the usual scan axis).
 int longest_axis(const io::Bounds& box);
 
+// The format an output is written in: the one named (a registry name), else the one of the
+// output name's extension. Throws io::OptionError (the output format's setting) when neither
+// names a writable format.
+const io::Format& output_format(const std::string& output, const std::string& format_name);
+
 // An input for refuse_output_over_inputs: its path ("-" = stdin) and the other files its
 // reader read (MeshHeader::side_files).
 struct InputFiles {

@@ -51,4 +51,9 @@ public:
     Cancelled() : std::runtime_error("cancelled") {}
 };
 
+// Throws Cancelled once `progress` says cancelled().
+inline void throw_if_cancelled(const ProgressSink& progress) {
+    if (progress.cancelled()) throw Cancelled();
+}
+
 }  // namespace meshstream::engine

@@ -90,6 +90,21 @@ struct WriteFlags {
     // kStreamingMemory.
     io::WriteOptions options(const ReadFlags& read, const io::Format& output) const;
 };
+// The files and options a convert or sort job takes from the flags (engine/convert.hpp); the
+// caller adds its own (clean, threads, the axis).
+template <class Settings>
+Settings job_settings(const std::string& input, const std::string& output, const io::Format& out_format,
+                      const ReadFlags& read, const WriteFlags& write) {
+    Settings s;
+    s.input = input;
+    s.output = output;
+    s.input_format = read.from;
+    s.output_format = std::string(out_format.name);
+    s.read = read.options();
+    s.write = write.options(read, out_format);
+    s.gzip_level = write.gzip_level;
+    return s;
+}
 // `with_memory`: false when add_read_flags already added --memory/--tmpdir to `cmd`.
 void add_write_flags(CLI::App* cmd, WriteFlags& flags);
 // The format an output is written in: --to's, else its extension's, else, for stdout or a

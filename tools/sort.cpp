@@ -66,16 +66,9 @@ void run_sort(const SortOptions& opt) {
     const auto t0 = std::chrono::steady_clock::now();
     if (opt.json) refuse_json_with_stdout_output(opt.output);
     const io::Format& out_format = resolve_output_format(opt.output, opt.write);
-    engine::SortSettings settings;
-    settings.input = opt.input;
-    settings.output = opt.output;
-    settings.input_format = opt.read.from;
-    settings.output_format = std::string(out_format.name);
+    auto settings = job_settings<engine::SortSettings>(opt.input, opt.output, out_format, opt.read, opt.write);
     settings.clean = opt.clean;
     settings.threads = opt.threads;
-    settings.read = opt.read.options();
-    settings.write = opt.write.options(opt.read, out_format);
-    settings.gzip_level = opt.write.gzip_level;
     if (opt.axis != "auto")
         settings.axis = static_cast<int>(std::find(std::begin(kAxisNames), std::end(kAxisNames), opt.axis) -
                                          std::begin(kAxisNames));
