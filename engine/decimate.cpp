@@ -124,7 +124,7 @@ public:
             records_.encode(chunk, bytes_);
             file_->write(bytes_.data(), bytes_.size());
         } catch (const io::Error& e) {
-            error_ = e.what();
+            error_ = e.raw_what();
             file_.reset();
             return;
         }
@@ -690,7 +690,7 @@ DecimateResult decimate_file(const DecimateSettings& s, ProgressSink& progress) 
         } catch (const io::Error& e) {
             if (part) throw;
             ranges = 1;
-            one_thread_why = e.what();
+            one_thread_why = e.raw_what();
         }
     }
     // The merge: its plan is the parts' (each part file says it was made with it), read before
@@ -836,7 +836,7 @@ DecimateResult decimate_file(const DecimateSettings& s, ProgressSink& progress) 
             // spool.
             if (sort_first || spool) throw;
             outcome.kind = SortOutcome::Kind::kCouldNot;
-            outcome.why_not = std::string("sorting failed: ") + e.what();
+            outcome.why_not = std::string("sorting failed: ") + e.raw_what();
         }
         gate.release();  // no restart after this one
         if (sorted) {

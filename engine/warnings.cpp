@@ -3,16 +3,16 @@
 
 namespace meshstream::engine {
 
-std::vector<Warnings::Line> Warnings::all() const {
+std::vector<Warnings::Line> Warnings::all(io::SettingNames name) const {
     std::vector<Line> out;
-    for (const auto& [text, entry] : entries_) out.push_back({entry.code, text, entry.count});
+    for (const auto& [text, entry] : entries_) out.push_back({entry.code, io::render(text, name), entry.count});
     return out;
 }
 
-std::vector<std::string> Warnings::lines() const {
+std::vector<std::string> Warnings::lines(io::SettingNames name) const {
     std::vector<std::string> out;
-    for (const auto& [text, entry] : entries_)
-        out.push_back(entry.count == 0 ? text : text + " (" + std::to_string(entry.count) + ")");
+    for (const Line& line : all(name))
+        out.push_back(line.count == 0 ? line.text : line.text + " (" + std::to_string(line.count) + ")");
     return out;
 }
 

@@ -4,6 +4,7 @@
 // user reads all().
 #pragma once
 
+#include "io/error.hpp"
 #include "io/format.hpp"
 #include "io/triangle_input.hpp"
 
@@ -38,10 +39,11 @@ public:
         std::string code, text;
         uint64_t count = 0;  // 0 for a one-off finding
     };
-    // In a stable order (by text); text without the count.
-    std::vector<Line> all() const;
+    // In a stable order (by text); text without the count, its settings (io::mention) in the
+    // words of `name` (io::setting_words when null).
+    std::vector<Line> all(io::SettingNames name = nullptr) const;
     // The same as lines of text: a counted one with its count, "text (12)".
-    std::vector<std::string> lines() const;
+    std::vector<std::string> lines(io::SettingNames name = nullptr) const;
 
 private:
     struct Entry {

@@ -153,7 +153,7 @@ public:
             if (const int64_t t = first_repeated_vertex(mesh.indices); t >= 0)
                 throw Error(sink_.name(), "triangle " + std::to_string(t) +
                                               " has two corners at one vertex, which "
-                                              "Draco's encoder drops (--strict)");
+                                              "Draco's encoder drops (" + mention(Setting::kStrict) + ")");
         std::vector<uint32_t> all(mesh.vertex_count());
         std::iota(all.begin(), all.end(), 0u);
         VertexValues values = mesh.values(all);
@@ -389,25 +389,29 @@ uint64_t draco_encode_estimate_bytes(uint64_t vertex_count, uint64_t triangle_co
 
 DracoSettings check_draco_settings(const std::string& file, const WriteOptions& options) {
     const DracoSettings s = options.format_options.get<DracoSettings>();
-    auto check = [&](int value, int low, int high, const char* flag) {
+    auto check = [&](int value, int low, int high, Setting setting) {
         if (value < low || value > high)
-            throw Error(file, std::string(flag) + " must be " + std::to_string(low) + "-" + std::to_string(high) +
-                                  ", got " + std::to_string(value));
+            throw OptionError(setting, file + ": " + mention(setting) + " must be " + std::to_string(low) + "-" +
+                                           std::to_string(high) + ", got " + std::to_string(value));
     };
-    check(s.position_bits, 1, 30, "--draco-qp");
-    check(s.normal_bits, 2, 30, "--draco-qn");
-    check(s.texcoord_bits, 1, 30, "--draco-qt");
-    check(s.color_bits, 1, 30, "--draco-qc");
-    check(s.level, 0, 10, "--draco-cl");
+    check(s.position_bits, 1, 30, Setting::kDracoPositionBits);
+    check(s.normal_bits, 2, 30, Setting::kDracoNormalBits);
+    check(s.texcoord_bits, 1, 30, Setting::kDracoTexcoordBits);
+    check(s.color_bits, 1, 30, Setting::kDracoColorBits);
+    check(s.level, 0, 10, Setting::kDracoLevel);
     const uint64_t tables = draco_table_bytes(options, s);
     if (tables <= options.memory_budget_bytes) return s;
     throw Error(
         file,
-        "Draco's coding tables for --draco-qp " + std::to_string(s.position_bits) +
-            (options.normals || options.channels.normal ? " and --draco-qn " + std::to_string(s.normal_bits) : "") +
-            " at --draco-cl " + std::to_string(s.level) + " take about " + binary_size(tables) +
+        "Draco's coding tables for " + mention(Setting::kDracoPositionBits) + " " + std::to_string(s.position_bits) +
+            (options.normals || options.channels.normal
+                 ? " and " + mention(Setting::kDracoNormalBits) + " " + std::to_string(s.normal_bits)
+                 : "") +
+            " at " + mention(Setting::kDracoLevel) + " " + std::to_string(s.level) + " take about " +
+            binary_size(tables) +
             " (they double with each bit), over the memory budget of " + binary_size(options.memory_budget_bytes) +
-            ": give fewer bits (float positions hold 24) or --memory " + std::to_string((tables >> 20) + 1) +
+            ": give fewer bits (float positions hold 24) or " + mention(Setting::kMemory) + " " +
+            std::to_string((tables >> 20) + 1) +
             "M or more");
 }
 
@@ -450,13 +454,15 @@ DracoEncoded encode_draco(const std::vector<float>& positions, const std::vector
         if (!std::isfinite(range))
             throw Error(file_name,
                         "the mesh is wider along an axis than a float can hold (3.4e38): Draco cannot "
-                        "quantize it; write it without Draco (--compress none for glTF, or another format)");
+                        "quantize it; write it without Draco (" + mention(Setting::kCompress) +
+                            " none for glTF, or another format)");
         if (range > 0 && !std::isfinite(max_q / range)) {
             std::string extent;
             append_number(extent, range);
             throw Error(file_name, "the mesh is too small for Draco's " + std::to_string(settings.position_bits) +
                                        "-bit quantization (largest extent " + extent +
-                                       "): write it with fewer --draco-qp bits, or without Draco");
+                                       "): write it with fewer " + mention(Setting::kDracoPositionBits) +
+                                       " bits, or without Draco");
         }
     }
     const size_t n = positions.size() / 3;
@@ -563,13 +569,13 @@ std::vector<std::string> draco_notes(const DracoEncoded& encoded, uint64_t trian
     if (encoded.dropped)
         out.push_back(std::to_string(encoded.dropped) + " of the " + std::to_string(triangles) +
                       " triangles have two corners at one vertex (degenerate), which Draco's encoder drops: left out "
-                      "(write without Draco to keep them; --strict makes this an error)");
+                      "(write without Draco to keep them; " + mention(Setting::kStrict) + " makes this an error)");
     if (encoded.flattened)
         out.push_back(std::to_string(encoded.flattened) + " of the " + std::to_string(triangles) +
                       " triangles have zero area once decoded: thinner than Draco's " +
                       std::to_string(settings.position_bits) +
-                      "-bit quantization step (the largest extent / (2^bits - 1)); raise --draco-qp, or write without "
-                      "Draco");
+                      "-bit quantization step (the largest extent / (2^bits - 1)); raise " +
+                      mention(Setting::kDracoPositionBits) + ", or write without Draco");
     return out;
 }
 

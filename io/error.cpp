@@ -25,13 +25,77 @@ std::string format_what(const std::string& file, uint64_t byte_offset, uint64_t 
 }  // namespace
 
 Error::Error(std::string file, uint64_t byte_offset, uint64_t line, std::string message)
-    : std::runtime_error(format_what(file, byte_offset, line, message)),
+    : meshstream::Error(format_what(file, byte_offset, line, render(message)),
+                        format_what(file, byte_offset, line, message)),
       file_(std::move(file)),
       byte_offset_(byte_offset),
       line_(line),
       message_(std::move(message)) {}
 
 Error::Error(std::string file, std::string message) : Error(std::move(file), kNoOffset, 0, std::move(message)) {}
+
+std::string Error::describe(SettingNames name) const {
+    return format_what(file_, byte_offset_, line_, render(message_, name));
+}
+
+std::string Error::raw_what() const { return format_what(file_, byte_offset_, line_, message_); }
+
+std::string_view setting_words(Setting setting) {
+    static constexpr std::string_view kWords[kSettingCount] = {
+        "the input",
+        "the output",
+        "the input format",
+        "the output format",
+        "the memory budget",
+        "the temporary-directory setting",
+        "strict reading",
+        "the channels left out",
+        "dropping bad triangles",
+        "the glTF compression",
+        "the Draco position bits",
+        "the Draco normal bits",
+        "the Draco texture coordinate bits",
+        "the Draco colour bits",
+        "the Draco compression level",
+        "the gzip level",
+        "the ratio",
+        "the target",
+        "the buffer",
+        "the weld",
+        "the attribute weights",
+        "the sorted axis",
+        "the seed",
+        "the thread count",
+        "the sort policy",
+        "the sort axis",
+        "the part",
+        "the part files",
+    };
+    const int i = int(setting);
+    return i >= 0 && i < kSettingCount ? kWords[i] : std::string_view("a setting");
+}
+
+namespace {
+// A mention: this byte, the setting's number as one byte (1-based, so never a NUL), this byte.
+constexpr char kMark = '\x1e';
+}  // namespace
+
+std::string mention(Setting setting) { return {kMark, char(int(setting) + 1), kMark}; }
+
+std::string render(std::string_view text, SettingNames name) {
+    std::string out;
+    out.reserve(text.size());
+    for (size_t i = 0; i < text.size(); ++i) {
+        if (text[i] == kMark && i + 2 < text.size() && text[i + 2] == kMark) {
+            const auto setting = Setting(int(static_cast<unsigned char>(text[i + 1])) - 1);
+            out += name != nullptr ? name(setting) : std::string(setting_words(setting));
+            i += 2;
+        } else {
+            out += text[i];
+        }
+    }
+    return out;
+}
 
 std::string printable(std::string_view text, size_t max_chars) {
     std::string out;
@@ -61,3 +125,9 @@ std::string quote_token(std::string_view token) {
 }
 
 }  // namespace meshstream::io
+
+namespace meshstream {
+
+Error::Error(std::string message) : Error(io::render(message), message) {}
+
+}  // namespace meshstream

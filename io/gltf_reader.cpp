@@ -306,7 +306,7 @@ public:
             if (bytes.size() > options.memory_budget_bytes)
                 throw Error(name_,
                             "glTF documents are read whole into memory and this one is over the memory budget of " +
-                                binary_size(options.memory_budget_bytes) + "; raise --memory");
+                                binary_size(options.memory_budget_bytes) + "; raise " + mention(Setting::kMemory));
         }
         // A cut inside the magic ("g" of "glTF") is a GLB cut short too: no JSON starts so.
         const bool glb = !bytes.empty() && std::memcmp(bytes.data(), kGlbMagic, std::min<size_t>(bytes.size(), 4)) == 0;
@@ -344,7 +344,7 @@ public:
                         "glTF documents are read whole into memory with their buffers: this one and its buffer "
                         "files take " +
                             binary_size(bytes.size() + external) + ", over the memory budget of " +
-                            binary_size(options.memory_budget_bytes) + "; raise --memory");
+                            binary_size(options.memory_budget_bytes) + "; raise " + mention(Setting::kMemory));
 
         tinygltf::TinyGLTF gltf;
         ImageBytes images;
@@ -638,7 +638,8 @@ const std::vector<unsigned char>& GltfReader::meshopt_view(int index, const std:
                                " bytes)");
     if (decoded_bytes > budget_bytes_ || meshopt_bytes_ + decoded_bytes > budget_bytes_)
         throw Error(name_, at + " decodes to " + binary_size(decoded_bytes) + ", which with the views decoded before " +
-                               "passes the memory budget of " + binary_size(budget_bytes_) + "; raise --memory");
+                               "passes the memory budget of " + binary_size(budget_bytes_) + "; raise " +
+                               mention(Setting::kMemory));
     std::vector<unsigned char> out(decoded_bytes);
     const unsigned char* src = data.data() + *offset;
     int rc = 0;
@@ -900,7 +901,7 @@ AccessorView GltfReader::view(int accessor, const std::string& what) const {
         if (a.count > budget_bytes_ / (4 * uint64_t(v.components)))
             throw Error(name_, where_acc + " has no bufferView (all zeros) and count " + std::to_string(a.count) +
                                    ", over the memory budget of " + binary_size(budget_bytes_) +
-                                   " once decoded; raise --memory");
+                                   " once decoded; raise " + mention(Setting::kMemory));
         return v;
     }
     if (a.bufferView >= static_cast<int>(model_.bufferViews.size()))
@@ -972,7 +973,7 @@ std::shared_ptr<const PrimitiveGeometry> GltfReader::geometry(int mesh, int prim
         try {
             d = decode_draco({start, bv.byteLength}, name_, 0, attrs.Get("POSITION").Get<int>());
         } catch (const Error& e) {
-            throw Error(name_, at + " (KHR_draco_mesh_compression): " + e.message());
+            throw Error(name_, at + " (KHR_draco_mesh_compression): " + e.raw_message());
         }
         uint64_t stated = primitive_triangle_count(mesh, prim);
         if (d.indices.size() / 3 != stated)

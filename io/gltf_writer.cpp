@@ -685,7 +685,7 @@ void GltfWriter::finish_output() {
             if (const int64_t t = first_repeated_vertex(mesh.indices); t >= 0)
                 throw Error(sink_.name(), "triangle " + std::to_string(t) +
                                               " has two corners at one vertex, which "
-                                              "Draco's encoder drops (--strict)");
+                                              "Draco's encoder drops (" + mention(Setting::kStrict) + ")");
 #endif
         // --normals adds smooth normals to a mesh that has none of its own.
         Channels ch = mesh.channels;
@@ -704,7 +704,7 @@ void GltfWriter::finish_output() {
             if (!std::isfinite(extent))
                 throw Error(sink_.name(),
                             "the mesh is wider along an axis than a float can hold (3.4e38): it cannot be "
-                            "quantized for meshopt; write it with --compress none");
+                            "quantized for meshopt; write it with " + mention(Setting::kCompress) + " none");
             q.scale = extent > 0 ? extent : 1.0f;
         }
 #if MESHSTREAM_WITH_DRACO

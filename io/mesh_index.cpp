@@ -257,7 +257,7 @@ void MeshIndexer::add(const TriangleChunk& chunk) {
                 throw Error(file_name_, "triangle " + std::to_string(input_triangles_) +
                                             " has a NaN or infinite "
                                             "coordinate, which " +
-                                            format_ + " cannot store (--strict)");
+                                            format_ + " cannot store (" + mention(Setting::kStrict) + ")");
             ++non_finite_;
             continue;
         }
@@ -290,7 +290,7 @@ std::vector<std::string> MeshIndexer::notes() const {
     if (non_finite_)
         out.push_back(std::to_string(non_finite_) + " of the " + std::to_string(input_triangles_) +
                       " triangles have a NaN or infinite coordinate, which " + format_ +
-                      " cannot store: left out (--strict makes this an error)");
+                      " cannot store: left out (" + mention(Setting::kStrict) + " makes this an error)");
     if (non_finite_attributes_)
         out.push_back(std::to_string(non_finite_attributes_) +
                       " attribute values (normal, colour, texture coordinate or scalar) were NaN or infinite: written "
@@ -310,12 +310,12 @@ IndexedMesh MeshIndexer::take() {
 
 namespace {
 
-// The budget, and the share of --memory it is when it is not all of it.
+// The budget, and the share of the whole budget it is when it is not all of it.
 std::string budget_text(uint64_t budget, uint32_t divisor) {
-    return binary_size(budget) + (divisor > 1 ? " (1/" + std::to_string(divisor) + " of --memory)" : std::string());
+    return binary_size(budget) + (divisor > 1 ? " (1/" + std::to_string(divisor) + " of " + mention(Setting::kMemory) + ")" : std::string());
 }
 
-// The --memory, in whole MiB, that gives a writer `bytes`.
+// The whole budget, in whole MiB, that gives a writer `bytes`.
 std::string memory_option_mib(uint64_t bytes, uint32_t divisor) {
     const long double all = (long double)bytes * (long double)std::max<uint32_t>(divisor, 1);
     return std::to_string(uint64_t(std::ceil(all / (long double)(uint64_t{1} << 20))));
@@ -334,7 +334,7 @@ void budget_check_up_front(const std::string& file, const WriteOptions& options,
     if (least <= options.memory_budget_bytes) return;
     throw Error(file, std::string(why) + ": the " + std::to_string(*n) + " triangles to be written need at least " +
                           binary_size(least) + ", over the memory budget of " +
-                          budget_text(options.memory_budget_bytes, options.memory_budget_divisor) + "; give --memory " +
+                          budget_text(options.memory_budget_bytes, options.memory_budget_divisor) + "; give " + mention(Setting::kMemory) + " " +
                           memory_option_mib(least, options.memory_budget_divisor) + "M or more");
 }
 
@@ -367,7 +367,7 @@ void WholeMeshBudget::refuse(uint64_t total) const {
                            (total > triangles_
                                 ? " (the first " + std::to_string(triangles_) + " took " + binary_size(need_) + ")"
                                 : std::string()) +
-                           ", over the memory budget of " + budget_text(budget_, divisor_) + "; give --memory " +
+                           ", over the memory budget of " + budget_text(budget_, divisor_) + "; give " + mention(Setting::kMemory) + " " +
                            memory_option_mib(all, divisor_) + "M or more");
 }
 

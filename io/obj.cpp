@@ -442,7 +442,7 @@ private:
             face_.push_back(c);
         }
         if (face_.size() < 3) {
-            if (options_.strict) fail("face with " + std::to_string(face_.size()) + " vertices (--strict)");
+            if (options_.strict) fail("face with " + std::to_string(face_.size()) + " vertices (" + mention(Setting::kStrict) + ")");
             ++short_faces_;
             return false;
         }
@@ -701,7 +701,7 @@ private:
         if (!findings_.missing_images.empty())
             add("texture images not found, kept by name only: " + joined(findings_.missing_images));
         if (!findings_.unloaded_images.empty())
-            add("texture images past --memory not loaded, kept by name only: " + joined(findings_.unloaded_images));
+            add("texture images past " + mention(Setting::kMemory) + " not loaded, kept by name only: " + joined(findings_.unloaded_images));
         if (!findings_.skipped_keywords.empty())
             add("material statements not kept: " + joined(findings_.skipped_keywords, 12) +
                 " (meshstream keeps Kd, d or Tr, and map_Kd)");

@@ -276,7 +276,7 @@ private:
                             quote_token(elements_.back().name));
                 elements_.back().props.push_back(std::move(prop));
             } else {
-                if (options_.strict) bad("unknown keyword " + quote_token(key) + " (--strict)");
+                if (options_.strict) bad("unknown keyword " + quote_token(key) + " (" + mention(Setting::kStrict) + ")");
                 if (stray_lines++ == 0) {
                     stray_line = line_;
                     stray_offset = line_start;
@@ -833,7 +833,7 @@ private:
         if (options_.strict)
             throw Error(src_.name(), offset, line,
                         "element '" + e.name + "' item " + std::to_string(item_) + ": face with " +
-                            std::to_string(corners) + " vertices (--strict)");
+                            std::to_string(corners) + " vertices (" + mention(Setting::kStrict) + ")");
         warn("faces with fewer than 3 vertices skipped", line, offset);
     }
 

@@ -112,7 +112,7 @@ const Format& detect_input_format(ByteSource& source) {
     for (const Format* f : kFormats)
         if (f->open_reader && f->guess && f->guess(head)) return *f;
     if (head.empty()) throw Error(source.name(), "file is empty");
-    throw Error(source.name(), "unrecognised format (no known magic bytes or extension; use --from, one of: " +
+    throw Error(source.name(), "unrecognised format (no known magic bytes or extension; use " + mention(Setting::kFrom) + ", one of: " +
                                    format_names(false) + ")");
 }
 
@@ -124,7 +124,7 @@ Channels writable_channels(const Format& format, const Channels& in, const Write
 
 const Format& detect_output_format(const std::string& path) {
     if (const Format* f = format_for_extension(path, true)) return *f;
-    throw Error(path, "cannot tell the output format from the name (use --to, one of: " + format_names(true) + ")");
+    throw Error(path, "cannot tell the output format from the name (use " + mention(Setting::kTo) + ", one of: " + format_names(true) + ")");
 }
 
 bool wants_gzip(std::string_view path) { return lower(path).ends_with(".gz"); }
@@ -151,7 +151,7 @@ Input open_input(const std::string& path, std::string_view from, const ReadOptio
     } catch (const Error& e) {
         if (!guessed) throw;
         throw Error(e.file(), e.byte_offset(), e.line(),
-                    e.message() + "; its content reads as " + std::string(guessed->name) + " (--from " +
+                    e.raw_message() + "; its content reads as " + std::string(guessed->name) + " (" + mention(Setting::kFrom) + " " +
                         std::string(guessed->name) + ")");
     }
     return in;
@@ -164,7 +164,7 @@ const Format& output_format(const std::string& path, std::string_view to) {
             throw Error(path, "unknown output format '" + std::string(to) + "' (one of: " + format_names(true) + ")");
         return *f;
     }
-    if (path == "-") throw Error("<stdout>", "writing to stdout needs --to (one of: " + format_names(true) + ")");
+    if (path == "-") throw Error("<stdout>", "writing to stdout needs " + mention(Setting::kTo) + " (one of: " + format_names(true) + ")");
     return detect_output_format(path);
 }
 

@@ -396,7 +396,7 @@ private:
         }
         if (strict_)
             throw Error(source_.name(), Error::kNoOffset, facet_line_,
-                        "facet with " + std::to_string(n) + " vertices (--strict)");
+                        "facet with " + std::to_string(n) + " vertices (" + mention(Setting::kStrict) + ")");
         if (n < 3) {
             warn("facets with fewer than 3 vertices skipped", facet_line_);
             return;

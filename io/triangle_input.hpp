@@ -11,6 +11,7 @@
 // indices out of range) themselves. Memory: none beyond the caller's chunk.
 #pragma once
 
+#include "io/error.hpp"
 #include "io/format.hpp"
 #include "io/input_count.hpp"
 
@@ -27,12 +28,13 @@ enum class BadTriangles : uint8_t {
 
 class TriangleInput {
 public:
-    // Takes over an opened input. `refuse_note` ends the kRefuse error (e.g. " (--strict)").
-    TriangleInput(Input input, BadTriangles policy, std::string refuse_note = " (--strict)");
+    // Takes over an opened input. `refuse_note` ends the kRefuse error (by default: strict
+    // reading, as a mention: io/error.hpp).
+    TriangleInput(Input input, BadTriangles policy, std::string refuse_note = " (" + mention(Setting::kStrict) + ")");
     // The same for a bare reader (no source or format: source() and format() must not be
     // called); `name` names the input in errors.
     TriangleInput(std::unique_ptr<Reader> reader, std::string name, BadTriangles policy,
-                  std::string refuse_note = " (--strict)");
+                  std::string refuse_note = " (" + mention(Setting::kStrict) + ")");
 
     // Fills `chunk` (cleared first) with the next triangles that pass the policy, at least one,
     // and returns true; returns false at the end of the input, once the header's promised

@@ -195,7 +195,7 @@ public:
                         "header of " + std::to_string(body_bytes) +
                             " bytes (its material table) is over the memory "
                             "budget of " +
-                            std::to_string(options.memory_budget_bytes) + " bytes; raise --memory");
+                            std::to_string(options.memory_budget_bytes) + " bytes; raise " + mention(Setting::kMemory));
         std::vector<std::byte> body(static_cast<size_t>(body_bytes));
         if (source_.read(body.data(), body.size()) != body.size())
             throw Error(source_.name(), source_.offset(), 0,

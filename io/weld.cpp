@@ -330,7 +330,7 @@ std::unique_ptr<Welder::Core> make_core(uint64_t budget, const std::string& tmpd
     if (n <= Welder::kMaxAttributeBytes) return std::make_unique<WeldCore<V<256>>>(budget, tmpdir, name, layout);
     throw Error(name, std::to_string(n) + " bytes of vertex attributes per corner, more than the " +
                           std::to_string(Welder::kMaxAttributeBytes) +
-                          " an indexed writer keeps (drop some with --drop extra)");
+                          " an indexed writer keeps (drop some with " + mention(Setting::kDrop) + " extra)");
 }
 
 }  // namespace

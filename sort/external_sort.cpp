@@ -224,7 +224,8 @@ void ExternalSorter::write_temp(io::TempFile& file, const void* data, size_t n) 
         file.flush();
     } catch (const io::Error& e) {
         throw io::Error(e.file(), e.byte_offset(), 0,
-                        e.message() + " (temporary file of meshstream sort; --tmpdir picks another directory)");
+                        e.raw_message() + " (temporary file of meshstream sort; " + io::mention(io::Setting::kTmpdir) +
+                            " picks another directory)");
     }
     stats_.temp_bytes_written += n;
     live_temp_bytes_ += n;

@@ -52,16 +52,16 @@ int run_command_line(CLI::App& app, const std::string& program, int argc, char**
         say(program + ": " + command + ": " + e.what());
         return 2;
     } catch (const io::OptionError& e) {  // a setting the libraries cannot work with: a bad command line
-        say(program + ": " + command + ": " + e.what());
+        say(program + ": " + command + ": " + e.describe(flag_name));
         return 2;
-    } catch (const io::Error& e) {
-        say(program + ": error: " + e.what());
+    } catch (const meshstream::Error& e) {  // io::Error and the rest of the libraries' failures
+        say(program + ": error: " + e.describe(flag_name));
         return 1;
     } catch (const std::bad_alloc&) {
         say(program + ": error: out of memory");
         return 1;
     } catch (const std::exception& e) {
-        say(program + ": error: " + e.what());
+        say(program + ": error: " + describe_error(e));
         return 1;
     }
     // Reports and summaries printed to stdout (info, compare, --help) are output too: a full

@@ -465,8 +465,24 @@ void Progress::done() {
     drawn_ = false;
 }
 
+std::string flag_name(io::Setting setting) {
+    static constexpr const char* kFlags[io::kSettingCount] = {
+        "IN",        "OUT",       "--from",     "--to",       "--memory",    "--tmpdir",   "--strict",
+        "--drop",    "--clean",   "--compress", "--draco-qp", "--draco-qn",  "--draco-qt", "--draco-qc",
+        "--draco-cl", "--gzip-level", "--ratio", "--target",  "--buffer",    "--weld",     "--weights",
+        "--sorted-axis", "--seed", "--threads",  "--sort",     "--axis",      "--part",     "--merge",
+    };
+    const int i = int(setting);
+    return i >= 0 && i < io::kSettingCount ? kFlags[i] : std::string(io::setting_words(setting));
+}
+
+std::string describe_error(const std::exception& e) {
+    if (const auto* error = dynamic_cast<const meshstream::Error*>(&e)) return error->describe(flag_name);
+    return e.what();
+}
+
 void print_warnings(const Warnings& warnings) {
-    for (const std::string& line : warnings.lines())
+    for (const std::string& line : warnings.lines(flag_name))
         std::fprintf(stderr, "%s: warning: %s\n", global().program.c_str(), line.c_str());
 }
 

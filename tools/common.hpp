@@ -25,6 +25,12 @@
 
 namespace meshstream::tools {
 
+// The flag (or argument) that sets a library setting, as the libraries' messages name it:
+// "--memory", "IN"; the command renders their errors and warnings with these.
+std::string flag_name(io::Setting setting);
+// A library error as the command says it: its settings named by their flags.
+std::string describe_error(const std::exception& e);
+
 // Counted warnings (engine::Warnings, with a stable code for --json: docs/cli.md lists them),
 // printed once at the end of a command on stderr ("PROGRAM: warning: ...").
 using engine::Warnings;

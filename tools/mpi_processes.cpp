@@ -87,10 +87,13 @@ void wait_idle(MPI_Request& request) {
     }
 }
 
-// The message's text of an exception.
+// The message's text of an exception; a library error's with its settings' mentions, which rank
+// 0 renders as it renders its own.
 std::string message_of(const std::exception_ptr& error) {
     try {
         std::rethrow_exception(error);
+    } catch (const meshstream::Error& e) {
+        return e.raw_what();
     } catch (const std::exception& e) {
         return e.what();
     } catch (...) {
@@ -229,7 +232,7 @@ void MpiProcesses::receive(std::span<RangeSink* const> sinks, std::atomic<bool>&
                 std::exception_ptr error;
                 if (header.failed)
                     error = std::make_exception_ptr(
-                        std::runtime_error(std::string(bytes.begin() + sizeof header, bytes.end())));
+                        meshstream::Error(std::string(bytes.begin() + sizeof header, bytes.end())));
                 // A range that failed, or stopped at a forced write, stops the others (as one
                 // thread's does on one machine).
                 if (header.failed || header.outcome.forced) stop = true;

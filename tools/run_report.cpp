@@ -24,7 +24,7 @@ nlohmann::ordered_json run_report_json(const RunReport& r, const Warnings& warni
     j["peak_rss_bytes"] = r.peak_rss_bytes;
     if (!r.details.empty()) j[r.command] = r.details;
     nlohmann::ordered_json list = nlohmann::ordered_json::array();
-    for (const Warnings::Line& w : warnings.all()) {
+    for (const Warnings::Line& w : warnings.all(flag_name)) {
         nlohmann::ordered_json e = {{"code", w.code}, {"text", w.text}};
         if (w.count > 0) e["count"] = w.count;
         list.push_back(e);
