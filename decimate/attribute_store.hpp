@@ -21,6 +21,7 @@
 // round seams).
 #pragma once
 
+#include "decimate/attribute_quadric.hpp"
 #include "decimate/attributes.hpp"
 #include "decimate/halfedge_buffer.hpp"
 
@@ -28,9 +29,6 @@
 #include <cstdint>
 
 namespace meshstream::decimate {
-
-// The most components a corner's vector may have.
-inline constexpr int kMaxAttributeComponents = 32;
 
 class AttributeStore {
 public:

@@ -3,9 +3,14 @@
 // the sorted-sweep finalization of hole boundaries and forced writes for stuck buffers.
 #include "decimate/stream_decimator.hpp"
 
+#include "decimate/attribute_store.hpp"
+#include "decimate/collapse_queue.hpp"
 #include "decimate/greedy.hpp"
+#include "decimate/halfedge_buffer.hpp"
 #include "decimate/phase_timers.hpp"
+#include "decimate/random.hpp"
 #include "decimate/schedule.hpp"
+#include "decimate/writing.hpp"
 
 #include <algorithm>
 #include <cassert>
@@ -49,15 +54,82 @@ double choose_ratio(const Options& options, std::optional<uint64_t> input_count)
 
 }  // namespace
 
+struct StreamDecimator::Impl {
+    Impl(const Options& options, io::InputCount own, const io::InputCount* input, const AttributeLayout& attributes);
+
+    void push(const io::TriangleChunk& in, double weight, const Emit& out);
+    void finish(const Emit& out);
+    void finish_at(uint64_t target, const Emit& out);
+    void finish_range(const Emit& interior, const Emit& first_seam, const Emit& last_seam);
+
+    void read_triangle(const io::TriangleChunk& in, size_t i, const uint64_t hashes[3], const Emit& out);
+    void make_room(const Emit& out);
+    void write_one(const Emit& out, bool allow_forced);
+    void sweep();
+    void track_sweep(const float tri[9]);
+    void follow_dropped();
+    double budget() const;
+    void decimate_final(size_t keep);  // down to `keep` faces in core (kRange: follows budget())
+    void collect_stats();
+
+    Options options_;
+    io::InputCount own_count_;     // the count given to the first constructor
+    const io::InputCount* input_;  // own_count_ or the caller's read loop's
+    double ratio_;
+    HalfEdgeBuffer buffer_;
+    std::unique_ptr<AttributeStore> attributes_;  // null for positions only
+    std::vector<double> face_scalars_;            // the triangle being read's (with attributes_)
+    CollapseQueue queue_;
+    Rng rng_;
+    TriangleOutput output_;
+    uint64_t next_id_ = 0;
+    double weight_ = 1;       // input triangles each triangle being read stands for (kSeams)
+    double represented_ = 0;  // input triangles the triangles read stand for (kRange, kSeams)
+    Stats stats_;
+    bool finished_ = false;
+
+    // Sorted input (--sorted-axis): FIFO of vertices entering P_in with their coordinate.
+    struct SweepEntry {
+        float coordinate;
+        uint32_t vertex, generation;
+    };
+    std::unique_ptr<SweepEntry[]> sweep_queue_;
+    size_t sweep_capacity_ = 0, sweep_head_ = 0, sweep_size_ = 0;
+    // Ascending input: the front is the largest triangle minimum read (lo_max_); descending:
+    // the smallest triangle maximum (hi_min_). The direction is decided once the front has
+    // left the first triangle by more than two margins.
+    double lo_max_ = -INFINITY, hi_min_ = INFINITY, sweep_margin_ = 0;
+    double first_lo_ = 0, first_hi_ = 0;
+    bool sweep_started_ = false, sweep_enabled_ = true;
+    std::optional<double> swept_to_;  // threshold of the last sweep that finalized vertices
+};
+
+// The public face: each call hands a whole chunk or the end of input to the implementation.
 StreamDecimator::StreamDecimator(const Options& options, std::optional<uint64_t> input_triangle_count,
                                  const AttributeLayout& attributes)
-    : StreamDecimator(options, io::InputCount{input_triangle_count}, nullptr, attributes) {}
+    : impl_(std::make_unique<Impl>(options, io::InputCount{input_triangle_count}, nullptr, attributes)) {}
 
 StreamDecimator::StreamDecimator(const Options& options, const io::InputCount& input, const AttributeLayout& attributes)
-    : StreamDecimator(options, io::InputCount{input.promised}, &input, attributes) {}
+    : impl_(std::make_unique<Impl>(options, io::InputCount{input.promised}, &input, attributes)) {}
 
-StreamDecimator::StreamDecimator(const Options& options, io::InputCount own, const io::InputCount* input,
-                                 const AttributeLayout& attributes)
+StreamDecimator::StreamDecimator(StreamDecimator&&) noexcept = default;
+StreamDecimator& StreamDecimator::operator=(StreamDecimator&&) noexcept = default;
+StreamDecimator::~StreamDecimator() = default;
+
+void StreamDecimator::push(const io::TriangleChunk& in, const Emit& out) { impl_->push(in, 1.0, out); }
+void StreamDecimator::push(const io::TriangleChunk& in, double weight, const Emit& out) {
+    impl_->push(in, weight, out);
+}
+void StreamDecimator::finish(const Emit& out) { impl_->finish(out); }
+void StreamDecimator::finish_at(uint64_t target, const Emit& out) { impl_->finish_at(target, out); }
+void StreamDecimator::finish_range(const Emit& interior, const Emit& first_seam, const Emit& last_seam) {
+    impl_->finish_range(interior, first_seam, last_seam);
+}
+const Stats& StreamDecimator::stats() const { return impl_->stats_; }
+double StreamDecimator::ratio() const { return impl_->ratio_; }
+
+StreamDecimator::Impl::Impl(const Options& options, io::InputCount own, const io::InputCount* input,
+                            const AttributeLayout& attributes)
     : options_(checked(options, own.promised)),
       own_count_(own),
       input_(input != nullptr ? input : &own_count_),
@@ -86,9 +158,7 @@ size_t StreamDecimator::reserved_bytes(size_t buffer_triangles, const AttributeL
            (attributes.any() ? AttributeStore::reserved_bytes(attributes, buffer_triangles) : 0);
 }
 
-void StreamDecimator::push(const io::TriangleChunk& in, const Emit& out) { push(in, 1.0, out); }
-
-void StreamDecimator::push(const io::TriangleChunk& in, double weight, const Emit& out) {
+void StreamDecimator::Impl::push(const io::TriangleChunk& in, double weight, const Emit& out) {
     if (finished_) throw std::logic_error("StreamDecimator::push after finish()");
     assert(weight == 1.0 || options_.part == Part::kSeams);
     weight_ = weight;
@@ -130,7 +200,8 @@ void StreamDecimator::push(const io::TriangleChunk& in, double weight, const Emi
     }
 }
 
-void StreamDecimator::read_triangle(const io::TriangleChunk& in, size_t i, const uint64_t hashes[3], const Emit& out) {
+void StreamDecimator::Impl::read_triangle(const io::TriangleChunk& in, size_t i, const uint64_t hashes[3],
+                                          const Emit& out) {
     const float* tri = &in.xyz()[9 * i];
     if (buffer_.full() || buffer_.free_vertex_count() < 3) make_room(out);
     // The triangle's channels, as the attribute store keeps them.
@@ -195,7 +266,7 @@ void StreamDecimator::read_triangle(const io::TriangleChunk& in, size_t i, const
     }
 }
 
-void StreamDecimator::track_sweep(const float tri[9]) {
+void StreamDecimator::Impl::track_sweep(const float tri[9]) {
     const int axis = *options_.sorted_axis;
     const double lo = std::min({tri[axis], tri[3 + axis], tri[6 + axis]});
     const double hi = std::max({tri[axis], tri[3 + axis], tri[6 + axis]});
@@ -226,7 +297,7 @@ void StreamDecimator::track_sweep(const float tri[9]) {
     }
 }
 
-void StreamDecimator::sweep() {
+void StreamDecimator::Impl::sweep() {
     // A future triangle has a sort key ≥ the front (every key lies within its triangle, and
     // the front is the largest triangle minimum read so far), so it can only reach vertices
     // within one triangle extent behind the front. Twice the largest extent seen leaves room
@@ -268,7 +339,7 @@ void StreamDecimator::sweep() {
     }
 }
 
-void StreamDecimator::write_one(const Emit& out, bool allow_forced) {
+void StreamDecimator::Impl::write_one(const Emit& out, bool allow_forced) {
     const PhaseTimer timer(Phase::kWrite);
     uint32_t f = pick_write(buffer_);
     if (f == kNoIndex) {
@@ -303,7 +374,7 @@ void StreamDecimator::write_one(const Emit& out, bool allow_forced) {
     stats_.vertices_moved += write_face(buffer_, f, next_id_, output_, out);
 }
 
-void StreamDecimator::follow_dropped() {
+void StreamDecimator::Impl::follow_dropped() {
     if (!options_.target || input_->dropped == 0 || *input_->promised == 0) return;
     // The most the input can still hold: never below the triangles already read, so the
     // writes this ratio allows never pass the target.
@@ -311,12 +382,12 @@ void StreamDecimator::follow_dropped() {
     ratio_ = usable > 0 ? std::min(1.0, double(*options_.target) / double(usable)) : 1.0;
 }
 
-double StreamDecimator::budget() const {
+double StreamDecimator::Impl::budget() const {
     if (options_.part == Part::kWhole) return resolution_budget(ratio_, stats_.triangles_in, output_.triangle_count());
     return part_budget(ratio_, represented_, output_.triangle_count(), buffer_.pinned_face_count());
 }
 
-void StreamDecimator::make_room(const Emit& out) {
+void StreamDecimator::Impl::make_room(const Emit& out) {
     follow_dropped();
     if (options_.sorted_axis) sweep();
     const RoomPlan plan = plan_full_buffer(buffer_.face_capacity(), budget());
@@ -341,12 +412,12 @@ void StreamDecimator::make_room(const Emit& out) {
     assert(!buffer_.full() && buffer_.free_vertex_count() >= 3);
 }
 
-void StreamDecimator::finish(const Emit& out) {
+void StreamDecimator::Impl::finish(const Emit& out) {
     if (finished_) throw std::logic_error("StreamDecimator::finish called twice");
     finish_at(options_.target ? *options_.target : final_triangle_count(ratio_, stats_.triangles_in), out);
 }
 
-void StreamDecimator::finish_at(uint64_t target, const Emit& out) {
+void StreamDecimator::Impl::finish_at(uint64_t target, const Emit& out) {
     if (finished_) throw std::logic_error("StreamDecimator::finish called twice");
     if (options_.part == Part::kRange) throw std::logic_error("StreamDecimator: a range ends with finish_range()");
     finished_ = true;
@@ -362,7 +433,7 @@ void StreamDecimator::finish_at(uint64_t target, const Emit& out) {
     collect_stats();
 }
 
-void StreamDecimator::finish_range(const Emit& interior, const Emit& first_seam, const Emit& last_seam) {
+void StreamDecimator::Impl::finish_range(const Emit& interior, const Emit& first_seam, const Emit& last_seam) {
     if (finished_) throw std::logic_error("StreamDecimator::finish_range called twice");
     if (options_.part != Part::kRange) throw std::logic_error("StreamDecimator::finish_range needs Part::kRange");
     finished_ = true;
@@ -385,7 +456,7 @@ void StreamDecimator::finish_range(const Emit& interior, const Emit& first_seam,
     collect_stats();
 }
 
-void StreamDecimator::decimate_final(size_t keep) {
+void StreamDecimator::Impl::decimate_final(size_t keep) {
     // A range's budget falls as collapses remove faces on P_in (they stood for themselves): it is
     // followed as it falls.
     const bool range = options_.part == Part::kRange;
@@ -412,7 +483,7 @@ void StreamDecimator::decimate_final(size_t keep) {
     }
 }
 
-void StreamDecimator::collect_stats() {
+void StreamDecimator::Impl::collect_stats() {
     stats_.triangles_out = output_.triangle_count();
     stats_.peak_vertices = buffer_.peak_vertices();
     stats_.vertices_merged = buffer_.vertices_merged();

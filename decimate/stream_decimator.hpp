@@ -10,21 +10,18 @@
 // and counted instead of failing.
 #pragma once
 
-#include "decimate/attribute_store.hpp"
-#include "decimate/collapse_queue.hpp"
-#include "decimate/halfedge_buffer.hpp"
-#include "decimate/random.hpp"
-#include "decimate/writing.hpp"
+#include "decimate/attributes.hpp"
+#include "decimate/emit.hpp"
+#include "decimate/stats.hpp"
 #include "io/chunk.hpp"
 #include "io/input_count.hpp"
 
+#include <algorithm>
 #include <array>
-#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <optional>
-#include <vector>
 
 namespace meshstream::decimate {
 
@@ -44,16 +41,25 @@ enum class Part : uint8_t {
     kSeams,
 };
 
-// TEMPORARY until the decimate constants land.
+// The in-core buffer a decimator has unless told otherwise (Options::buffer_triangles): about
+// 230 MB of address space reserved for positions only (reserved_bytes()).
 inline constexpr size_t kDefaultBufferTriangles = 400000;
 
+// The seam pass's buffer (Part::kSeams) for ranges decimated through `range_buffer` triangles
+// each: a quarter of it, but the whole of it up to kSeamBufferTriangles (about 13 MB resident).
+inline constexpr size_t kSeamBufferTriangles = 65536;
+constexpr size_t seam_pass_buffer(size_t range_buffer) {
+    return std::max(range_buffer / 4, std::min(range_buffer, kSeamBufferTriangles));
+}
+
 struct Options {
-    double ratio = 0.1;                // p in (0, 1]: output = round(p · input)
-    std::optional<uint64_t> target;    // exact output triangle count instead of ratio
-    size_t buffer_triangles = 400000;  // N_max, in-core capacity (≥ 16)
-    uint64_t seed = 1;                 // draws the candidates of forced writes
-    double weld_eps = 0;               // 0: exact welding; > 0: grid cell size (absolute)
-    std::optional<int> sorted_axis;    // 0,1,2 when the input is sorted on it (either direction)
+    double ratio = 0.1;              // p in (0, 1]: output = round(p · input)
+    std::optional<uint64_t> target;  // exact output triangle count instead of ratio
+    // N_max, in-core capacity (≥ 16)
+    size_t buffer_triangles = kDefaultBufferTriangles;
+    uint64_t seed = 1;               // draws the candidates of forced writes
+    double weld_eps = 0;             // 0: exact welding; > 0: grid cell size (absolute)
+    std::optional<int> sorted_axis;  // 0,1,2 when the input is sorted on it (either direction)
     // The order is known exactly: ascending by each triangle's minimum coordinate along
     // sorted_axis, as `meshstream sort` writes it (the file's own flag says so). The sweep then
     // needs no margin, and one triangle whose minimum descends shows the order is not that.
@@ -64,31 +70,6 @@ struct Options {
     // this range. A vertex inside it may be shared with an earlier range: the sweep leaves it
     // open (it finalizes only vertices no other range can reach).
     std::optional<std::array<double, 2>> earlier_span;
-};
-
-struct Stats {
-    uint64_t triangles_in = 0;
-    uint64_t triangles_out = 0;
-    uint64_t target_triangles = 0;  // round(p·N_in) or --target (known at finish)
-    size_t buffer_capacity = 0;
-    size_t peak_buffer_triangles = 0;
-    size_t peak_vertices = 0;
-    uint64_t collapses = 0;
-    uint64_t forced_writes = 0;      // written while touching P_in (buffer stuck)
-    uint64_t premature_writes = 0;   // written before R reached p (decimation stalled)
-    uint64_t degenerate_passed = 0;  // repeated corners in the input: passed through
-    uint64_t weld_dropped = 0;       // distinct corners that --weld merged: dropped
-    uint64_t nonmanifold_edges = 0;  // half-edges frozen as non-manifold
-    uint64_t boundary_edges = 0;     // edges without a partner: holes, borders, cracks
-    uint64_t vertices_merged = 0;    // vertices that absorbed other positions (--weld)
-    uint64_t vertices_finalized_by_sweep = 0;
-    int sweep_direction = 0;       // sorted input: +1 ascending, −1 descending, 0 not yet seen
-    uint64_t sort_violations = 0;  // triangles reaching behind the sweep (sweep then stops)
-    uint64_t orphans_evicted = 0;
-    uint64_t vertices_moved = 0;           // moved to their quadric optimum when written
-    uint64_t seam_vertices = 0;            // vertices whose corners disagree (kept in place)
-    uint64_t attribute_values_zeroed = 0;  // non-finite channel values read as 0
-    bool no_valid_collapse_left = false;   // the end's scan of every half-edge found none valid
 };
 
 class StreamDecimator {
@@ -133,58 +114,25 @@ public:
     // `interior` stands for 1/ratio input triangles, one written to a seam for one.
     void finish_range(const Emit& interior, const Emit& first_seam, const Emit& last_seam);
 
-    const Stats& stats() const { return stats_; }
+    // Movable (a decimator moved from may only be destroyed or assigned to), not copyable.
+    StreamDecimator(StreamDecimator&&) noexcept;
+    StreamDecimator& operator=(StreamDecimator&&) noexcept;
+    ~StreamDecimator();
+
+    const Stats& stats() const;
     // round(ratio · input_triangle_count): the output size finish() lands on.
     static uint64_t expected_output(double ratio, uint64_t input_triangle_count);
     // The address space a decimator with a buffer of `buffer_triangles` reserves (the buffer,
     // hash tables and collapse queue); see docs/decimation.md for what becomes resident.
     static size_t reserved_bytes(size_t buffer_triangles, const AttributeLayout& attributes = {});
     // The ratio in use (target / input count with Options::target, less what was dropped).
-    double ratio() const { return ratio_; }
+    double ratio() const;
 
 private:
-    StreamDecimator(const Options& options, io::InputCount own, const io::InputCount* input,
-                    const AttributeLayout& attributes);
-    void read_triangle(const io::TriangleChunk& in, size_t i, const uint64_t hashes[3], const Emit& out);
-    void make_room(const Emit& out);
-    void write_one(const Emit& out, bool allow_forced);
-    void sweep();
-    void track_sweep(const float tri[9]);
-    void follow_dropped();
-    double budget() const;
-    void decimate_final(size_t keep);  // down to `keep` faces in core (kRange: follows budget())
-    void collect_stats();
-
-    Options options_;
-    io::InputCount own_count_;     // the count given to the first constructor
-    const io::InputCount* input_;  // own_count_ or the caller's read loop's
-    double ratio_;
-    HalfEdgeBuffer buffer_;
-    std::unique_ptr<AttributeStore> attributes_;  // null for positions only
-    std::vector<double> face_scalars_;            // the triangle being read's (with attributes_)
-    CollapseQueue queue_;
-    Rng rng_;
-    TriangleOutput output_;
-    uint64_t next_id_ = 0;
-    double weight_ = 1;       // input triangles each triangle being read stands for (kSeams)
-    double represented_ = 0;  // input triangles the triangles read stand for (kRange, kSeams)
-    Stats stats_;
-    bool finished_ = false;
-
-    // Sorted input (--sorted-axis): FIFO of vertices entering P_in with their coordinate.
-    struct SweepEntry {
-        float coordinate;
-        uint32_t vertex, generation;
-    };
-    std::unique_ptr<SweepEntry[]> sweep_queue_;
-    size_t sweep_capacity_ = 0, sweep_head_ = 0, sweep_size_ = 0;
-    // Ascending input: the front is the largest triangle minimum read (lo_max_); descending:
-    // the smallest triangle maximum (hi_min_). The direction is decided once the front has
-    // left the first triangle by more than two margins.
-    double lo_max_ = -INFINITY, hi_min_ = INFINITY, sweep_margin_ = 0;
-    double first_lo_ = 0, first_hi_ = 0;
-    bool sweep_started_ = false, sweep_enabled_ = true;
-    std::optional<double> swept_to_;  // threshold of the last sweep that finalized vertices
+    // The buffer, queue, output and sweep state (stream_decimator.cpp): every triangle of a
+    // chunk is read, decimated and written inside it.
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
 };
 
 }  // namespace meshstream::decimate

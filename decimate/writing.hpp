@@ -4,17 +4,13 @@
 #pragma once
 
 #include "decimate/attributes.hpp"
+#include "decimate/emit.hpp"
 #include "decimate/halfedge_buffer.hpp"
 #include "io/chunk.hpp"
 
 #include <cstdint>
-#include <functional>
 
 namespace meshstream::decimate {
-
-// Receives each full chunk of output triangles (positions + vertex_id channel, plus the carried
-// channels with an attribute store); the chunk is reused after the call returns.
-using Emit = std::function<void(const io::TriangleChunk&)>;
 
 // Collects written triangles into a fixed chunk and hands it to an Emit when full.
 class TriangleOutput {

@@ -883,7 +883,7 @@ DecimateResult decimate_file(const DecimateSettings& s, ProgressSink& progress) 
     if (part) facts.parts = ranges;
     if (processes) facts.processes = threaded ? ranges : 1;
     if (threaded) {
-        facts.seam_buffer = seam_buffer(s.buffer);
+        facts.seam_buffer = decimate::seam_pass_buffer(s.buffer);
         facts.seam_forced_writes = threaded->seams.forced_writes;
     }
     facts.target_given = options.target.has_value();

@@ -249,7 +249,6 @@ unsigned range_count(unsigned threads, uint64_t triangles, size_t buffer) {
     return unsigned(std::max<uint64_t>(1, std::min<uint64_t>(threads, triangles / buffer)));
 }
 
-size_t seam_buffer(size_t buffer) { return std::max(buffer / 4, std::min(buffer, kSeamBufferFloor)); }
 
 RangesResult decimate_in_ranges(const RangesJob& job, const decimate::Emit& emit, ProgressSink& progress) {
     if (job.remote_ranges >= job.ranges || (job.remote_ranges > 0 && !job.receive_remote))
@@ -264,7 +263,7 @@ RangesResult decimate_in_ranges(const RangesJob& job, const decimate::Emit& emit
     // again on the same weld grid.
     decimate::Options seam_options = job.options;
     seam_options.part = decimate::Part::kSeams;
-    seam_options.buffer_triangles = seam_buffer(job.options.buffer_triangles);
+    seam_options.buffer_triangles = decimate::seam_pass_buffer(job.options.buffer_triangles);
     seam_options.sorted_axis.reset();
     seam_options.sorted_by_minimum = false;
     seam_options.earlier_span.reset();
@@ -340,35 +339,11 @@ RangesResult decimate_in_ranges(const RangesJob& job, const decimate::Emit& emit
     seams->finish_at(
         job.target ? *job.target : decimate::StreamDecimator::expected_output(job.options.ratio, triangles_in), emit);
 
-    const decimate::Stats& s = seams->stats();
-    decimate::Stats& t = result.stats;
-    t = s;
-    t.triangles_in = 0;
-    t.buffer_capacity = job.options.buffer_triangles;
-    t.peak_buffer_triangles = t.peak_vertices = 0;
-    t.forced_writes = t.premature_writes = t.degenerate_passed = t.nonmanifold_edges = 0;
-    t.vertices_merged = t.vertices_finalized_by_sweep = t.sort_violations = 0;
-    t.sweep_direction = outcomes.front().stats.sweep_direction;
-    for (const RangeOutcome& o : outcomes) {
-        const decimate::Stats& x = o.stats;
-        t.triangles_in += x.triangles_in;
-        t.peak_buffer_triangles = std::max(t.peak_buffer_triangles, x.peak_buffer_triangles);
-        t.peak_vertices = std::max(t.peak_vertices, x.peak_vertices);
-        t.collapses += x.collapses;
-        t.forced_writes += x.forced_writes;
-        t.premature_writes += x.premature_writes;
-        t.degenerate_passed += x.degenerate_passed;
-        t.weld_dropped += x.weld_dropped;
-        t.nonmanifold_edges += x.nonmanifold_edges;
-        t.vertices_merged += x.vertices_merged;
-        t.vertices_finalized_by_sweep += x.vertices_finalized_by_sweep;
-        t.sort_violations += x.sort_violations;
-        t.orphans_evicted += x.orphans_evicted;
-        t.vertices_moved += x.vertices_moved;
-        t.seam_vertices += x.seam_vertices;  // met by a range (and again by the seam pass at a cut)
-        t.attribute_values_zeroed += x.attribute_values_zeroed;
-    }
-    result.seams = s;
+    // The ranges' and the seam pass's, summed as the summary shows them (decimate/stats.hpp).
+    std::vector<decimate::Stats> range_stats;
+    for (const RangeOutcome& o : outcomes) range_stats.push_back(o.stats);
+    result.stats = decimate::combine_ranges(seams->stats(), range_stats, job.options.buffer_triangles);
+    result.seams = seams->stats();
     const Range& last = *ranges.back();
     result.count = last.count;
     result.dropped = last.dropped;

@@ -13,10 +13,10 @@
 // per MPI rank: RangeProcesses) that sends its pieces here as it makes them.
 //
 // Each range re-opens the input and reads its way to its range (no format has to seek): the
-// reading before a range is the serial part besides the seam pass. Memory: N decimators of
-// --buffer triangles, N readers, the seam pass's decimator of a quarter of --buffer; the ranges'
-// outputs wait on disk (36 bytes a triangle, plus the channels carried: io::TriangleRecords), not
-// in memory.
+// reading before a range is the serial part besides the seam pass. Memory: N decimators of the
+// buffer's triangles, N readers, the seam pass's decimator of a quarter of the buffer
+// (decimate::seam_pass_buffer); the ranges' outputs wait on disk (36 bytes a triangle, plus the
+// channels carried: io::TriangleRecords), not in memory.
 #pragma once
 
 #include "decimate/stream_decimator.hpp"
@@ -47,10 +47,6 @@ inline constexpr size_t kMinRangeBuffer = 16384;
 // input of fewer than 2·buffer triangles, or a buffer below kMinRangeBuffer, is decimated whole.
 unsigned range_count(unsigned threads, uint64_t triangles, size_t buffer);
 
-// The seam pass's buffer for ranges decimated through `buffer` triangles each: a quarter of it,
-// but the whole of it up to kSeamBufferFloor triangles (about 13 MB resident).
-inline constexpr size_t kSeamBufferFloor = 65536;
-size_t seam_buffer(size_t buffer);
 
 // The pieces of a range's output: the decimated rest, the faces on P_in read first (along the
 // seam with the range before), the faces on P_in read last (along the seam with the range after).

@@ -1,5 +1,7 @@
-// decimate/attributes.hpp: the corner vector of a stream's channels and the attribute quadric.
+// decimate/attributes.hpp and attribute_quadric.hpp: the corner vector of a stream's channels and
+// the attribute quadric.
 #include "decimate/attributes.hpp"
+#include "decimate/attribute_quadric.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,8 +1,9 @@
 // Test helpers for the decimator: a tiny binary STL loader (tests must not depend on the io
 // codecs), a driver that pushes a soup through StreamDecimator in chunks of a given size,
-// and topology checks on indexed output.
+// and topology checks on indexed output and on the half-edge buffer.
 #pragma once
 
+#include "decimate/halfedge_buffer.hpp"
 #include "decimate/stream_decimator.hpp"
 
 #include <array>

@@ -1,6 +1,8 @@
 // Tests of decimate/schedule: the closed-form §4.1 schedule reproduces the paper's loop counts.
 #include "decimate/schedule.hpp"
 
+#include "decimate/stream_decimator.hpp"
+
 #include <gtest/gtest.h>
 
 using namespace meshstream::decimate;
@@ -16,7 +18,7 @@ TEST(Schedule, MainLoopMatchesPaperCounts) {
     // Steady state: the buffer held N_max/2 at resolution p, N_max/2 more were read.
     // The paper: DECIMATE((1-p) N_max/4) collapses, i.e. down to N_max/2 + p N_max/2, then
     // WRITE(p N_max/2).
-    const size_t n_max = 400000;
+    const size_t n_max = kDefaultBufferTriangles;
     const double p = 0.1;
     const uint64_t n_out = 123456;
     const uint64_t n_in_before = static_cast<uint64_t>((n_out + n_max / 2) / p);  // R = p

@@ -4,6 +4,7 @@
 #include "decimate/stream_decimator.hpp"
 
 #include "compare/metro.hpp"
+#include "decimate/random.hpp"
 #include "mesh_util.hpp"
 
 #include <gtest/gtest.h>
