@@ -94,7 +94,7 @@ ConvertResult convert_file(const ConvertSettings& s, ProgressSink& progress) {
 
     ConvertResult result;
     Warnings& warnings = result.warnings;
-    for (const std::string& note : out.writer->notes()) warnings.note("output_note", note);
+    for (const std::string& note : out.writer->raw_notes()) warnings.note("output_note", note);
     if (!dropped.empty()) warnings.note("channels_dropped", dropped_channels_text(dropped, *out.format, wo.channels));
     note_dropped_triangles(dropped_triangles(in), removed(), warnings);
     note_input_changes(in.header(), in.name(), warnings);
@@ -262,7 +262,7 @@ SortResult sort_file(const SortSettings& s, ProgressSink& progress) {
     out.finish();
 
     Warnings& warnings = result.warnings;
-    for (const std::string& note : out.writer->notes()) warnings.note("output_note", note);
+    for (const std::string& note : out.writer->raw_notes()) warnings.note("output_note", note);
     if (!dropped.empty()) warnings.note("channels_dropped", dropped_channels_text(dropped, *out.format, so.channels));
     // STL, PLY and OBJ have a place for the axis (a header or a comment); glTF has none.
     if (!out.format->sorted_axis_unrecorded.empty())

@@ -909,7 +909,7 @@ DecimateResult decimate_file(const DecimateSettings& s, ProgressSink& progress) 
         warnings.note("channels_rounded", "vertex scalars " + carried.rounded +
                                               " carried through decimation as float: values rounded to about 7 "
                                               "significant digits");
-    for (const std::string& note : out->writer->notes()) warnings.note("output_note", note);
+    for (const std::string& note : out->writer->raw_notes()) warnings.note("output_note", note);
     note_dropped_triangles(sorted     ? sorted->dropped
                            : threaded ? threaded->dropped
                                       : dropped_triangles(in),

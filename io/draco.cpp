@@ -170,7 +170,7 @@ public:
         for (std::string& note : draco_notes(encoded, mesh.triangle_count(), settings_))
             notes_.push_back(std::move(note));
     }
-    std::vector<std::string> notes() const override {
+    std::vector<std::string> format_notes() const override {
         std::vector<std::string> out;
         for (const std::string& note : notes_) out.push_back(sink_.name() + ": " + note);
         return out;

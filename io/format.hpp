@@ -5,6 +5,7 @@
 
 #include "io/byte_stream.hpp"
 #include "io/chunk.hpp"
+#include "io/error.hpp"
 
 #include <any>
 #include <array>
@@ -147,10 +148,19 @@ public:
         materials_updated(materials);
     }
     // After finish(): what the user should know about the output written (lossy encodings
-    // that lost something), one sentence each. The commands print them as warnings.
-    virtual std::vector<std::string> notes() const { return {}; }
+    // that lost something), one sentence each, its settings in io::setting_words.
+    std::vector<std::string> notes() const {
+        std::vector<std::string> out = raw_notes();
+        for (std::string& note : out) note = render(note);
+        return out;
+    }
+    // The same with the settings' mentions kept (io::mention), for a caller that names them in
+    // its own words (the commands print them as warnings, with their flags).
+    std::vector<std::string> raw_notes() const { return format_notes(); }
 
 protected:
+    // The format's notes (raw_notes()).
+    virtual std::vector<std::string> format_notes() const { return {}; }
     // What each format does: the calls above, checked.
     virtual void write_chunk(const TriangleChunk& chunk) = 0;
     virtual void finish_output() = 0;

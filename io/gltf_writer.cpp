@@ -515,7 +515,7 @@ public:
 
     void finish_output() override;
     void materials_updated(const std::vector<Material>& materials) override { options_.materials = materials; }
-    std::vector<std::string> notes() const override {
+    std::vector<std::string> format_notes() const override {
         std::vector<std::string> out;
         for (const std::string& note : notes_) out.push_back(sink_.name() + ": " + note);
         return out;

@@ -127,7 +127,8 @@ public:
     uint64_t non_finite_attribute_count() const { return non_finite_attributes_; }
     size_t vertex_count() const { return mesh_.vertex_count(); }
     size_t triangle_count() const { return mesh_.triangle_count(); }
-    // What a writer says of the two counts above, a sentence each (none when both are 0).
+    // What a writer says of the two counts above, a sentence each (none when both are 0), with
+    // the settings' mentions kept (Writer::raw_notes).
     std::vector<std::string> notes() const;
     // Bytes held by the tables now (positions, records, ids, hash slots, indices), for budget checks.
     uint64_t memory_bytes() const;

@@ -894,7 +894,7 @@ public:
 
     void finish_output() override;
 
-    std::vector<std::string> notes() const override { return notes_; }
+    std::vector<std::string> format_notes() const override { return notes_; }
 
 private:
     struct Run {

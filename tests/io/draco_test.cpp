@@ -189,7 +189,8 @@ TEST(DracoWriter, RefusesPastMemoryBudgetAndLeavesNoFile) {
         FAIL() << "no memory error";
     } catch (const io::Error& e) {
         EXPECT_EQ(e.file(), dir / "b.drc");
-        EXPECT_NE(std::string(e.what()).find("over the memory budget of 1 MiB; give --memory "), std::string::npos)
+        EXPECT_NE(std::string(e.what()).find("over the memory budget of 1 MiB; give the memory budget "),
+                  std::string::npos)
             << e.what();
     }
     EXPECT_TRUE(fs::is_empty(dir.path()));
@@ -206,7 +207,7 @@ TEST(DracoWriter, RefusesEmptyMeshAndLeavesOutNonFiniteTriangles) {
     ASSERT_EQ(notes.size(), 1u);
     EXPECT_EQ(notes[0], dir / "nan.drc" +
                             ": 1 of the 2 triangles have a NaN or infinite coordinate, which Draco cannot "
-                            "store: left out (--strict makes this an error)");
+                            "store: left out (strict reading makes this an error)");
     EXPECT_EQ(read_soup(dir / "nan.drc").triangles(), 1u);
     io::WriteOptions strict;
     strict.strict = true;
@@ -215,7 +216,7 @@ TEST(DracoWriter, RefusesEmptyMeshAndLeavesOutNonFiniteTriangles) {
         FAIL();
     } catch (const io::Error& e) {
         EXPECT_NE(std::string(e.what()).find("triangle 0 has a NaN or infinite coordinate, which Draco cannot store "
-                                             "(--strict)"),
+                                             "(strict reading)"),
                   std::string::npos)
             << e.what();
     }
@@ -288,19 +289,24 @@ TEST(DracoWriter, RejectsOutOfRangeSettings) {
     TempDir dir;
     struct Case {
         io::DracoSettings settings;
+        io::Setting setting;
         const char* message;
     };
     const Case cases[] = {
-        {{.position_bits = 0}, "--draco-qp must be 1-30, got 0"},
-        {{.position_bits = 31}, "--draco-qp must be 1-30, got 31"},
-        {{.normal_bits = 1}, "--draco-qn must be 2-30, got 1"},
-        {{.normal_bits = 31}, "--draco-qn must be 2-30, got 31"},
-        {{.texcoord_bits = 0}, "--draco-qt must be 1-30, got 0"},
-        {{.texcoord_bits = 31}, "--draco-qt must be 1-30, got 31"},
-        {{.color_bits = 0}, "--draco-qc must be 1-30, got 0"},
-        {{.color_bits = 31}, "--draco-qc must be 1-30, got 31"},
-        {{.level = -1}, "--draco-cl must be 0-10, got -1"},
-        {{.level = 11}, "--draco-cl must be 0-10, got 11"},
+        {{.position_bits = 0}, io::Setting::kDracoPositionBits, "the Draco position bits must be 1-30, got 0"},
+        {{.position_bits = 31}, io::Setting::kDracoPositionBits, "the Draco position bits must be 1-30, got 31"},
+        {{.normal_bits = 1}, io::Setting::kDracoNormalBits, "the Draco normal bits must be 2-30, got 1"},
+        {{.normal_bits = 31}, io::Setting::kDracoNormalBits, "the Draco normal bits must be 2-30, got 31"},
+        {{.texcoord_bits = 0},
+         io::Setting::kDracoTexcoordBits,
+         "the Draco texture coordinate bits must be 1-30, got 0"},
+        {{.texcoord_bits = 31},
+         io::Setting::kDracoTexcoordBits,
+         "the Draco texture coordinate bits must be 1-30, got 31"},
+        {{.color_bits = 0}, io::Setting::kDracoColorBits, "the Draco colour bits must be 1-30, got 0"},
+        {{.color_bits = 31}, io::Setting::kDracoColorBits, "the Draco colour bits must be 1-30, got 31"},
+        {{.level = -1}, io::Setting::kDracoLevel, "the Draco compression level must be 0-10, got -1"},
+        {{.level = 11}, io::Setting::kDracoLevel, "the Draco compression level must be 0-10, got 11"},
     };
     for (const char* name : {"x.drc", "x.glb"})
         for (const Case& c : cases) {
@@ -310,8 +316,11 @@ TEST(DracoWriter, RejectsOutOfRangeSettings) {
             try {
                 io::open_output(dir / name, {}, o);
                 ADD_FAILURE() << "accepted";
-            } catch (const io::Error& e) {
+            } catch (const io::OptionError& e) {
+                // A bad setting, in a library user's words; the command names its flag instead.
+                EXPECT_EQ(e.setting(), c.setting);
                 EXPECT_EQ(std::string(e.what()), dir / name + ": " + c.message);
+                EXPECT_EQ(std::string(e.what()).find("--"), std::string::npos);
             }
             EXPECT_TRUE(fs::is_empty(dir.path()));
         }
