@@ -34,6 +34,9 @@ constexpr uint32_t kNoMaterial = ~uint32_t{0};
 constexpr const char* kDefaultMaterial = "default";
 // The header note key of what the reader skipped or filled in (one sentence each).
 constexpr const char* kObjWarningNote = "warning";
+// The counted warning (MeshHeader::warnings) of a usemtl without a name.
+constexpr const char* kNamelessUsemtlWarning =
+    "usemtl statements without a material name read as material 'default', that of faces before any usemtl";
 
 bool file_exists(const std::string& path) {
     struct stat st;
@@ -468,11 +471,17 @@ private:
         return index;
     }
 
+    // A usemtl without a name (some exporters write one for "the default material") selects
+    // the material of faces before any usemtl, counted; an error under --strict.
     void use_material(std::string_view name) {
-        if (name.empty()) fail("'usemtl' without a material name");
+        if (name.empty() && options_.strict) fail("'usemtl' without a material name (--strict)");
         if (decided_ && !material_) {
             ++materials_dropped_;
             return;
+        }
+        if (name.empty()) {
+            warn(kNamelessUsemtlWarning, line_no_, line_offset_);
+            name = kDefaultMaterial;
         }
         saw_material_statement_ = true;
         current_material_ = material_index(name);
