@@ -1,6 +1,7 @@
 #include "io/line_reader.hpp"
 
 #include "io/error.hpp"
+#include "io/text_tokens.hpp"
 
 #include <cstring>
 
@@ -9,12 +10,6 @@ namespace meshstream::io {
 const char* const kCarriageReturnInLine =
     "carriage return inside a line: lines ending in CR alone (classic Mac OS) are not supported "
     "(tr '\\r' '\\n' converts them)";
-
-namespace {
-
-bool is_trailing_blank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
-
-}  // namespace
 
 bool LineReader::next(std::string_view& line) {
     joined_.clear();
@@ -49,7 +44,7 @@ bool LineReader::next(std::string_view& line) {
         const uint64_t at = source_.offset();
         source_.consume(nl ? len + 1 : len);
         ++physical_lines_;
-        while (!view.empty() && is_trailing_blank(view.back())) view.remove_suffix(1);
+        while (!view.empty() && is_blank(view.back())) view.remove_suffix(1);
         unterminated_ = !nl && !view.empty();
         if (std::memchr(view.data(), '\r', view.size()))
             throw Error(source_.name(), at, physical_lines_, kCarriageReturnInLine);

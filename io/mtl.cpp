@@ -1,11 +1,13 @@
 // MTL reading and writing (see mtl.hpp): the file is read whole and parsed line by line, as
-// the OBJ reader does its statements, numbers with std::from_chars.
+// the OBJ reader does its statements, words and numbers in the text grammar of
+// io/text_tokens.hpp.
 #include "io/mtl.hpp"
 
 #include "io/byte_stream.hpp"
 #include "io/error.hpp"
 #include "io/line_reader.hpp"
 #include "io/text_number.hpp"
+#include "io/text_tokens.hpp"
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -13,39 +15,12 @@
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
-#include <charconv>
 #include <cstring>
 
 namespace meshstream::io {
 namespace {
 
 constexpr uint64_t kMaxMtlBytes = uint64_t{16} << 20;
-
-bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
-
-std::string_view trim(std::string_view s) {
-    while (!s.empty() && is_space(s.front())) s.remove_prefix(1);
-    while (!s.empty() && is_space(s.back())) s.remove_suffix(1);
-    return s;
-}
-
-std::string_view next_word(std::string_view& rest) {
-    size_t i = 0;
-    while (i < rest.size() && is_space(rest[i])) ++i;
-    size_t j = i;
-    while (j < rest.size() && !is_space(rest[j])) ++j;
-    std::string_view w = rest.substr(i, j - i);
-    rest.remove_prefix(j);
-    return w;
-}
-
-bool parse_float(std::string_view tok, float* out) {
-    const char* b = tok.data();
-    const char* e = b + tok.size();
-    if (b != e && *b == '+') ++b;
-    auto [p, ec] = std::from_chars(b, e, *out);
-    return ec == std::errc() && p == e && b != e;
-}
 
 void add_once(std::vector<std::string>& list, std::string item) {
     if (std::find(list.begin(), list.end(), item) == list.end()) list.push_back(std::move(item));
@@ -118,7 +93,7 @@ public:
                 if (u < 0x20 && c != '\t' && c != '\v' && c != '\f')
                     fail("is not text (a byte " + std::to_string(u) + " in it): not an MTL file");
             }
-            statement(trim(line));
+            statement(trim_blanks(line));
         }
         finish_material();
         return std::move(materials_);
@@ -130,7 +105,7 @@ private:
     float number(std::string_view tok, const char* what) const {
         float v = 0;
         if (tok.empty()) fail(std::string("expected ") + what + ", found the end of the line");
-        if (!parse_float(tok, &v)) fail(std::string("expected ") + what + ", found " + quote_token(tok));
+        if (!parse_number(tok, v)) fail(std::string("expected ") + what + ", found " + quote_token(tok));
         return v;
     }
 
@@ -144,7 +119,7 @@ private:
             fail("not an MTL statement: " + quote_token(key));
         if (key == "newmtl") {
             finish_material();
-            std::string_view name = trim(rest);
+            std::string_view name = trim_blanks(rest);
             if (name.empty()) fail("'newmtl' without a material name");
             current_ = Material{};
             current_.name = std::string(name);
@@ -206,11 +181,11 @@ private:
                 std::string_view after = rest;
                 std::string_view arg = next_word(after);
                 float ignored;
-                if (arg.empty() || (n < 0 && !parse_float(arg, &ignored))) break;
+                if (arg.empty() || (n < 0 && !parse_number(arg, ignored))) break;
                 rest = after;
             }
         }
-        const std::string name(trim(rest));
+        const std::string name(trim_blanks(rest));
         if (name.empty()) fail("'map_Kd' without a file name");
         Texture t;
         const bool absolute = name[0] == '/';

@@ -1,8 +1,9 @@
 // OBJ reader and writer: line-based parsing from the ByteSource window (lines up to 1 MiB,
-// `\` continuations joined in a scratch string), numbers with std::from_chars, as fast_obj
-// does with its 64 KiB refill loop; positions, texture coordinates and normals in three
-// spillable tables sharing the budget; the writer spools through io::Welder and writes its
-// .mtl and texture images beside the output as the .gltf writer does its .bin.
+// `\` continuations joined in a scratch string), words and numbers in the text grammar of
+// io/text_tokens.hpp (std::from_chars), as fast_obj does with its 64 KiB refill loop;
+// positions, texture coordinates and normals in three spillable tables sharing the budget; the
+// writer spools through io::Welder and writes its .mtl and texture images beside the output as
+// the .gltf writer does its .bin.
 #include "io/obj.hpp"
 
 #include "io/error.hpp"
@@ -10,6 +11,7 @@
 #include "io/line_reader.hpp"
 #include "io/mtl.hpp"
 #include "io/text_number.hpp"
+#include "io/text_tokens.hpp"
 #include "io/triangulate.hpp"
 #include "io/vertex_table.hpp"
 #include "io/weld.hpp"
@@ -18,7 +20,6 @@
 #include <algorithm>
 #include <cassert>
 #include <charconv>
-#include <cstdlib>
 #include <cstring>
 #include <string>
 #include <unordered_map>
@@ -33,25 +34,9 @@ constexpr uint32_t kNoMaterial = ~uint32_t{0};
 constexpr const char* kDefaultMaterial = "default";
 // The header note key of what the reader skipped or filled in (one sentence each).
 constexpr const char* kObjWarningNote = "warning";
-
-bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
-
-// Splits off the next blank-separated word of `rest`.
-std::string_view next_word(std::string_view& rest) {
-    size_t i = 0;
-    while (i < rest.size() && is_space(rest[i])) ++i;
-    size_t j = i;
-    while (j < rest.size() && !is_space(rest[j])) ++j;
-    std::string_view w = rest.substr(i, j - i);
-    rest.remove_prefix(j);
-    return w;
-}
-
-std::string_view trim(std::string_view s) {
-    while (!s.empty() && is_space(s.front())) s.remove_prefix(1);
-    while (!s.empty() && is_space(s.back())) s.remove_suffix(1);
-    return s;
-}
+// The counted warning (MeshHeader::warnings) of a usemtl without a name.
+constexpr const char* kNamelessUsemtlWarning =
+    "usemtl statements without a material name read as material 'default', that of faces before any usemtl";
 
 bool file_exists(const std::string& path) {
     struct stat st;
@@ -275,9 +260,9 @@ private:
             } else if (key == "f" || key == "fo") {  // "fo": the face keyword of old OBJ files
                 if (read_face(rest)) return true;
             } else if (key == "usemtl") {
-                use_material(trim(rest));
+                use_material(trim_blanks(rest));
             } else if (key == "mtllib") {
-                load_material_libraries(trim(rest));
+                load_material_libraries(trim_blanks(rest));
             } else if (key == "l" || key == "p") {
                 ++lines_and_points_;
             } else if (is_free_form_statement(key)) {
@@ -303,15 +288,8 @@ private:
     }
 
     float parse_number(std::string_view tok, const char* what) const {
-        const char* b = tok.data();
-        const char* e = b + tok.size();
-        if (*b == '+') ++b;
         float v = 0;
-        auto [p, ec] = std::from_chars(b, e, v);
-        if (ec == std::errc::result_out_of_range)
-            v = std::strtof(std::string(tok).c_str(), nullptr);
-        else if (ec != std::errc() || p != e)
-            fail(std::string("expected ") + what + ", found " + quote_token(tok));
+        if (!io::parse_number(tok, v)) fail(std::string("expected ") + what + ", found " + quote_token(tok));
         return v;
     }
 
@@ -405,11 +383,8 @@ private:
             for (; q != e && static_cast<unsigned>(*q - '0') < 10; ++q) v = v * 10 + static_cast<unsigned>(*q - '0');
             if (q == e && v <= defined) return v - 1;
         }
-        if (b != e && *b == '+') ++b;
         int64_t index = 0;
-        auto [p, ec] = std::from_chars(b, e, index);
-        if (ec != std::errc() || p != e || b == e)
-            fail(std::string("expected a ") + what + " index, found " + quote_token(tok));
+        if (!parse_integer(num, index)) fail(std::string("expected a ") + what + " index, found " + quote_token(tok));
         if (index == 0) fail(std::string(what) + " index 0 is invalid (OBJ indices start at 1)");
         int64_t zero_based = index > 0 ? index - 1 : static_cast<int64_t>(defined) + index;
         if (zero_based < 0 || static_cast<uint64_t>(zero_based) >= defined)
@@ -496,11 +471,17 @@ private:
         return index;
     }
 
+    // A usemtl without a name (some exporters write one for "the default material") selects
+    // the material of faces before any usemtl, counted; an error under --strict.
     void use_material(std::string_view name) {
-        if (name.empty()) fail("'usemtl' without a material name");
+        if (name.empty() && options_.strict) fail("'usemtl' without a material name (--strict)");
         if (decided_ && !material_) {
             ++materials_dropped_;
             return;
+        }
+        if (name.empty()) {
+            warn(kNamelessUsemtlWarning, line_no_, line_offset_);
+            name = kDefaultMaterial;
         }
         saw_material_statement_ = true;
         current_material_ = material_index(name);
@@ -783,7 +764,7 @@ bool obj_uses_library(const std::string& obj_path, const std::string& mtl_name) 
         std::string_view line = rest.substr(0, nl);
         rest = nl == std::string_view::npos ? std::string_view() : rest.substr(nl + 1);
         std::string_view args = line;
-        if (next_word(args) == "mtllib" && trim(args) == mtl_name) return true;
+        if (next_word(args) == "mtllib" && trim_blanks(args) == mtl_name) return true;
     }
     return false;
 }
@@ -926,8 +907,13 @@ private:
 std::vector<std::string> ObjWriter::material_names() const {
     std::vector<std::string> names;
     for (size_t i = 0; i < materials_.size(); ++i) {
+        // Blanks at the ends dropped; a line break, as every other control byte, becomes '_'.
+        std::string_view trimmed = materials_[i].name;
+        const auto end_blank = [](char c) { return c != '\n' && is_blank(c); };
+        while (!trimmed.empty() && end_blank(trimmed.front())) trimmed.remove_prefix(1);
+        while (!trimmed.empty() && end_blank(trimmed.back())) trimmed.remove_suffix(1);
         std::string base;
-        for (char c : trim(materials_[i].name)) {
+        for (char c : trimmed) {
             const auto u = static_cast<unsigned char>(c);
             base += u < 0x20 || u == 0x7f ? '_' : c;
         }

@@ -20,8 +20,9 @@
 //    stdin), then names used but defined nowhere (white, kept by name; one warning; a missing
 //    MTL file is one warning too). Faces before the first usemtl (a file that names its
 //    library first) get a material "default" (white), added only then (also when no usemtl
-//    follows at all: that cannot be known at the first face). A usemtl name first
-//    met after the first face is appended to the table while reading (see
+//    follows at all: that cannot be known at the first face), and so do faces after a usemtl
+//    without a name (counted in MeshHeader::warnings; an error under ReadOptions::strict).
+//    A usemtl name first met after the first face is appended to the table while reading (see
 //    Writer::update_materials). With neither before the first face, later ones are dropped,
 //    counted. The MTL files and images read are listed in MeshHeader::side_files.
 // Vertex ids: with texture coordinates or normals in the chunk, one id per distinct

@@ -1,9 +1,9 @@
 // PLY reader and writer. The header is parsed line by line (CRLF and trailing blanks allowed);
 // the body is decoded from the ByteSource's window with explicit byte-order helpers (binary) or
-// whitespace-separated tokens parsed with std::from_chars (ascii), the way miniply walks its
-// refill buffer. Based on Greg Turk's PLY description and the quirks seen in PDAL's PlyReader
-// and happly: type aliases (float32, uint8, ...), `vertex_index` as well as `vertex_indices`,
-// elements in any order around vertex and face. Without a face element, a `tristrips` element
+// as blank-separated tokens in the text grammar of io/text_tokens.hpp (ascii), the way miniply
+// walks its refill buffer. Based on Greg Turk's PLY description and the quirks seen in PDAL's
+// PlyReader and happly: type aliases (float32, uint8, ...), `vertex_index` as well as
+// `vertex_indices`, elements in any order around vertex and face. Without a face element, a `tristrips` element
 // (old Stanford scans: one list of vertex indices per strip, -1 restarting) is read instead.
 // Property names follow what the common writers use: MeshLab/VCG (texture_u, quality), Blender
 // (s, t), PCL (normal_x), CGAL and Open3D (nx, red).
@@ -13,13 +13,13 @@
 #include "io/error.hpp"
 #include "io/line_reader.hpp"
 #include "io/text_number.hpp"
+#include "io/text_tokens.hpp"
 #include "io/vertex_table.hpp"
 #include "io/weld.hpp"
 
 #include <algorithm>
 #include <array>
 #include <bit>
-#include <charconv>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -80,8 +80,6 @@ struct Element {
         return n;
     }
 };
-
-bool is_blank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\v' || c == '\f'; }
 
 std::vector<std::string_view> split_words(std::string_view line) {
     std::vector<std::string_view> words;
@@ -247,8 +245,7 @@ private:
                 if (words.size() != 3) bad("expected 'element <name> <count>'");
                 Element e;
                 e.name = std::string(words[1]);
-                auto [p, ec] = std::from_chars(words[2].data(), words[2].data() + words[2].size(), e.count);
-                if (ec != std::errc() || p != words[2].data() + words[2].size()) bad("bad element count");
+                if (!io::parse_integer(words[2], e.count)) bad("bad element count");
                 elements_.push_back(std::move(e));
             } else if (key == "property") {
                 if (elements_.empty()) bad("property before any element");
@@ -520,41 +517,29 @@ private:
         return {p, j};
     }
 
+    // Ascii values by their declared type, in the text grammar (io/text_tokens.hpp): numbers
+    // for float and double, integers for the integer types (a token that is no number at all
+    // is "expected a number" either way).
     double parse_number(std::string_view tok) const {
-        const char* b = tok.data();
-        const char* e = b + tok.size();
-        if (b != e && *b == '+') ++b;
         double v = 0;
-        auto [p, ec] = std::from_chars(b, e, v);
-        if (ec == std::errc::result_out_of_range) {
-            // Subnormal or huge: keep strtod's value (from_chars leaves v unchanged here).
-            v = std::strtod(std::string(tok).c_str(), nullptr);
-        } else if (ec != std::errc() || p != e) {
-            item_fail(token_offset_, "expected a number, found " + quote_token(tok));
-        }
+        if (!io::parse_number(tok, v)) item_fail(token_offset_, "expected a number, found " + quote_token(tok));
         return v;
     }
 
     float parse_float(std::string_view tok) const {
-        const char* b = tok.data();
-        const char* e = b + tok.size();
-        if (b != e && *b == '+') ++b;
         float v = 0;
-        auto [p, ec] = std::from_chars(b, e, v);
-        if (ec == std::errc::result_out_of_range)
-            v = std::strtof(std::string(tok).c_str(), nullptr);
-        else if (ec != std::errc() || p != e)
-            item_fail(token_offset_, "expected a number, found " + quote_token(tok));
+        if (!io::parse_number(tok, v)) item_fail(token_offset_, "expected a number, found " + quote_token(tok));
         return v;
     }
 
-    int64_t parse_integer(std::string_view tok) const {
-        const char* b = tok.data();
-        const char* e = b + tok.size();
-        if (b != e && *b == '+') ++b;
+    int64_t parse_integer(std::string_view tok, ScalarType t) const {
         int64_t v = 0;
-        auto [p, ec] = std::from_chars(b, e, v);
-        if (ec == std::errc() && p == e) return v;
+        if (!is_float_type(t)) {
+            if (io::parse_integer(tok, v)) return v;
+            parse_number(tok);
+            item_fail(token_offset_, "expected an integer, found " + quote_token(tok));
+        }
+        // A list of float indices: each an integral value.
         double d = parse_number(tok);
         if (d != std::floor(d) || !(std::fabs(d) < 9e18))
             item_fail(token_offset_, "expected an integer, found " + quote_token(tok));
@@ -562,7 +547,8 @@ private:
     }
 
     double read_scalar(ScalarType t) {
-        if (encoding_ == Encoding::kAscii) return parse_number(token());
+        if (encoding_ == Encoding::kAscii)
+            return is_float_type(t) ? parse_number(token()) : static_cast<double>(parse_integer(token(), t));
         size_t n = scalar_type_bytes(t);
         double v = decode(need(n), t);
         src_.consume(n);
@@ -570,7 +556,7 @@ private:
     }
 
     int64_t read_integer(ScalarType t) {
-        if (encoding_ == Encoding::kAscii) return parse_integer(token());
+        if (encoding_ == Encoding::kAscii) return parse_integer(token(), t);
         size_t n = scalar_type_bytes(t);
         token_offset_ = src_.offset();
         int64_t v = decode_int(need(n), t);
@@ -591,7 +577,7 @@ private:
         }
         int64_t n = read_count(p);
         if (encoding_ == Encoding::kAscii) {
-            for (int64_t i = 0; i < n; ++i) parse_number(token());
+            for (int64_t i = 0; i < n; ++i) read_scalar(p.type);
         } else {
             uint64_t bytes = uint64_t(n) * scalar_type_bytes(p.type);
             if (src_.skip(bytes) != bytes) truncated();

@@ -10,6 +10,7 @@
 
 #include "io/endian.hpp"
 #include "io/error.hpp"
+#include "io/text_tokens.hpp"
 #include "io/triangulate.hpp"
 
 #include <algorithm>
@@ -17,7 +18,6 @@
 #include <cassert>
 #include <charconv>
 #include <cmath>
-#include <cstdlib>
 #include <cstring>
 #include <string>
 #include <string_view>
@@ -34,8 +34,6 @@ constexpr std::string_view kSortMarker = "meshstream sorted-axis=";
 constexpr std::string_view kWriterName = "meshstream";
 
 // ---- text classification ----
-
-bool is_space(char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\v' || c == '\f'; }
 
 // Bytes that never occur in an ASCII STL: NUL and the control characters other than
 // whitespace. Bytes >= 0x80 are allowed (UTF-8 or Latin-1 solid names).
@@ -65,9 +63,9 @@ bool has_utf8_bom(std::span<const std::byte> head) {
 bool starts_with_solid(std::span<const std::byte> head) {
     std::string_view text(reinterpret_cast<const char*>(head.data()), head.size());
     if (has_utf8_bom(head)) text.remove_prefix(3);
-    while (!text.empty() && is_space(text.front())) text.remove_prefix(1);
+    while (!text.empty() && is_blank(text.front())) text.remove_prefix(1);
     if (text.size() < 5 || !keyword_is(text.substr(0, 5), "solid")) return false;
-    return text.size() == 5 || is_space(text[5]);
+    return text.size() == 5 || is_blank(text[5]);
 }
 
 bool looks_like_ascii_stl(std::span<const std::byte> head) {
@@ -194,26 +192,6 @@ private:
 
 // ---------------- ASCII reader ----------------
 
-// Parses "+1.5e3", "-0", "nan", "inf"; the whole token must be a number.
-bool parse_float(std::string_view token, float& out) {
-    const char* first = token.data();
-    const char* last = first + token.size();
-    // from_chars accepts no leading '+'.
-    if (first != last && *first == '+') {
-        ++first;
-        if (first == last || *first == '+' || *first == '-') return false;
-    }
-    auto [ptr, ec] = std::from_chars(first, last, out);
-    if (ec == std::errc::result_out_of_range) {
-        // Past float's range: 1e-50 is 0 (or a denormal), 1e400 infinite, as in the OBJ and
-        // PLY readers (which then count the triangle as non-finite); 1e400 used to be "not a
-        // number" here alone.
-        out = std::strtof(std::string(first, last).c_str(), nullptr);
-        ec = std::errc();
-    }
-    return ec == std::errc() && ptr == last;
-}
-
 class AsciiReader : public Reader {
 public:
     AsciiReader(ByteSource& source, bool strict) : source_(source), strict_(strict) {
@@ -293,13 +271,13 @@ private:
             size_t pos = 0;
             bool stop = false;
             while (!stop) {
-                while (pos < text.size() && is_space(text[pos])) {
+                while (pos < text.size() && is_blank(text[pos])) {
                     if (text[pos] == '\n') ++line_;
                     ++pos;
                 }
                 if (pos == text.size()) break;
                 size_t end = pos;
-                while (end < text.size() && !is_space(text[end])) ++end;
+                while (end < text.size() && !is_blank(text[end])) ++end;
                 std::string_view token = text.substr(pos, end - pos);
                 pos = end;
                 switch (state_) {
@@ -353,7 +331,7 @@ private:
                         }
                         break;
                     case State::kCoordinate:
-                        if (!parse_float(token, corners_[corners_.size() - 3 + size_t(axis_)]))
+                        if (!parse_number(token, corners_[corners_.size() - 3 + size_t(axis_)]))
                             expected("a number", token);
                         if (++axis_ == 3) state_ = State::kVertex;
                         break;
@@ -377,10 +355,7 @@ private:
         size_t end = text.find('\n', pos);
         if (end == std::string_view::npos) end = text.size();
         if (rest) {
-            std::string_view name = text.substr(pos, end - pos);
-            while (!name.empty() && is_space(name.front())) name.remove_prefix(1);
-            while (!name.empty() && is_space(name.back())) name.remove_suffix(1);
-            rest->assign(name);
+            rest->assign(trim_blanks(text.substr(pos, end - pos)));
         }
         return end;
     }

@@ -579,6 +579,41 @@ TEST(ObjMaterials, DefaultMaterialLateNamesAndDroppedStatements) {
               "when mtllib or usemtl comes before it\n");
 }
 
+// A usemtl without a name (some exporters write it for the default material) selects the
+// material of faces before any usemtl, with a counted warning; --strict refuses it at its line.
+TEST(ObjMaterials, UsemtlWithoutANameIsTheDefaultMaterial) {
+    TempDir dir;
+    const std::string v = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+    test::spit(dir / "lib.mtl", "newmtl red\nKd 1 0 0\n");
+    test::spit(dir / "late.obj", "mtllib lib.mtl\n" + v + "f 1 2 3\nusemtl red\nf 1 2 3\nusemtl\nf 3 2 1\n");
+    const std::string text =
+        "usemtl statements without a material name read as material 'default', that of faces before any usemtl";
+    const Mesh late = read_mesh(dir / "late.obj");
+    EXPECT_EQ(late.material, (std::vector<std::string>{"default", "red", "default"}));
+    ASSERT_EQ(late.header.materials.size(), 2u);  // red, default: the same entry twice
+    EXPECT_EQ(late.header.warnings, (std::vector<io::ReaderWarning>{{text, 1, 8, 66}}));
+    EXPECT_EQ(warnings_of(late.header), "");
+    // Before the first face, blanks only: it is what announces materials.
+    test::spit(dir / "first.obj", "usemtl \t\n" + v + "f 1 2 3\nusemtl red\nf 1 2 3\nusemtl\nf 1 2 3\n");
+    const Mesh first = read_mesh(dir / "first.obj");
+    EXPECT_TRUE(first.header.channels.material);
+    EXPECT_EQ(first.material, (std::vector<std::string>{"default", "red", "default"}));
+    EXPECT_EQ(first.header.warnings, (std::vector<io::ReaderWarning>{{text, 2, 1, 0}}));
+    EXPECT_EQ(warnings_of(first.header),
+              "materials used but defined in no material library, kept by name only: 'red'\n");
+    io::ReadOptions strict;
+    strict.strict = true;
+    try {
+        read_mesh(dir / "late.obj", io::TriangleChunk::kDefaultCapacity, strict);
+        ADD_FAILURE() << "no error under --strict";
+    } catch (const io::Error& e) {
+        EXPECT_EQ(e.file(), dir / "late.obj");
+        EXPECT_EQ(e.message(), "'usemtl' without a material name (--strict)");
+        EXPECT_EQ(e.line(), 8u);
+        EXPECT_EQ(e.byte_offset(), 66u);
+    }
+}
+
 TEST(ObjChannels, TheFirstFaceAndVertexDecideAndTheRestIsCounted) {
     TempDir dir;
     struct Case {
@@ -648,7 +683,6 @@ TEST(ObjReader, BadAttributesAndMaterialStatementsNameFileLineAndOffset) {
         {head + "vn 0 0\n", "'vn' needs 3 numbers, found 2", 6, head.size()},
         {head + "vn 0 0 1 1\n", "'vn' with more than 3 numbers", 6, head.size()},
         {head + "vn 0 x 1\n", "expected a normal component, found 'x'", 6, head.size()},
-        {head + "usemtl\n", "'usemtl' without a material name", 6, head.size()},
         {head + "mtllib   \n", "'mtllib' without a file name", 6, head.size()},
     };
     for (const Case& c : cases) {

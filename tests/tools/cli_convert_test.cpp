@@ -1,7 +1,8 @@
 // `meshstream info` and `convert` through the built binary: the foundation issue's pipe
 // acceptance (binary STL -> ASCII on stdout -> stdin -> gzip, then info agrees with the
 // original), errors that name the file and position with exit 1 and no output left, exit 2 for
-// a bad command line, and --help on every command.
+// a bad command line, --help on every command, and a reader's counted warning (OBJ's nameless
+// usemtl) against its --strict error.
 #include "tools/cli_util.hpp"
 
 #include <gtest/gtest.h>
@@ -85,6 +86,27 @@ TEST(CliConvert, AsciiStlMissingEndloopNamesLine) {
     EXPECT_EQ(r.code, 1);
     EXPECT_NE(r.err.find(in + ":7: expected 'endloop', found 'endfacet'"), std::string::npos) << r.err;
     EXPECT_EQ(listing(dir.path()), (std::vector<std::string>{"bad.stl"}));
+}
+
+// An OBJ `usemtl` without a name reads as the default material with a warning; --strict
+// refuses it at its line, with exit 1 and no output.
+TEST(CliConvert, NamelessUsemtlIsTheDefaultMaterialOrAStrictError) {
+    TempDir dir;
+    const std::string in = dir / "in.obj";
+    write_file(in, "v 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl\nf 1 2 3\n");
+    auto r = run("convert " + in + " " + (dir / "out.stl"));
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.err.find("warning: " + in +
+                         ": usemtl statements without a material name read as material 'default', that of faces "
+                         "before any usemtl (at line 4, byte 24) (1)\n"),
+              std::string::npos)
+        << r.err;
+    auto strict = run("convert --strict " + in + " " + (dir / "strict.stl"));
+    EXPECT_EQ(strict.code, 1);
+    EXPECT_NE(strict.err.find("meshstream: error: " + in + ":4: byte 24: 'usemtl' without a material name (--strict)"),
+              std::string::npos)
+        << strict.err;
+    EXPECT_EQ(listing(dir.path()), (std::vector<std::string>{"in.obj", "out.stl"}));
 }
 
 TEST(CliConvert, BadCommandLineExits2) {
