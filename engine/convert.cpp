@@ -144,8 +144,8 @@ SortResult sort_file(const SortSettings& s, ProgressSink& progress) {
                                                   "regular file; give " +
                                                   mention(Setting::kAxis) + " x, y or z to sort a stream");
     if (s.axis && (*s.axis < 0 || *s.axis > 2))
-        throw io::OptionError(Setting::kAxis, "the sort axis must be 0, 1 or 2 (x, y or z), got " +
-                                                  std::to_string(*s.axis));
+        throw io::OptionError(Setting::kAxis,
+                              "the sort axis must be 0, 1 or 2 (x, y or z), got " + std::to_string(*s.axis));
     io::TriangleInput in = open_input(s, ro);
     const io::MeshHeader header = in.header();
     SortResult result;
@@ -166,7 +166,8 @@ SortResult sort_file(const SortSettings& s, ProgressSink& progress) {
     // The pipeline's chunks are part of the sorter's share: each at most 1/64 of the budget
     // (counted whether or not threads are used); a chunk holds a record and the positions.
     const size_t chunk_bytes = record_bytes + io::TriangleRecords::kPositionBytes;
-    const size_t chunk_capacity = std::clamp<size_t>(budget / 64 / chunk_bytes, 256, io::TriangleChunk::kDefaultCapacity);
+    const size_t chunk_capacity =
+        std::clamp<size_t>(budget / 64 / chunk_bytes, 256, io::TriangleChunk::kDefaultCapacity);
     const uint64_t pipe_bytes = io::kPipelineChunks * chunk_capacity * chunk_bytes;
     if (budget - budget / 4 <= pipe_bytes) {
         // The least budget b with b - b/4 > pipe_bytes (the pipe's size is fixed at such small
@@ -174,10 +175,10 @@ SortResult sort_file(const SortSettings& s, ProgressSink& progress) {
         uint64_t least = pipe_bytes * 4 / 3;
         while (least - least / 4 <= pipe_bytes) ++least;
         const uint64_t least_kib = (least + 1023) / 1024;
-        throw io::OptionError(Setting::kMemory,
-                              result.input_name + ": " + mention(Setting::kMemory) + " " +
-                                  (s.memory_text.empty() ? io::binary_size(budget) : s.memory_text) +
-                                  " is too small to sort: give at least " + std::to_string(least_kib) + "K");
+        throw io::OptionError(Setting::kMemory, result.input_name + ": " + mention(Setting::kMemory) + " " +
+                                                    (s.memory_text.empty() ? io::binary_size(budget) : s.memory_text) +
+                                                    " is too small to sort: give at least " +
+                                                    std::to_string(least_kib) + "K");
     }
     so.memory_budget_bytes = budget - budget / 4 - pipe_bytes;
 

@@ -25,8 +25,8 @@
 namespace meshstream::engine {
 
 struct ConvertSettings {
-    std::string input;   // a path, or "-" for stdin
-    std::string output;  // a path, or "-" for stdout
+    std::string input;          // a path, or "-" for stdin
+    std::string output;         // a path, or "-" for stdout
     std::string input_format;   // registry name; empty: detected
     std::string output_format;  // registry name; empty: from the output's extension
     // Drop triangles with a NaN or infinite coordinate and degenerate ones, and count them (else

@@ -274,13 +274,13 @@ std::unique_ptr<decimate::StreamDecimator> make_decimator(const decimate::Option
         // the run (meshstream::Error), naming the buffer that asked for it.
         throw meshstream::Error(
             mention(Setting::kBuffer) + " " + std::to_string(options.buffer_triangles) + " reserves " +
-                human_bytes(double(bytes)) + " of memory (about " +
-                std::to_string(bytes / std::max<size_t>(options.buffer_triangles, 1)) +
-                " bytes a triangle), which this system refused: give a smaller " + mention(Setting::kBuffer) +
-                " (the default " + std::to_string(decimate::kDefaultBufferTriangles) + " reserves " +
-                human_bytes(double(
-                    decimate::StreamDecimator::reserved_bytes(decimate::kDefaultBufferTriangles, attributes))) +
-                ")");
+            human_bytes(double(bytes)) + " of memory (about " +
+            std::to_string(bytes / std::max<size_t>(options.buffer_triangles, 1)) +
+            " bytes a triangle), which this system refused: give a smaller " + mention(Setting::kBuffer) +
+            " (the default " + std::to_string(decimate::kDefaultBufferTriangles) + " reserves " +
+            human_bytes(
+                double(decimate::StreamDecimator::reserved_bytes(decimate::kDefaultBufferTriangles, attributes))) +
+            ")");
     }
 }
 
@@ -439,23 +439,23 @@ void refuse_other_range_count(const DecimateSettings& s, PartIndex part, const s
                                                   mention(Setting::kBuffer) + " below " +
                                                   std::to_string(kMinRangeBuffer) + " is never cut into ranges (" +
                                                   mention(Setting::kBuffer) + " " + std::to_string(s.buffer) + ")");
-    throw io::OptionError(
-        Setting::kPart,
-        input_name + ": " + std::to_string(cut_triangles) + " triangles through " + mention(Setting::kBuffer) + " " +
-            std::to_string(s.buffer) + " make at most " + std::to_string(ranges) +
-            (ranges == 1 ? " range" : " ranges") + " (each holds at least " + mention(Setting::kBuffer) +
-            " triangles), not " + std::to_string(part.parts) + ": " +
-            (ranges >= 2 ? "use " + mention(Setting::kPart) + " k/" + std::to_string(ranges) + " or a smaller " +
-                               mention(Setting::kBuffer)
-                         : std::string("the input is too small to cut; decimate it in one job")));
+    throw io::OptionError(Setting::kPart,
+                          input_name + ": " + std::to_string(cut_triangles) + " triangles through " +
+                              mention(Setting::kBuffer) + " " + std::to_string(s.buffer) + " make at most " +
+                              std::to_string(ranges) + (ranges == 1 ? " range" : " ranges") + " (each holds at least " +
+                              mention(Setting::kBuffer) + " triangles), not " + std::to_string(part.parts) + ": " +
+                              (ranges >= 2 ? "use " + mention(Setting::kPart) + " k/" + std::to_string(ranges) +
+                                                 " or a smaller " + mention(Setting::kBuffer)
+                                           : std::string("the input is too small to cut; decimate it in one job")));
 }
 
 // The settings a part job or a merge cannot work with, refused before any work.
 void check_part_settings(const DecimateSettings& s) {
     const PartIndex part = *s.part;
     if (part.parts < 2 || part.parts > 1024 || part.k < 1 || part.k > part.parts)
-        throw io::OptionError(Setting::kPart, mention(Setting::kPart) + " must be k/K with 1 <= k <= K and 2 <= K <= "
-                                                                        "1024, found " +
+        throw io::OptionError(Setting::kPart, mention(Setting::kPart) +
+                                                  " must be k/K with 1 <= k <= K and 2 <= K <= "
+                                                  "1024, found " +
                                                   part_text(part));
     const std::string both = mention(Setting::kPart) + " " + part_text(part);
     if (s.threads > 1)
@@ -511,7 +511,8 @@ PartResult decimate_part(const DecimateSettings& s, ProgressSink& progress) {
         throw io::OptionError(Setting::kPart, "decimate_part makes a part job's part file: give a part k < K");
     check_part_settings(s);
     const PartIndex part = *s.part;
-    const io::Format& out_format = s.output_format.empty() ? io::kTriangleStreamFormat : output_format(s.output, s.output_format);
+    const io::Format& out_format =
+        s.output_format.empty() ? io::kTriangleStreamFormat : output_format(s.output, s.output_format);
     const io::WriteOptions& wo = s.write;
     const io::ReadOptions read = decimate_read_options(s, out_format, wo);
     io::TriangleInput in = open_decimate_input(s, read);
@@ -523,7 +524,7 @@ PartResult decimate_part(const DecimateSettings& s, ProgressSink& progress) {
     refuse_output_over_inputs(s.output, std::vector<std::string>{}, {input_files(s.input, header)});
     std::optional<CountPass> counted;
     std::optional<uint64_t> input_count = header.triangle_count;
-    in.close();                     // every pass below, and the range, open the input afresh
+    in.close();                      // every pass below, and the range, open the input afresh
     if (s.target && !input_count) {  // as the merge counts it (decimate_file)
         counted = count_usable_triangles(s, read, progress);
         input_count = counted->count.promised;
@@ -854,18 +855,16 @@ DecimateResult decimate_file(const DecimateSettings& s, ProgressSink& progress) 
                 done += chunk.size();
                 return true;
             };
-            decimate_pass(next, carried.channels, *decimator, emit, [&] { progress.update(done); }, {}, progress);
+            decimate_pass(
+                next, carried.channels, *decimator, emit, [&] { progress.update(done); }, {}, progress);
         } else {
             in = open_decimate_input(s, read);
             decimator = make_decimator(options, decimator_count(in.count()), carried.layout);
             progress.phase("decimating", input_count);
-            decimate_pass([&](io::TriangleChunk& chunk) { return in.next(chunk); }, carried.channels, *decimator,
-                          emit,
-                          [&] {
-                              progress.update(in.count().read, in.source().stored_offset(),
-                                              in.source().stored_size());
-                          },
-                          {}, progress);
+            decimate_pass(
+                [&](io::TriangleChunk& chunk) { return in.next(chunk); }, carried.channels, *decimator, emit,
+                [&] { progress.update(in.count().read, in.source().stored_offset(), in.source().stored_size()); }, {},
+                progress);
         }
     }
     progress.phase("finishing", std::nullopt);

@@ -249,7 +249,6 @@ unsigned range_count(unsigned threads, uint64_t triangles, size_t buffer) {
     return unsigned(std::max<uint64_t>(1, std::min<uint64_t>(threads, triangles / buffer)));
 }
 
-
 RangesResult decimate_in_ranges(const RangesJob& job, const decimate::Emit& emit, ProgressSink& progress) {
     if (job.remote_ranges >= job.ranges || (job.remote_ranges > 0 && !job.receive_remote))
         throw std::logic_error("decimate_in_ranges: the last range runs here, and remote ranges need receive_remote");

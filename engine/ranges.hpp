@@ -47,7 +47,6 @@ inline constexpr size_t kMinRangeBuffer = 16384;
 // input of fewer than 2·buffer triangles, or a buffer below kMinRangeBuffer, is decimated whole.
 unsigned range_count(unsigned threads, uint64_t triangles, size_t buffer);
 
-
 // The pieces of a range's output: the decimated rest, the faces on P_in read first (along the
 // seam with the range before), the faces on P_in read last (along the seam with the range after).
 // The seam pass reads them in this order: the rest as the range makes it, the seam faces, which
@@ -151,9 +150,9 @@ struct RangesResult {
 void run_range(const RangesJob& job, unsigned k, RangeSink& sink, std::atomic<bool>& stop);
 
 // Runs the job: ranges on their threads (or elsewhere: RangesJob::remote_ranges), the seam pass on this one writing to
-// `emit`, updating `progress` with the input triangles decimated so far. An exception on any thread (the first bad input
-// in the file's order, whichever range met it) is rethrown here once every thread has stopped; nothing is written after
-// it. Once `progress` says cancelled(), every range stops between chunks and Cancelled is thrown.
+// `emit`, updating `progress` with the input triangles decimated so far. An exception on any thread (the first bad
+// input in the file's order, whichever range met it) is rethrown here once every thread has stopped; nothing is written
+// after it. Once `progress` says cancelled(), every range stops between chunks and Cancelled is thrown.
 RangesResult decimate_in_ranges(const RangesJob& job, const decimate::Emit& emit, ProgressSink& progress);
 
 }  // namespace meshstream::engine

@@ -25,16 +25,16 @@ namespace meshstream::io {
 
 // The settings a message may name.
 enum class Setting : uint8_t {
-    kInput,           // the input file
-    kOutput,          // the output file
-    kFrom,            // the input's format
-    kTo,              // the output's format
-    kMemory,          // the memory budget
-    kTmpdir,          // the temporary directory
-    kStrict,          // strict reading and writing
-    kDrop,            // channel kinds not read
-    kClean,           // bad triangles dropped
-    kCompress,        // glTF compression
+    kInput,     // the input file
+    kOutput,    // the output file
+    kFrom,      // the input's format
+    kTo,        // the output's format
+    kMemory,    // the memory budget
+    kTmpdir,    // the temporary directory
+    kStrict,    // strict reading and writing
+    kDrop,      // channel kinds not read
+    kClean,     // bad triangles dropped
+    kCompress,  // glTF compression
     kDracoPositionBits,
     kDracoNormalBits,
     kDracoTexcoordBits,
@@ -43,16 +43,16 @@ enum class Setting : uint8_t {
     kGzipLevel,
     kRatio,
     kTarget,
-    kBuffer,       // the decimator's buffer
+    kBuffer,  // the decimator's buffer
     kWeld,
-    kWeights,      // attribute weights
-    kSortedAxis,   // the axis the input is sorted along
+    kWeights,     // attribute weights
+    kSortedAxis,  // the axis the input is sorted along
     kSeed,
     kThreads,
-    kSort,         // the sort policy
-    kAxis,         // the sort's axis
-    kPart,         // a part job's index
-    kMerge,        // the part files a merge reads
+    kSort,   // the sort policy
+    kAxis,   // the sort's axis
+    kPart,   // a part job's index
+    kMerge,  // the part files a merge reads
 };
 inline constexpr int kSettingCount = int(Setting::kMerge) + 1;
 

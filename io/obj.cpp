@@ -474,7 +474,7 @@ private:
     // A usemtl without a name (some exporters write one for "the default material") selects
     // the material of faces before any usemtl, counted; an error under --strict.
     void use_material(std::string_view name) {
-        if (name.empty() && options_.strict) fail("'usemtl' without a material name (--strict)");
+        if (name.empty() && options_.strict) fail("'usemtl' without a material name (" + mention(Setting::kStrict) + ")");
         if (decided_ && !material_) {
             ++materials_dropped_;
             return;

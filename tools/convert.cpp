@@ -29,8 +29,7 @@ void run_convert(const ConvertOptions& opt) {
     const auto start = std::chrono::steady_clock::now();
     if (opt.json) refuse_json_with_stdout_output(opt.output);
     const io::Format& out_format = resolve_output_format(opt.output, opt.write);
-    auto settings =
-        job_settings<engine::ConvertSettings>(opt.input, opt.output, out_format, opt.read, opt.write);
+    auto settings = job_settings<engine::ConvertSettings>(opt.input, opt.output, out_format, opt.read, opt.write);
     settings.clean = opt.clean;
     settings.threads = opt.threads;
     engine::ConvertResult result;

@@ -2,8 +2,8 @@
 // Kobbelt stream decimator between any reader and writer, on every core, sorting on demand:
 // engine/decimate.hpp). This file turns the flags into DecimateSettings, draws the progress, and
 // prints the summary, the warnings and --json; --report measures the output against the input.
-#include "compare/metro.hpp"
 #include "engine/decimate.hpp"
+#include "compare/metro.hpp"
 #include "io/error.hpp"
 #include "io/triangle_stream.hpp"
 #include "tools/cli_checks.hpp"
@@ -313,8 +313,9 @@ void add_decimate(CLI::App& app, RangeProcesses* processes) {
         ->check(whole_number(1, "a whole number of triangles"));
     cmd->add_option("--buffer", opt->buffer,
                     "in-core buffer in triangles, which fixes the memory (default " +
-                        std::to_string(decimate::kDefaultBufferTriangles) + ")\n"
-                    "About 580 bytes a triangle; a larger buffer holds input in a poorer order")
+                        std::to_string(decimate::kDefaultBufferTriangles) +
+                        ")\n"
+                        "About 580 bytes a triangle; a larger buffer holds input in a poorer order")
         ->type_name("N")
         ->check(CLI::Range(size_t{16}, size_t{1} << 29));
     cmd->add_option("--weld", opt->weld, "weld corners on a grid of EPS, or of P% of the bounding-box diagonal")

@@ -2,8 +2,8 @@
 // exact counts, ranges on two threads, part files merged to the bytes two threads write, the
 // progress a sink sees, cancellation that leaves nothing behind, and settings refused as
 // io::OptionError naming the setting.
-#include "engine/convert.hpp"
 #include "engine/decimate.hpp"
+#include "engine/convert.hpp"
 #include "io/error.hpp"
 #include "io/format.hpp"
 #include "test_util.hpp"
