@@ -207,7 +207,7 @@ public:
             if (bytes.size() > options.memory_budget_bytes)
                 throw Error(source.name(),
                             "Draco decodes whole files in memory and this one is over the memory budget of " +
-                                binary_size(options.memory_budget_bytes) + "; raise --memory");
+                                binary_size(options.memory_budget_bytes) + "; raise " + mention(Setting::kMemory));
         }
         mesh_ = decode_draco(bytes, source.name());
         header_.triangle_count = mesh_.indices.size() / 3;

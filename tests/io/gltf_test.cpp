@@ -526,7 +526,7 @@ TEST(GltfReader, BufferFilesCountAgainstTheMemoryBudget) {
         what = e.what();
     }
     EXPECT_NE(what.find("glTF documents are read whole into memory with their buffers: this one and its buffer files "
-                        "take 4.4 KiB, over the memory budget of 3.9 KiB; raise --memory"),
+                        "take 4.4 KiB, over the memory budget of 3.9 KiB; raise the memory budget"),
               std::string::npos)
         << what;
     options.memory_budget_bytes = 3695 + 840;
@@ -597,7 +597,7 @@ TEST(GltfReader, OffsetsAndCountsNearTwoToThe64AreRefusedNotWrapped) {
          "POSITION (accessor 0) reaches byte 2^64 or more of a buffer view ending at 36"},
         {R"({"buffer":0,"byteLength":36})", R"("count":6148914691236517206)",
          "POSITION (accessor 0) has no bufferView (all zeros) and count 6148914691236517206, over the memory budget of "
-         "256 MiB once decoded; raise --memory"},
+         "256 MiB once decoded; raise the memory budget"},
         {R"({"buffer":0,"byteLength":36})", R"("count":300000000)",  // 3.6 GB of floats from 300 bytes
          "has no bufferView (all zeros) and count 300000000, over the memory budget"},
     };
@@ -901,7 +901,7 @@ TEST(GltfWriter, RefusesPastMemoryBudget) {
             write_soup(bunny, dir / "b.glb", o);
             ADD_FAILURE() << "no memory error";
         } catch (const io::Error& e) {
-            EXPECT_NE(std::string(e.what()).find("; give --memory "), std::string::npos) << e.what();
+            EXPECT_NE(std::string(e.what()).find("; give the memory budget "), std::string::npos) << e.what();
         }
     }
     EXPECT_TRUE(fs::is_empty(dir.path()));
@@ -1036,7 +1036,7 @@ TEST(GltfWriter, KeepsDegenerateAndZeroAreaTrianglesExceptWithDraco) {
     ASSERT_EQ(notes.size(), 1u);
     EXPECT_EQ(notes[0], dir / "d.glb" +
                             ": 2 of the 5 triangles have two corners at one vertex (degenerate), which "
-                            "Draco's encoder drops: left out (write without Draco to keep them; --strict "
+                            "Draco's encoder drops: left out (write without Draco to keep them; strict mode "
                             "makes this an error)");
     EXPECT_EQ(read_soup(dir / "d.glb").triangles(), 3u);
     io::WriteOptions strict;
@@ -1047,7 +1047,7 @@ TEST(GltfWriter, KeepsDegenerateAndZeroAreaTrianglesExceptWithDraco) {
     } catch (const io::Error& e) {
         EXPECT_EQ(std::string(e.what()), dir / "s.glb" +
                                              ": triangle 1 has two corners at one vertex, which Draco's "
-                                             "encoder drops (--strict)");
+                                             "encoder drops (strict mode)");
     }
     strict.format_options.set(io::GltfSettings{Compression::kMeshopt});
     EXPECT_TRUE(write_soup(soup, dir / "s.glb", strict).empty()) << "glTF holds them: nothing to refuse";
@@ -1065,7 +1065,7 @@ TEST(GltfWriter, LeavesOutNonFiniteTrianglesOrRefusesThemUnderStrict) {
         ASSERT_EQ(notes.size(), 1u);
         EXPECT_EQ(notes[0], dir / "n.glb" +
                                 ": 2 of the 5 triangles have a NaN or infinite coordinate, which glTF "
-                                "cannot store: left out (--strict makes this an error)");
+                                "cannot store: left out (strict mode makes this an error)");
         expect_valid_allowing(dir / "n.glb", {"ACCESSOR_INDEX_TRIANGLE_DEGENERATE"});
         EXPECT_EQ(read_soup(dir / "n.glb").triangles(), 3u);
         o.strict = true;
@@ -1074,7 +1074,7 @@ TEST(GltfWriter, LeavesOutNonFiniteTrianglesOrRefusesThemUnderStrict) {
             ADD_FAILURE() << "accepted";
         } catch (const io::Error& e) {
             EXPECT_NE(std::string(e.what()).find("triangle 2 has a NaN or infinite coordinate, which glTF cannot store "
-                                                 "(--strict)"),
+                                                 "(strict mode)"),
                       std::string::npos)
                 << e.what();
         }

@@ -287,7 +287,7 @@ TEST(ObjFormat, TextIsGuessedObjWhenTheNameSaysNothingElse) {
         ADD_FAILURE() << "read as STL";
     } catch (const io::Error& e) {
         EXPECT_NE(std::string(e.what()).find("binary STL header (neither binary nor ASCII STL); its content reads as "
-                                             "obj (--from obj)"),
+                                             "obj (the input format obj)"),
                   std::string::npos)
             << e.what();
     }
