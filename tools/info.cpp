@@ -194,7 +194,7 @@ void run_info(const InfoOptions& opt) {
         if (!header.warnings.empty()) {
             auto& list = j["warnings"] = nlohmann::ordered_json::array();
             for (const io::ReaderWarning& w : header.warnings) {
-                nlohmann::ordered_json e = {{"text", w.text}, {"count", w.count}};
+                nlohmann::ordered_json e = {{"text", io::render(w.text, flag_name)}, {"count", w.count}};
                 if (w.first_line != 0) e["line"] = w.first_line;
                 if (w.first_byte_offset != io::Error::kNoOffset) e["byte"] = w.first_byte_offset;
                 list.push_back(e);
@@ -277,8 +277,8 @@ void run_info(const InfoOptions& opt) {
     }
     for (const auto& [k, v] : header.notes) std::printf("%-12s %s\n", (k + ":").c_str(), v.c_str());
     for (const io::ReaderWarning& w : header.warnings) {
-        std::printf("warning:     %s%s (%llu)\n", w.text.c_str(), io::warning_position(w).c_str(),
-                    (unsigned long long)w.count);
+        std::printf("warning:     %s%s (%llu)\n", io::render(w.text, flag_name).c_str(),
+                    io::warning_position(w).c_str(), (unsigned long long)w.count);
     }
     if (topology) {
         TopologyReport t = topology->finish();
