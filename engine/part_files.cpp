@@ -133,30 +133,34 @@ const char* axis_text(const std::optional<int>& axis) {
 }
 
 // How `part` (the file's plan) differs from `job` (this job's), as "was made with ..., this job
-// has ..."; empty when they are the same.
+// has ..."; empty when they are the same. The settings are mentions (io::mention).
 std::string plan_difference(const PartPlan& part, const PartPlan& job) {
+    using io::mention;
+    using io::Setting;
     const decimate::Options &a = part.options, &b = job.options;
     auto differs = [](const std::string& what, const std::string& x, const std::string& y) {
         return "was made with " + what + " " + x + ", this job has " + y;
     };
     auto target_text = [](const std::optional<uint64_t>& t) { return t ? std::to_string(*t) : std::string("none"); };
-    if (part.target != job.target) return differs("--target", target_text(part.target), target_text(job.target));
+    if (part.target != job.target)
+        return differs(mention(Setting::kTarget), target_text(part.target), target_text(job.target));
     if (a.ratio != b.ratio)
         return "was made with the ranges decimating at ratio " + number_text(a.ratio) + ", this job's is " +
-               number_text(b.ratio) + " (--ratio or --target differ)";
+               number_text(b.ratio) + " (" + mention(Setting::kRatio) + " or " + mention(Setting::kTarget) + " differ)";
     if (a.buffer_triangles != b.buffer_triangles)
-        return differs("--buffer", std::to_string(a.buffer_triangles), std::to_string(b.buffer_triangles));
-    if (a.seed != b.seed) return differs("--seed", std::to_string(a.seed), std::to_string(b.seed));
+        return differs(mention(Setting::kBuffer), std::to_string(a.buffer_triangles),
+                       std::to_string(b.buffer_triangles));
+    if (a.seed != b.seed) return differs(mention(Setting::kSeed), std::to_string(a.seed), std::to_string(b.seed));
     if (a.weld_eps != b.weld_eps)
         return "was made welding on a grid of " + number_text(a.weld_eps) + ", this job's is " +
-               number_text(b.weld_eps) + " (--weld differs)";
+               number_text(b.weld_eps) + " (" + mention(Setting::kWeld) + " differs)";
     if (a.sorted_axis != b.sorted_axis)
-        return differs("the input sorted along", axis_text(a.sorted_axis), axis_text(b.sorted_axis)) +
-               " (--sorted-axis differs)";
+        return differs("the input sorted along", axis_text(a.sorted_axis), axis_text(b.sorted_axis)) + " (" +
+               mention(Setting::kSortedAxis) + " differs)";
     if (a.sorted_by_minimum != b.sorted_by_minimum)
         return std::string("was made with the input ") + (a.sorted_by_minimum ? "" : "not ") +
-               "known to be sorted by triangle minimum, this job " + (b.sorted_by_minimum ? "" : "not ") +
-               "(--sorted-axis differs)";
+               "known to be sorted by triangle minimum, this job " + (b.sorted_by_minimum ? "" : "not ") + "(" +
+               mention(Setting::kSortedAxis) + " differs)";
     if (a.output_chunk_triangles != b.output_chunk_triangles)
         return "was made by a build that writes chunks of " + std::to_string(a.output_chunk_triangles) +
                " triangles, this one " + std::to_string(b.output_chunk_triangles);
@@ -170,11 +174,11 @@ std::string plan_difference(const PartPlan& part, const PartPlan& job) {
         std::string text = "carries other channels than this job";
         if (!more.empty()) text += ": it carries " + more + ", which this job does not";
         if (!less.empty()) text += std::string(more.empty() ? ": " : "; ") + "this job carries " + less;
-        return text +
-               " (the channels carried depend on the merge's output format and --drop: give every part the "
-               "merge's --drop, and --to naming its output format)";
+        return text + " (the channels carried depend on the merge's output format and " + mention(Setting::kDrop) +
+               ": give every part the merge's " + mention(Setting::kDrop) + ", and " + mention(Setting::kTo) +
+               " naming its output format)";
     }
-    if (part.omega != job.omega) return "was made with other --weights";
+    if (part.omega != job.omega) return "was made with other " + mention(Setting::kWeights);
     return {};
 }
 
@@ -362,8 +366,8 @@ PartFileReader::PartFileReader(const std::string& path, unsigned parts, const In
     const std::string name = "part " + part_text(k_, file_parts);
     if (file_parts != parts || k_ < 1 || k_ >= parts)
         throw io::Error(path, name + " is not one of parts 1/" + std::to_string(parts) + " to " +
-                                  part_text(parts - 1, parts) + " of this job (--part " + part_text(parts, parts) +
-                                  ")");
+                                  part_text(parts - 1, parts) + " of this job (" + io::mention(io::Setting::kPart) +
+                                  " " + part_text(parts, parts) + ")");
     if (made_from.size != input.size)
         throw io::Error(path, name + " was made from an input of " + std::to_string(made_from.size) +
                                   " bytes, this job's has " + std::to_string(input.size));
