@@ -190,7 +190,7 @@ void run_info(const InfoOptions& opt) {
                 list.push_back(e);
             }
         }
-        for (const auto& [k, v] : header.notes) j["notes"][k] = v;
+        for (const auto& [k, v] : header.notes) j["notes"][k] = io::render(v, flag_name);
         if (!header.warnings.empty()) {
             auto& list = j["warnings"] = nlohmann::ordered_json::array();
             for (const io::ReaderWarning& w : header.warnings) {
@@ -275,7 +275,8 @@ void run_info(const InfoOptions& opt) {
             std::printf("%s\n", line.c_str());
         }
     }
-    for (const auto& [k, v] : header.notes) std::printf("%-12s %s\n", (k + ":").c_str(), v.c_str());
+    for (const auto& [k, v] : header.notes)
+        std::printf("%-12s %s\n", (k + ":").c_str(), io::render(v, flag_name).c_str());
     for (const io::ReaderWarning& w : header.warnings) {
         std::printf("warning:     %s%s (%llu)\n", io::render(w.text, flag_name).c_str(),
                     io::warning_position(w).c_str(), (unsigned long long)w.count);
