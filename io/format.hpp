@@ -79,7 +79,9 @@ struct MeshHeader {
     // never change, so the table as it stands after the last next() holds every index read.
     std::vector<Material> materials;
     std::string variant;                                     // e.g. "binary", "ascii", "binary_big_endian"
-    std::vector<std::pair<std::string, std::string>> notes;  // extra facts for `info`
+    // Extra facts for `info` (key, text); a text may mention settings (io::mention), which
+    // io::render() words.
+    std::vector<std::pair<std::string, std::string>> notes;
     // Files besides the input that the reader read (a .gltf's buffer files, an OBJ's .mtl and
     // textures), so the commands can refuse an output that would overwrite one of them.
     std::vector<std::string> side_files;
