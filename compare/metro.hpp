@@ -27,13 +27,13 @@
 #pragma once
 
 #include "compare/topology.hpp"
+#include "io/error.hpp"
 #include "io/format.hpp"
 
 #include <cstdint>
 #include <functional>
 #include <memory>
 #include <optional>
-#include <stdexcept>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -125,10 +125,11 @@ struct CompareResult {
 };
 
 // Thrown by compare_meshes with CompareOptions::attributes when the two meshes share neither
-// colours nor normals, before any triangle is read; what() names what each one has.
-class NoSharedAttributes : public std::runtime_error {
+// colours nor normals, before any triangle is read; what() names what each one has. An
+// io::OptionError about Setting::kAttributes: the setting cannot work with these meshes.
+class NoSharedAttributes : public io::OptionError {
 public:
-    using std::runtime_error::runtime_error;
+    explicit NoSharedAttributes(std::string message) : io::OptionError(io::Setting::kAttributes, std::move(message)) {}
 };
 
 // Compares A and B as described at the top of this file. Deterministic for a given seed and

@@ -1,9 +1,10 @@
 // Per-vertex and per-face channels of the in-core mesh, and the seam rules.
 #include "decimate/attribute_store.hpp"
 
+#include "io/error.hpp"
+
 #include <algorithm>
 #include <cmath>
-#include <stdexcept>
 #include <string>
 
 namespace meshstream::decimate {
@@ -48,8 +49,10 @@ AttributeStore::AttributeStore(const AttributeLayout& layout, size_t triangle_ca
       value_offset_(AttributeQuadric::size(layout.size()) + 3),
       face_scalar_count_(layout.face_scalar_count()) {
     if (m_ > kMaxAttributeComponents)
-        throw std::invalid_argument(std::to_string(m_) + " attribute values per corner, more than the " +
-                                    std::to_string(kMaxAttributeComponents) + " the decimator carries");
+        throw io::OptionError(io::Setting::kDrop, std::to_string(m_) + " attribute values per corner, more than the " +
+                                                      std::to_string(kMaxAttributeComponents) +
+                                                      " the decimator carries: add some to " +
+                                                      io::mention(io::Setting::kDrop));
     const size_t vertices = 3 * triangle_capacity + 3;
     records_ = raw_array<float>(vertices * stride_);
     ranges_ = raw_array<float>(std::max<size_t>(1, 2 * vertices * size_t(m_)));

@@ -32,7 +32,8 @@ namespace meshstream::decimate {
 
 class AttributeStore {
 public:
-    // Throws std::invalid_argument when the layout has more than kMaxAttributeComponents.
+    // Throws io::OptionError (Setting::kDrop) when the layout has more than
+    // kMaxAttributeComponents.
     AttributeStore(const AttributeLayout& layout, size_t triangle_capacity);
     static size_t reserved_bytes(const AttributeLayout& layout, size_t triangle_capacity);
 

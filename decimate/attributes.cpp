@@ -1,17 +1,23 @@
 // The attribute vector of a corner: a stream's channels gathered into m numbers and back.
 #include "decimate/attributes.hpp"
 
+#include "io/error.hpp"
+
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
-#include <stdexcept>
 
 namespace meshstream::decimate {
 
 AttributeLayout::AttributeLayout(const io::Channels& channels, const AttributeWeights& weights) {
     auto checked = [](double w, const std::string& what) {
-        if (!(w >= 0) || !std::isfinite(w))
-            throw std::invalid_argument("attribute weight of " + what + " must be a finite number >= 0");
+        if (!(w >= 0) || !std::isfinite(w)) {
+            char value[32];
+            std::snprintf(value, sizeof value, "%g", w);
+            throw io::OptionError(io::Setting::kWeights,
+                                  "attribute weight of " + what + " must be a finite number >= 0, got " + value);
+        }
         return w * w;
     };
     const double normal = checked(weights.normal, "normals"), color = checked(weights.color, "colours"),
@@ -45,7 +51,7 @@ AttributeLayout::AttributeLayout(const io::Channels& channels, const AttributeWe
     for (const auto& [name, w] : weights.scalars) {
         const auto& s = channels.vertex_scalars;
         const auto it = std::find_if(s.begin(), s.end(), [&](const io::ScalarChannel& c) { return c.name == name; });
-        if (it == s.end()) throw std::invalid_argument("no vertex scalar '" + name + "' to weigh");
+        if (it == s.end()) throw io::OptionError(io::Setting::kWeights, "no vertex scalar '" + name + "' to weigh");
         omega_[size_t(scalar_) + size_t(it - s.begin())] = checked(w, "'" + name + "'");
     }
     channels_.material = channels.material;

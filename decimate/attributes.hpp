@@ -54,8 +54,8 @@ inline constexpr int kMaxAttributeComponents = 32;
 class AttributeLayout {
 public:
     AttributeLayout() = default;  // no channel
-    // `channels`: the stream's (vertex ids are ignored). Throws std::invalid_argument when a
-    // weight names a scalar the stream does not have, or a weight is negative or not finite.
+    // `channels`: the stream's (vertex ids are ignored). Throws io::OptionError (Setting::kWeights)
+    // when a weight names a scalar the stream does not have, or a weight is negative or not finite.
     AttributeLayout(const io::Channels& channels, const AttributeWeights& weights);
 
     int size() const { return size_; }  // m

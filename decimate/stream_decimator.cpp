@@ -11,10 +11,12 @@
 #include "decimate/random.hpp"
 #include "decimate/schedule.hpp"
 #include "decimate/writing.hpp"
+#include "io/error.hpp"
 
 #include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -28,21 +30,37 @@ constexpr size_t kScanLimit = 4096;
 // Candidates for a forced write.
 constexpr int kForcedCandidates = 8;
 
-// The options, checked before anything is allocated (std::invalid_argument: the command line
-// checks them itself, with its own messages, so these only reach library callers).
+// The options, checked before anything is allocated: an io::OptionError naming the setting and
+// the value given (the commands check their flags first, with their own messages).
 const Options& checked(const Options& options, std::optional<uint64_t> input_count) {
-    auto refuse = [](const char* what) { throw std::invalid_argument(std::string("decimate::Options: ") + what); };
-    if (options.target ? !input_count.has_value() : !(options.ratio > 0 && options.ratio <= 1))
-        refuse(options.target ? "target needs the input triangle count" : "ratio must be in (0, 1]");
-    if (options.target && *options.target > *input_count) refuse("target is more than the input triangle count");
-    if (options.sorted_by_minimum && !options.sorted_axis) refuse("sorted_by_minimum needs sorted_axis");
-    if (options.buffer_triangles < 16) refuse("buffer_triangles must be at least 16");
+    using io::mention;
+    using io::Setting;
+    auto refuse = [](Setting setting, const std::string& why) { throw io::OptionError(setting, why); };
+    if (options.target && !input_count)
+        refuse(Setting::kTarget, mention(Setting::kTarget) + " needs the input's triangle count, which is not known");
+    if (!options.target && !(options.ratio > 0 && options.ratio <= 1)) {
+        char ratio[32];
+        std::snprintf(ratio, sizeof ratio, "%g", options.ratio);
+        refuse(Setting::kRatio, mention(Setting::kRatio) + " must be in (0, 1], got " + ratio);
+    }
+    if (options.target && *options.target > *input_count)
+        refuse(Setting::kTarget, mention(Setting::kTarget) + " " + std::to_string(*options.target) +
+                                     " is more than the " + std::to_string(*input_count) + " triangles of the input");
+    if (options.sorted_by_minimum && !options.sorted_axis)
+        refuse(Setting::kSortedAxis, "sorting by minimum needs " + mention(Setting::kSortedAxis));
+    if (options.buffer_triangles < 16)
+        refuse(Setting::kBuffer, mention(Setting::kBuffer) + " must hold at least 16 triangles, got " +
+                                     std::to_string(options.buffer_triangles));
     if (options.sorted_axis && (*options.sorted_axis < 0 || *options.sorted_axis > 2))
-        refuse("sorted_axis must be 0, 1 or 2");
-    if (options.output_chunk_triangles == 0) refuse("output_chunk_triangles must be at least 1");
-    if (options.part != Part::kWhole && options.target) refuse("a range or the seam pass takes a ratio, not a target");
+        refuse(Setting::kSortedAxis,
+               mention(Setting::kSortedAxis) + " must be 0, 1 or 2, got " + std::to_string(*options.sorted_axis));
+    if (options.output_chunk_triangles == 0)
+        refuse(Setting::kOutputChunk, mention(Setting::kOutputChunk) + " must be at least 1 triangle, got 0");
+    if (options.part != Part::kWhole && options.target)
+        refuse(Setting::kTarget,
+               "a range or the seam pass takes " + mention(Setting::kRatio) + ", not " + mention(Setting::kTarget));
     if (options.earlier_span && (options.part != Part::kRange || !options.sorted_axis))
-        refuse("earlier_span needs a range on a sorted axis");
+        refuse(Setting::kPart, "an earlier span needs a range (Part::kRange) on a sorted axis");
     return options;
 }
 

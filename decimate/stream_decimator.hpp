@@ -75,7 +75,9 @@ struct Options {
 class StreamDecimator {
 public:
     // `input_triangle_count` is the reader's count when known; Options::target needs it.
-    // Options outside their ranges throw std::invalid_argument. Allocates every buffer once;
+    // Options outside their ranges, or that do not fit together or with the count, throw
+    // io::OptionError naming the setting and the value; so does an attribute layout of more than
+    // kMaxAttributeComponents. Allocates every buffer once, std::bad_alloc when refused;
     // reserved_bytes() tells how much (about 580 bytes reserved per buffer triangle).
     //
     // With `attributes` carrying channels (AttributeLayout::any()), the decimator reads them from
@@ -92,9 +94,10 @@ public:
     StreamDecimator(const Options& options, const io::InputCount& input, const AttributeLayout& attributes = {});
 
     // Reads every triangle of `in` (positions, and the attribute layout's channels), decimating
-    // and writing to `out` as the schedule demands. Every coordinate must be finite, else it
-    // throws std::invalid_argument before reading any: NaN/inf corners can be neither welded
-    // nor finalized (the commands drop them first with tools::TriangleFilter).
+    // and writing to `out` as the schedule demands. Preconditions, std::invalid_argument before
+    // reading any triangle when broken: every coordinate is finite (NaN/inf corners can be
+    // neither welded nor finalized; io::TriangleInput drops them with BadTriangles::kDrop), and
+    // the chunk carries the attribute layout's channels.
     void push(const io::TriangleChunk& in, const Emit& out);
     // End of input: decimates to the target (as close as the mesh allows: see Stats), writes
     // the rest, flushes `out`.

@@ -85,8 +85,8 @@ Carried carried_channels(const DecimateSettings& s, const io::MeshHeader& header
     c.dropped = io::describe_missing(wanted, c.channels);
     try {
         c.layout = decimate::AttributeLayout(c.channels, s.weights);
-    } catch (const std::invalid_argument& e) {
-        throw io::OptionError(Setting::kWeights, input_name + ": " + mention(Setting::kWeights) + ": " + e.what());
+    } catch (const io::OptionError& e) {
+        throw io::OptionError(Setting::kWeights, input_name + ": " + mention(Setting::kWeights) + ": " + e.raw_what());
     }
     if (c.layout.size() > decimate::kMaxAttributeComponents)
         throw io::OptionError(Setting::kDrop, input_name + ": " + std::to_string(c.layout.size()) +

@@ -133,8 +133,10 @@ const char* axis_text(const std::optional<int>& axis) {
 }
 
 // How `part` (the file's plan) differs from `job` (this job's), as "was made with ..., this job
-// has ..."; empty when they are the same.
+// has ..."; empty when they are the same. The settings are mentions (io::mention).
 std::string plan_difference(const PartPlan& part, const PartPlan& job) {
+    using io::mention;
+    using io::Setting;
     const decimate::Options &a = part.options, &b = job.options;
     auto differs = [](const std::string& what, const std::string& x, const std::string& y) {
         return "was made with " + what + " " + x + ", this job has " + y;

@@ -54,8 +54,9 @@ bool probe_draco(std::span<const std::byte> head, std::optional<uint64_t> file_s
 // its entropy coder's tables, which double with each quantization bit).
 uint64_t draco_encode_estimate_bytes(uint64_t vertex_count, uint64_t triangle_count, const WriteOptions& options);
 
-// The DracoSettings of `options`, checked: throws io::Error naming `file` and the setting for
-// one out of its range, and for bit counts whose coding tables alone pass the memory budget.
+// The DracoSettings of `options`, checked: throws io::OptionError naming `file` and the setting
+// for one out of its range ("x.drc: the Draco position bits must be 1-30, got 31"), and for bit
+// counts whose coding tables alone pass the memory budget.
 DracoSettings check_draco_settings(const std::string& file, const WriteOptions& options);
 
 // The channels a Draco bitstream written with `options` keeps of `in` (per corner: normal,

@@ -48,7 +48,7 @@ std::string_view setting_words(Setting setting) {
         "the output format",
         "the memory budget",
         "the temporary-directory setting",
-        "strict reading",
+        "strict mode",
         "the channels left out",
         "dropping bad triangles",
         "the glTF compression",
@@ -62,7 +62,7 @@ std::string_view setting_words(Setting setting) {
         "the target",
         "the buffer",
         "the weld",
-        "the attribute weights",
+        "attribute weights",
         "the sorted axis",
         "the seed",
         "the thread count",
@@ -70,6 +70,8 @@ std::string_view setting_words(Setting setting) {
         "the sort axis",
         "the part",
         "the part files",
+        "the attributes compared",
+        "the output chunk size",
     };
     const int i = int(setting);
     return i >= 0 && i < kSettingCount ? kWords[i] : std::string_view("a setting");

@@ -8,7 +8,9 @@
 //   - meshstream::Error itself for the rest (memory the system refused for a buffer);
 //   - engine::Cancelled once the caller's ProgressSink asked for it.
 // Misuse of an object (a writer written to after finish(), a decimator pushed after finish())
-// throws std::logic_error, and memory exhausted std::bad_alloc, as in the standard library.
+// throws std::logic_error, an argument that breaks a precondition its header documents (a chunk
+// of capacity 0, a NaN corner pushed into a decimator) std::invalid_argument, and memory
+// exhausted std::bad_alloc, as in the standard library.
 //
 // Messages name the settings that matter (the remedy: "raise the memory budget") through
 // io::mention(setting): what() words them for a library user ("the memory budget"), and a
@@ -49,12 +51,14 @@ enum class Setting : uint8_t {
     kSortedAxis,  // the axis the input is sorted along
     kSeed,
     kThreads,
-    kSort,   // the sort policy
-    kAxis,   // the sort's axis
-    kPart,   // a part job's index
-    kMerge,  // the part files a merge reads
+    kSort,         // the sort policy
+    kAxis,         // the sort's axis
+    kPart,         // a part job's index
+    kMerge,        // the part files a merge reads
+    kAttributes,   // what compare measures besides geometry
+    kOutputChunk,  // the decimator's output chunk size
 };
-inline constexpr int kSettingCount = int(Setting::kMerge) + 1;
+inline constexpr int kSettingCount = int(Setting::kOutputChunk) + 1;
 
 // The setting in a library user's words: "the memory budget", "strict reading".
 std::string_view setting_words(Setting setting);

@@ -51,7 +51,9 @@ struct Material {
 // commands print each once, with its count, as a warning; under ReadOptions::strict the
 // readers throw io::Error instead for what is bad input.
 struct ReaderWarning {
-    std::string text;                           // what happened, e.g. "faces with fewer than 3 corners skipped"
+    // What happened, e.g. "faces with fewer than 3 corners skipped"; settings in it are mentions
+    // (io::mention), which io::render() words.
+    std::string text;
     uint64_t count = 0;                         // how often
     uint64_t first_line = 0;                    // of the first one: 1-based line, 0 = not known
     uint64_t first_byte_offset = ~uint64_t{0};  // and byte offset, ~0 = not known
@@ -59,7 +61,8 @@ struct ReaderWarning {
 };
 // " (first at line L, byte B)" (" (at ...)" for one), or "" when the position is not known.
 std::string warning_position(const ReaderWarning& warning);
-// "<file>: <text> (first at line L, byte B)", for a message (the count is the caller's).
+// "<file>: <text> (first at line L, byte B)", for a message (the count is the caller's); the
+// mentions are kept, for io::render().
 std::string describe_warning(const std::string& file, const ReaderWarning& warning);
 
 // What a reader knows from the file's header, before or while streaming. Every field is
@@ -77,7 +80,9 @@ struct MeshHeader {
     // never change, so the table as it stands after the last next() holds every index read.
     std::vector<Material> materials;
     std::string variant;                                     // e.g. "binary", "ascii", "binary_big_endian"
-    std::vector<std::pair<std::string, std::string>> notes;  // extra facts for `info`
+    // Extra facts for `info` (key, text); a text may mention settings (io::mention), which
+    // io::render() words.
+    std::vector<std::pair<std::string, std::string>> notes;
     // Files besides the input that the reader read (a .gltf's buffer files, an OBJ's .mtl and
     // textures), so the commands can refuse an output that would overwrite one of them.
     std::vector<std::string> side_files;
@@ -242,9 +247,9 @@ struct WriteOptions {
 };
 
 struct Format {
-    std::string_view name;         // for --from/--to: "stl", "stl-ascii", "ply", ...
+    std::string_view name;         // as open_input and open_output take it: "stl", "stl-ascii", "ply", ...
     std::string_view extensions;   // space separated, lower case, without dot: "stl"
-    std::string_view description;  // one line for --help and docs
+    std::string_view description;  // one line for listings and docs
     // True when `head` (the first bytes, up to 4 KiB) is this format. `file_size` is the
     // decoded size when known. May be null (never detected by content).
     bool (*probe)(std::span<const std::byte> head, std::optional<uint64_t> file_size);

@@ -1196,7 +1196,7 @@ const Format kPlyFormat = {
 const Format kPlyAsciiFormat = {
     "ply-ascii",
     "",
-    "PLY, ascii (write with --to ply-ascii)",
+    "PLY, ascii (written when named, having no extension of its own)",
     nullptr,
     &open_ply_reader,
     &open_ply_ascii_writer,

@@ -616,7 +616,7 @@ const Format kStlFormat = {
 const Format kStlAsciiFormat = {
     "stl-ascii",
     "",
-    "STL, ASCII (write with --to stl-ascii)",
+    "STL, ASCII (written when named, having no extension of its own)",
     &probe_stl_ascii,
     &open_stl_ascii_reader,
     &open_stl_ascii_writer,

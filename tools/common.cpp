@@ -467,11 +467,36 @@ void Progress::done() {
 
 std::string flag_name(io::Setting setting) {
     static constexpr const char* kFlags[io::kSettingCount] = {
-        "IN",         "OUT",        "--from",     "--to",          "--memory",   "--tmpdir",
-        "--strict",   "--drop",     "--clean",    "--compress",    "--draco-qp", "--draco-qn",
-        "--draco-qt", "--draco-qc", "--draco-cl", "--gzip-level",  "--ratio",    "--target",
-        "--buffer",   "--weld",     "--weights",  "--sorted-axis", "--seed",     "--threads",
-        "--sort",     "--axis",     "--part",     "--merge",
+        "IN",
+        "OUT",
+        "--from",
+        "--to",
+        "--memory",
+        "--tmpdir",
+        "--strict",
+        "--drop",
+        "--clean",
+        "--compress",
+        "--draco-qp",
+        "--draco-qn",
+        "--draco-qt",
+        "--draco-qc",
+        "--draco-cl",
+        "--gzip-level",
+        "--ratio",
+        "--target",
+        "--buffer",
+        "--weld",
+        "--weights",
+        "--sorted-axis",
+        "--seed",
+        "--threads",
+        "--sort",
+        "--axis",
+        "--part",
+        "--merge",
+        "--attributes",
+        "the output chunk size",  // no flag: the commands write chunks of the default size
     };
     const int i = int(setting);
     return i >= 0 && i < io::kSettingCount ? kFlags[i] : std::string(io::setting_words(setting));

@@ -201,7 +201,7 @@ void run_compare(const CompareCliOptions& opt) {
     try {
         r = compare_meshes(source(opt.a, opt.read, opt.attributes), source(opt.b, opt.read, opt.attributes), co);
     } catch (const NoSharedAttributes& e) {
-        throw UsageError(std::string("--attributes: ") + e.what());
+        throw UsageError(std::string("--attributes: ") + e.describe(flag_name));
     }
     progress.done();
 

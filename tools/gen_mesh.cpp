@@ -473,6 +473,19 @@ int run(const GenOptions& opt) {
     return 0;
 }
 
+// The flags of meshstream-gen that set a library setting, as its errors name them; the
+// library's words for the rest (it has no --memory: the default budget holds).
+std::string gen_flag_name(io::Setting setting) {
+    switch (setting) {
+        case io::Setting::kOutput: return "OUTPUT";
+        case io::Setting::kTo: return "--to";
+        case io::Setting::kTmpdir: return "--tmpdir";
+        case io::Setting::kSeed: return "--seed";
+        case io::Setting::kThreads: return "--threads";
+        default: return std::string(io::setting_words(setting));
+    }
+}
+
 }  // namespace
 }  // namespace meshstream::tools
 
@@ -556,6 +569,9 @@ int main(int argc, char** argv) {
         return tools::run(opt);
     } catch (const std::bad_alloc&) {
         std::fprintf(stderr, "meshstream-gen: error: out of memory\n");
+        return 1;
+    } catch (const meshstream::Error& e) {
+        std::fprintf(stderr, "meshstream-gen: error: %s\n", e.describe(tools::gen_flag_name).c_str());
         return 1;
     } catch (const std::exception& e) {
         std::fprintf(stderr, "meshstream-gen: error: %s\n", e.what());

@@ -190,11 +190,11 @@ void run_info(const InfoOptions& opt) {
                 list.push_back(e);
             }
         }
-        for (const auto& [k, v] : header.notes) j["notes"][k] = v;
+        for (const auto& [k, v] : header.notes) j["notes"][k] = io::render(v, flag_name);
         if (!header.warnings.empty()) {
             auto& list = j["warnings"] = nlohmann::ordered_json::array();
             for (const io::ReaderWarning& w : header.warnings) {
-                nlohmann::ordered_json e = {{"text", w.text}, {"count", w.count}};
+                nlohmann::ordered_json e = {{"text", io::render(w.text, flag_name)}, {"count", w.count}};
                 if (w.first_line != 0) e["line"] = w.first_line;
                 if (w.first_byte_offset != io::Error::kNoOffset) e["byte"] = w.first_byte_offset;
                 list.push_back(e);
@@ -275,10 +275,11 @@ void run_info(const InfoOptions& opt) {
             std::printf("%s\n", line.c_str());
         }
     }
-    for (const auto& [k, v] : header.notes) std::printf("%-12s %s\n", (k + ":").c_str(), v.c_str());
+    for (const auto& [k, v] : header.notes)
+        std::printf("%-12s %s\n", (k + ":").c_str(), io::render(v, flag_name).c_str());
     for (const io::ReaderWarning& w : header.warnings) {
-        std::printf("warning:     %s%s (%llu)\n", w.text.c_str(), io::warning_position(w).c_str(),
-                    (unsigned long long)w.count);
+        std::printf("warning:     %s%s (%llu)\n", io::render(w.text, flag_name).c_str(),
+                    io::warning_position(w).c_str(), (unsigned long long)w.count);
     }
     if (topology) {
         TopologyReport t = topology->finish();

@@ -562,6 +562,9 @@ TEST(MetroAttributes, OnlyTheChannelsBothHaveAreMeasured) {
         EXPECT_STREQ(e.what(),
                      "no colours or normals in both meshes to compare: A (a.ply) has colours, B (b.ply) has "
                      "normals");
+        // The library's option error: the setting that cannot work with these meshes.
+        const io::OptionError& option = e;
+        EXPECT_EQ(option.setting(), io::Setting::kAttributes);
     }
     try {
         compare_meshes(memory_source("a.stl", s), memory_source("b.ply", s, s, sphere_colours(s)),

@@ -2,11 +2,11 @@
 // the attribute quadric.
 #include "decimate/attributes.hpp"
 #include "decimate/attribute_quadric.hpp"
+#include "io/error.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <stdexcept>
 #include <vector>
 
 namespace {
@@ -167,15 +167,24 @@ TEST(AttributeLayout, PositionsOnlyCarriesNothing) {
 }
 
 TEST(AttributeLayout, RefusesWeightsForMissingScalarsAndBadNumbers) {
+    auto refused = [](const AttributeWeights& weights, const std::string& message) {
+        try {
+            AttributeLayout layout(every_channel(), weights);
+            ADD_FAILURE() << "accepted: " << message;
+        } catch (const io::OptionError& e) {
+            EXPECT_EQ(e.setting(), io::Setting::kWeights);
+            EXPECT_EQ(std::string(e.what()), message);
+        }
+    };
     AttributeWeights w;
     w.scalars = {{"temperature", 1}};
-    EXPECT_THROW(AttributeLayout(every_channel(), w), std::invalid_argument);
+    refused(w, "no vertex scalar 'temperature' to weigh");
     AttributeWeights negative;
     negative.color = -1;
-    EXPECT_THROW(AttributeLayout(every_channel(), negative), std::invalid_argument);
+    refused(negative, "attribute weight of colours must be a finite number >= 0, got -1");
     AttributeWeights nan;
     nan.normal = std::nan("");
-    EXPECT_THROW(AttributeLayout(every_channel(), nan), std::invalid_argument);
+    refused(nan, "attribute weight of normals must be a finite number >= 0, got nan");
 }
 
 TEST(AttributeLayout, ChunksWithoutAChannelDoNotCarryIt) {

@@ -5,6 +5,7 @@
 
 #include "compare/metro.hpp"
 #include "decimate/random.hpp"
+#include "io/error.hpp"
 #include "mesh_util.hpp"
 
 #include <gtest/gtest.h>
@@ -437,21 +438,49 @@ TEST(StreamDecimator, ThinTubesReachTheCountThroughKnifeEdgesAtTheEnd) {
 
 // Options out of range and calls out of order are errors for library callers, not crashes
 // (output chunks of 0 triangles crashed, pushing after finish() wrote
-// more output).
+// more output). Options are io::OptionErrors naming the setting and the value, in the library's
+// words (no command-line flag).
 TEST(StreamDecimator, BadOptionsAndCallOrderThrow) {
+    using meshstream::io::Setting;
     EXPECT_THROW(meshstream::io::TriangleChunk(0), std::invalid_argument);
-    auto refused = [](auto change, std::optional<uint64_t> count = std::nullopt) {
+    auto refused = [](auto change, Setting setting, const std::string& message,
+                      std::optional<uint64_t> count = std::nullopt) {
+        SCOPED_TRACE(message);
         Options options;
         change(options);
-        EXPECT_THROW(StreamDecimator(options, count), std::invalid_argument);
+        try {
+            StreamDecimator decimator(options, count);
+            ADD_FAILURE() << "accepted";
+        } catch (const meshstream::io::OptionError& e) {
+            EXPECT_EQ(e.setting(), setting);
+            EXPECT_EQ(std::string(e.what()), message);
+        }
     };
-    refused([](Options& o) { o.output_chunk_triangles = 0; });
-    refused([](Options& o) { o.buffer_triangles = 15; });
-    refused([](Options& o) { o.ratio = 0; });
-    refused([](Options& o) { o.sorted_axis = 3; });
-    refused([](Options& o) { o.target = 10; });               // without the input count
-    refused([](Options& o) { o.target = 50; }, 10);           // more than the input (it kept all, saying 50)
-    refused([](Options& o) { o.sorted_by_minimum = true; });  // without the axis
+    refused([](Options& o) { o.output_chunk_triangles = 0; }, Setting::kOutputChunk,
+            "the output chunk size must be at least 1 triangle, got 0");
+    refused([](Options& o) { o.buffer_triangles = 15; }, Setting::kBuffer,
+            "the buffer must hold at least 16 triangles, got 15");
+    refused([](Options& o) { o.ratio = 0; }, Setting::kRatio, "the ratio must be in (0, 1], got 0");
+    refused([](Options& o) { o.ratio = 1.5; }, Setting::kRatio, "the ratio must be in (0, 1], got 1.5");
+    refused([](Options& o) { o.sorted_axis = 3; }, Setting::kSortedAxis, "the sorted axis must be 0, 1 or 2, got 3");
+    refused([](Options& o) { o.target = 10; }, Setting::kTarget,  // without the input count
+            "the target needs the input's triangle count, which is not known");
+    refused([](Options& o) { o.target = 50; }, Setting::kTarget,  // more than the input (it kept all, saying 50)
+            "the target 50 is more than the 10 triangles of the input", 10);
+    refused([](Options& o) { o.sorted_by_minimum = true; }, Setting::kSortedAxis,  // without the axis
+            "sorting by minimum needs the sorted axis");
+    refused(
+        [](Options& o) {
+            o.part = Part::kRange;
+            o.target = 5;
+        },
+        Setting::kTarget, "a range or the seam pass takes the ratio, not the target", 10);
+    refused(
+        [](Options& o) {
+            o.sorted_axis = 0;
+            o.earlier_span = std::array<double, 2>{0, 1};
+        },
+        Setting::kPart, "an earlier span needs a range (Part::kRange) on a sorted axis");
     Options options;
     options.ratio = 1;
     StreamDecimator decimator(options, std::nullopt);

@@ -196,6 +196,29 @@ TEST(DracoWriter, RefusesPastMemoryBudgetAndLeavesNoFile) {
     EXPECT_TRUE(fs::is_empty(dir.path()));
 }
 
+// A library caller reads the remedy in the library's words, never a command-line flag; the
+// command names the flag (describe() with its names).
+TEST(DracoReader, PastTheMemoryBudgetSaysSoInTheLibrarysWords) {
+    TempDir dir;
+    write_soup(read_soup(fixture("bunny_from_draco.bin.stl")), dir / "b.drc");
+    io::ReadOptions o;
+    o.memory_budget_bytes = 16 << 10;
+    try {
+        io::open_input(dir / "b.drc", {}, o);
+        FAIL() << "read past the budget";
+    } catch (const io::Error& e) {
+        EXPECT_EQ(e.message().rfind("Draco decodes whole files in memory and this one is over the memory budget of "
+                                    "16 KiB; raise the memory budget",
+                                    0),
+                  0u)
+            << e.message();
+        EXPECT_EQ(std::string(e.what()).find("--"), std::string::npos) << e.what();
+        const std::string flagged = e.describe(
+            [](io::Setting s) { return std::string(s == io::Setting::kMemory ? "--memory" : io::setting_words(s)); });
+        EXPECT_NE(flagged.find("16 KiB; raise --memory"), std::string::npos) << flagged;
+    }
+}
+
 TEST(DracoWriter, RefusesEmptyMeshAndLeavesOutNonFiniteTriangles) {
     // No quantization holds a NaN: such a triangle is left out and counted in a note, or, with
     // --strict, refused by its number in the stream.
@@ -207,7 +230,7 @@ TEST(DracoWriter, RefusesEmptyMeshAndLeavesOutNonFiniteTriangles) {
     ASSERT_EQ(notes.size(), 1u);
     EXPECT_EQ(notes[0], dir / "nan.drc" +
                             ": 1 of the 2 triangles have a NaN or infinite coordinate, which Draco cannot "
-                            "store: left out (strict reading makes this an error)");
+                            "store: left out (strict mode makes this an error)");
     EXPECT_EQ(read_soup(dir / "nan.drc").triangles(), 1u);
     io::WriteOptions strict;
     strict.strict = true;
@@ -216,7 +239,7 @@ TEST(DracoWriter, RefusesEmptyMeshAndLeavesOutNonFiniteTriangles) {
         FAIL();
     } catch (const io::Error& e) {
         EXPECT_NE(std::string(e.what()).find("triangle 0 has a NaN or infinite coordinate, which Draco cannot store "
-                                             "(strict reading)"),
+                                             "(strict mode)"),
                   std::string::npos)
             << e.what();
     }
@@ -284,29 +307,27 @@ TEST(DracoWriter, SaysWhenQuantizationFlattensTriangles) {
 
 TEST(DracoWriter, RejectsOutOfRangeSettings) {
     // Each setting at the first value past either end of its range, for both writers that take
-    // DracoSettings: refused when the output is opened, naming the file and the setting, and
-    // nothing is left behind. The ends themselves are accepted.
+    // DracoSettings: refused when the output is opened with an io::OptionError naming the file,
+    // the setting (in the library's words: no command-line flag) and the value, and nothing is
+    // left behind. The ends themselves are accepted.
     TempDir dir;
+    using io::Setting;
     struct Case {
         io::DracoSettings settings;
-        io::Setting setting;
+        Setting setting;
         const char* message;
     };
     const Case cases[] = {
-        {{.position_bits = 0}, io::Setting::kDracoPositionBits, "the Draco position bits must be 1-30, got 0"},
-        {{.position_bits = 31}, io::Setting::kDracoPositionBits, "the Draco position bits must be 1-30, got 31"},
-        {{.normal_bits = 1}, io::Setting::kDracoNormalBits, "the Draco normal bits must be 2-30, got 1"},
-        {{.normal_bits = 31}, io::Setting::kDracoNormalBits, "the Draco normal bits must be 2-30, got 31"},
-        {{.texcoord_bits = 0},
-         io::Setting::kDracoTexcoordBits,
-         "the Draco texture coordinate bits must be 1-30, got 0"},
-        {{.texcoord_bits = 31},
-         io::Setting::kDracoTexcoordBits,
-         "the Draco texture coordinate bits must be 1-30, got 31"},
-        {{.color_bits = 0}, io::Setting::kDracoColorBits, "the Draco colour bits must be 1-30, got 0"},
-        {{.color_bits = 31}, io::Setting::kDracoColorBits, "the Draco colour bits must be 1-30, got 31"},
-        {{.level = -1}, io::Setting::kDracoLevel, "the Draco compression level must be 0-10, got -1"},
-        {{.level = 11}, io::Setting::kDracoLevel, "the Draco compression level must be 0-10, got 11"},
+        {{.position_bits = 0}, Setting::kDracoPositionBits, "the Draco position bits must be 1-30, got 0"},
+        {{.position_bits = 31}, Setting::kDracoPositionBits, "the Draco position bits must be 1-30, got 31"},
+        {{.normal_bits = 1}, Setting::kDracoNormalBits, "the Draco normal bits must be 2-30, got 1"},
+        {{.normal_bits = 31}, Setting::kDracoNormalBits, "the Draco normal bits must be 2-30, got 31"},
+        {{.texcoord_bits = 0}, Setting::kDracoTexcoordBits, "the Draco texture coordinate bits must be 1-30, got 0"},
+        {{.texcoord_bits = 31}, Setting::kDracoTexcoordBits, "the Draco texture coordinate bits must be 1-30, got 31"},
+        {{.color_bits = 0}, Setting::kDracoColorBits, "the Draco colour bits must be 1-30, got 0"},
+        {{.color_bits = 31}, Setting::kDracoColorBits, "the Draco colour bits must be 1-30, got 31"},
+        {{.level = -1}, Setting::kDracoLevel, "the Draco compression level must be 0-10, got -1"},
+        {{.level = 11}, Setting::kDracoLevel, "the Draco compression level must be 0-10, got 11"},
     };
     for (const char* name : {"x.drc", "x.glb"})
         for (const Case& c : cases) {
@@ -317,10 +338,8 @@ TEST(DracoWriter, RejectsOutOfRangeSettings) {
                 io::open_output(dir / name, {}, o);
                 ADD_FAILURE() << "accepted";
             } catch (const io::OptionError& e) {
-                // A bad setting, in a library user's words; the command names its flag instead.
                 EXPECT_EQ(e.setting(), c.setting);
                 EXPECT_EQ(std::string(e.what()), dir / name + ": " + c.message);
-                EXPECT_EQ(std::string(e.what()).find("--"), std::string::npos);
             }
             EXPECT_TRUE(fs::is_empty(dir.path()));
         }

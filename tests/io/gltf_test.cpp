@@ -1036,8 +1036,8 @@ TEST(GltfWriter, KeepsDegenerateAndZeroAreaTrianglesExceptWithDraco) {
     ASSERT_EQ(notes.size(), 1u);
     EXPECT_EQ(notes[0], dir / "d.glb" +
                             ": 2 of the 5 triangles have two corners at one vertex (degenerate), which "
-                            "Draco's encoder drops: left out (write without Draco to keep them; strict "
-                            "reading makes this an error)");
+                            "Draco's encoder drops: left out (write without Draco to keep them; strict mode "
+                            "makes this an error)");
     EXPECT_EQ(read_soup(dir / "d.glb").triangles(), 3u);
     io::WriteOptions strict;
     strict.strict = true;
@@ -1047,7 +1047,7 @@ TEST(GltfWriter, KeepsDegenerateAndZeroAreaTrianglesExceptWithDraco) {
     } catch (const io::Error& e) {
         EXPECT_EQ(std::string(e.what()), dir / "s.glb" +
                                              ": triangle 1 has two corners at one vertex, which Draco's "
-                                             "encoder drops (strict reading)");
+                                             "encoder drops (strict mode)");
     }
     strict.format_options.set(io::GltfSettings{Compression::kMeshopt});
     EXPECT_TRUE(write_soup(soup, dir / "s.glb", strict).empty()) << "glTF holds them: nothing to refuse";
@@ -1065,7 +1065,7 @@ TEST(GltfWriter, LeavesOutNonFiniteTrianglesOrRefusesThemUnderStrict) {
         ASSERT_EQ(notes.size(), 1u);
         EXPECT_EQ(notes[0], dir / "n.glb" +
                                 ": 2 of the 5 triangles have a NaN or infinite coordinate, which glTF "
-                                "cannot store: left out (strict reading makes this an error)");
+                                "cannot store: left out (strict mode makes this an error)");
         expect_valid_allowing(dir / "n.glb", {"ACCESSOR_INDEX_TRIANGLE_DEGENERATE"});
         EXPECT_EQ(read_soup(dir / "n.glb").triangles(), 3u);
         o.strict = true;
@@ -1074,7 +1074,7 @@ TEST(GltfWriter, LeavesOutNonFiniteTrianglesOrRefusesThemUnderStrict) {
             ADD_FAILURE() << "accepted";
         } catch (const io::Error& e) {
             EXPECT_NE(std::string(e.what()).find("triangle 2 has a NaN or infinite coordinate, which glTF cannot store "
-                                                 "(strict reading)"),
+                                                 "(strict mode)"),
                       std::string::npos)
                 << e.what();
         }

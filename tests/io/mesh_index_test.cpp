@@ -89,7 +89,7 @@ TEST(MeshIndexer, DropsNonFiniteTrianglesOrRefusesThemUnderStrict) {
     ASSERT_EQ(ix.notes().size(), 1u);
     EXPECT_EQ(io::render(ix.notes()[0]),
               "1 of the 3 triangles have a NaN or infinite coordinate, which glTF cannot store: left "
-              "out (strict reading makes this an error)");
+              "out (strict mode makes this an error)");
     io::MeshIndexer strict("out.drc", "Draco", {}, true);
     strict.add(chunk_of({{0, 0, 0, 1, 0, 0, 1, 1, 0}}));
     try {
@@ -98,7 +98,7 @@ TEST(MeshIndexer, DropsNonFiniteTrianglesOrRefusesThemUnderStrict) {
     } catch (const io::Error& e) {
         EXPECT_EQ(e.file(), "out.drc");
         EXPECT_NE(std::string(e.what()).find("triangle 1 has a NaN or infinite coordinate, which Draco cannot store "
-                                             "(strict reading)"),
+                                             "(strict mode)"),
                   std::string::npos)
             << e.what();
     }
@@ -172,7 +172,7 @@ TEST(MeshIndexer, GrowsPastTheInitialTable) {
 }
 
 // A count near 2^64 (a broken header) made the estimate wrap: "need at least 16777216 TiB …
-// give the memory budget 0M or more".
+// give --memory 0M or more".
 TEST(BudgetCheck, AnAbsurdCountIsRefusedWithALowerBoundThatDoesNotWrap) {
     io::WriteOptions options;
     options.memory_budget_bytes = uint64_t{256} << 20;

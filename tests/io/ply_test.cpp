@@ -940,7 +940,7 @@ TEST(PlyReader, HeaderLinesThatAreNoKeywordAreSkippedWithOneWarning) {
     } catch (const io::Error& e) {
         EXPECT_EQ(e.line(), 3u);
         EXPECT_EQ(e.byte_offset(), head.size());
-        EXPECT_NE(e.message().find("unknown keyword 'Created' (strict reading)"), std::string::npos) << e.what();
+        EXPECT_NE(e.message().find("unknown keyword 'Created' (strict mode)"), std::string::npos) << e.what();
     }
 }
 
@@ -988,7 +988,7 @@ TEST(PlyReader, FacesOfFewerThanThreeVerticesAreCountedOrStrictErrors) {
             EXPECT_EQ(e.line(), c.line);
             EXPECT_EQ(e.byte_offset(), c.offset);
             EXPECT_NE(
-                e.message().find("face with " + std::string(c.count == 3 ? "2" : "1") + " vertices (strict reading)"),
+                e.message().find("face with " + std::string(c.count == 3 ? "2" : "1") + " vertices (strict mode)"),
                 std::string::npos)
                 << e.what();
         }

@@ -488,10 +488,10 @@ TEST(StlReader, AsciiLenientFacetsAreCountedWarningsOrStrictErrors) {
     }
     // --strict: the first of them is an error naming its line.
     EXPECT_STREQ(error_of([&] { read_memory(text, "lenient.stl", true, 16, kWhole, strict_options()); }).what(),
-                 "lenient.stl:2: facet with 4 vertices (strict reading)");
+                 "lenient.stl:2: facet with 4 vertices (strict mode)");
     const std::string two = "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nendloop\n";
     EXPECT_STREQ(error_of([&] { read_memory(two, "two.stl", true, 16, kWhole, strict_options()); }).what(),
-                 "two.stl:2: facet with 2 vertices (strict reading)");
+                 "two.stl:2: facet with 2 vertices (strict mode)");
     const std::string open =
         "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
         "endloop\nendfacet\n";
@@ -565,7 +565,7 @@ TEST(StlReader, AsciiBadInputNamesLine) {
         {"solid x\nfacet normal 0 0 1\nouter loop\nvertex 1 2 3 4\n", "bad.stl:4: expected 'vertex', found '4'"},
         // Read with a counted warning, except under --strict (as here).
         {"solid x\nfacet normal 0 0 1\nouter loop\nvertex 1 2 3\nvertex 1 2 3\nendloop\n",
-         "bad.stl:2: facet with 2 vertices (strict reading)"},
+         "bad.stl:2: facet with 2 vertices (strict mode)"},
         {"solid x\nfacet normal 0 0 1 7 8\nouter loop\n", "bad.stl:2: expected 'outer', found '7'"},
         {"solid x\nfacet normal 0 0 1\nouter loop\nvertex 1 +-2 3\n", "bad.stl:4: expected a number, found '+-2'"},
         {"solid x\nfacet normal 0 0 1\nouter loop\nvertex 1 2 1e999z\n",

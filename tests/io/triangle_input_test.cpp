@@ -111,7 +111,7 @@ TEST(TriangleInput, RefuseNamesTheFileAndTheOrdinal) {
         drain(nan);
         FAIL() << "no error";
     } catch (const io::Error& e) {
-        EXPECT_STREQ(e.what(), "mem.stl: triangle 2 has a NaN or infinite coordinate (strict reading)");
+        EXPECT_STREQ(e.what(), "mem.stl: triangle 2 has a NaN or infinite coordinate (strict mode)");
     }
     const std::vector<float> all = mixed();
     std::vector<float> degenerate(all.begin() + 27, all.end());  // from triangle 3 on
@@ -120,7 +120,7 @@ TEST(TriangleInput, RefuseNamesTheFileAndTheOrdinal) {
         drain(deg);
         FAIL() << "no error";
     } catch (const io::Error& e) {
-        EXPECT_STREQ(e.what(), "mem.stl: triangle 1 is degenerate (two corners at the same position) (strict reading)");
+        EXPECT_STREQ(e.what(), "mem.stl: triangle 1 is degenerate (two corners at the same position) (strict mode)");
     }
 }
 

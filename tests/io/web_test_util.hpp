@@ -46,7 +46,14 @@ inline Soup read_soup(const std::string& path, size_t capacity = io::TriangleChu
     return s;
 }
 
-// Writes `soup` to `path`; returns the writer's notes.
+// The writer's notes in the library's words (io::render).
+inline std::vector<std::string> notes_in_words(const io::Writer& writer) {
+    std::vector<std::string> out;
+    for (const std::string& note : writer.notes()) out.push_back(io::render(note));
+    return out;
+}
+
+// Writes `soup` to `path`; returns the writer's notes in the library's words.
 inline std::vector<std::string> write_soup(const Soup& soup, const std::string& path,
                                            const io::WriteOptions& options = {}) {
     io::Output out = io::open_output(path, {}, options);
@@ -62,7 +69,7 @@ inline std::vector<std::string> write_soup(const Soup& soup, const std::string& 
     }
     if (!chunk.empty()) out.write(chunk);
     out.finish();
-    return out.writer->notes();
+    return notes_in_words(*out.writer);
 }
 
 // A soup with every channel its reader fills (the header's), corner by corner.
@@ -99,7 +106,7 @@ inline Mesh read_mesh(const std::string& path) {
 }
 
 // Writes `m` to `path` with the channels the output format keeps of m's (and its materials),
-// the way convert does; returns the writer's notes.
+// the way convert does; returns the writer's notes in the library's words.
 inline std::vector<std::string> write_mesh(const Mesh& m, const std::string& path, io::WriteOptions options = {}) {
     const io::Format& format = io::output_format(path, {});
     const io::Channels& in = m.header.channels;
@@ -128,7 +135,7 @@ inline std::vector<std::string> write_mesh(const Mesh& m, const std::string& pat
     }
     if (!chunk.empty()) out.write(chunk);
     out.finish();
-    return out.writer->notes();
+    return notes_in_words(*out.writer);
 }
 
 // The largest differences between the channels of two meshes holding the same triangles in

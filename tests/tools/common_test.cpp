@@ -2,16 +2,48 @@
 // tested through the binary in cli_*_test.cpp).
 #include "tools/common.hpp"
 
+#include "io/error.hpp"
 #include "test_util.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cstdlib>
 #include <fstream>
+#include <stdexcept>
 #include <string>
 
 namespace meshstream::tools {
 namespace {
+
+// The libraries' messages mention settings; the command names them by its flags, so that what
+// it prints does not change with the library's words for them.
+TEST(FlagName, EverySettingHasTheFlagThatSetsIt) {
+    EXPECT_EQ(flag_name(io::Setting::kMemory), "--memory");
+    EXPECT_EQ(flag_name(io::Setting::kDracoPositionBits), "--draco-qp");
+    EXPECT_EQ(flag_name(io::Setting::kAttributes), "--attributes");
+    EXPECT_EQ(flag_name(io::Setting::kInput), "IN");
+    for (int i = 0; i < io::kSettingCount; ++i) {
+        const std::string flag = flag_name(io::Setting(i));
+        SCOPED_TRACE(flag);
+        // A flag, an argument, or (set by no flag) the library's words.
+        EXPECT_TRUE(flag.starts_with("--") || flag == "IN" || flag == "OUT" ||
+                    flag == io::setting_words(io::Setting(i)));
+        for (int j = 0; j < i; ++j) EXPECT_NE(flag, flag_name(io::Setting(j))) << j;
+    }
+}
+
+TEST(FlagName, ErrorsAreDescribedWithFlagsAndQuotedErrorsKeepThem) {
+    const io::Error read("big.glb", 12, 0,
+                         "over the memory budget of 1 MiB; raise " + io::mention(io::Setting::kMemory));
+    EXPECT_STREQ(read.what(), "big.glb: byte 12: over the memory budget of 1 MiB; raise the memory budget");
+    EXPECT_EQ(describe_error(read), "big.glb: byte 12: over the memory budget of 1 MiB; raise --memory");
+    const io::Error quoting(read.file(), read.byte_offset(), read.line(), read.raw_message() + " (sorting)");
+    EXPECT_EQ(describe_error(quoting), "big.glb: byte 12: over the memory budget of 1 MiB; raise --memory (sorting)");
+    const io::OptionError option(io::Setting::kDracoLevel,
+                                 io::mention(io::Setting::kDracoLevel) + " must be 0-10, got 11");
+    EXPECT_EQ(describe_error(option), "--draco-cl must be 0-10, got 11");
+    EXPECT_EQ(describe_error(std::runtime_error("plain")), "plain");
+}
 
 TEST(DropList, NamesTheKindsNotRead) {
     const io::ChannelKinds all = kept_channel_kinds("");

@@ -67,6 +67,27 @@ TEST(CliInfo, ListsChannelsAndWarningsInJson) {
     EXPECT_FALSE(j.contains("warnings"));
 }
 
+// The readers' findings name the settings they are about as the library's mentions; info shows
+// them with the flag, in text and --json (the OBJ reader's are notes, "warning: ...").
+TEST(CliInfo, NamesTheSettingsInTheReadersFindingsByTheirFlags) {
+    TempDir dir;
+    std::FILE* f = std::fopen((dir / "t.obj").c_str(), "w");
+    std::fputs("mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl a\nf 1/1 2/2 3/3\n", f);
+    std::fclose(f);
+    f = std::fopen((dir / "m.mtl").c_str(), "w");
+    std::fputs("newmtl a\nKd 1 1 1\nmap_Kd big.png\n", f);
+    std::fclose(f);
+    f = std::fopen((dir / "big.png").c_str(), "w");
+    for (int i = 0; i < 100000; ++i) std::fputc(i & 0xff, f);  // past a budget of 64K
+    std::fclose(f);
+    const std::string text = info(dir, "--memory 64K " + dir / "t.obj");
+    EXPECT_NE(text.find("warning:     texture images past --memory not loaded, kept by name only: "), std::string::npos)
+        << text;
+    const nlohmann::json j = nlohmann::json::parse(info(dir, "--json --memory 64K " + dir / "t.obj"));
+    EXPECT_EQ(j["notes"]["warning"].get<std::string>().rfind("texture images past --memory not loaded", 0), 0u)
+        << j["notes"];
+}
+
 // A lenient read is reported by info as by the other commands: with the position of the first
 // case and the count.
 TEST(CliInfo, ShowsLenientReadsWithPositionAndCount) {
