@@ -60,7 +60,7 @@ enum class Setting : uint8_t {
 };
 inline constexpr int kSettingCount = int(Setting::kOutputChunk) + 1;
 
-// The setting in a library user's words: "the memory budget", "strict reading".
+// The setting in a library user's words: "the memory budget", "strict mode".
 std::string_view setting_words(Setting setting);
 // A mark standing for `setting` in a message (an io::Error's, an io::OptionError's, a warning's).
 std::string mention(Setting setting);

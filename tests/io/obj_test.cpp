@@ -608,7 +608,7 @@ TEST(ObjMaterials, UsemtlWithoutANameIsTheDefaultMaterial) {
         ADD_FAILURE() << "no error under --strict";
     } catch (const io::Error& e) {
         EXPECT_EQ(e.file(), dir / "late.obj");
-        EXPECT_EQ(e.message(), "'usemtl' without a material name (strict reading)");
+        EXPECT_EQ(e.message(), "'usemtl' without a material name (strict mode)");
         EXPECT_EQ(e.line(), 8u);
         EXPECT_EQ(e.byte_offset(), 66u);
     }
