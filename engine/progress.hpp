@@ -46,9 +46,9 @@ private:
 };
 
 // Thrown by a call whose ProgressSink said cancelled(): nothing of its output is left behind.
-class Cancelled : public std::runtime_error {
+class Cancelled : public meshstream::Error {
 public:
-    Cancelled() : std::runtime_error("cancelled") {}
+    Cancelled() : meshstream::Error("cancelled") {}
 };
 
 // Throws Cancelled once `progress` says cancelled().
