@@ -463,9 +463,9 @@ void check_part_settings(const DecimateSettings& s) {
                                                      mention(Setting::kThreads) + " does not go with it");
     // Every job opens the input by its name and reads it from its start to its range.
     if (!is_regular_file(s.input))
-        throw io::OptionError(Setting::kPart, shown_input(s.input) + ": " + both +
-                                                  ": every job reads IN from its start, so IN must be a file, not '-' "
-                                                  "or a pipe");
+        throw io::OptionError(Setting::kPart, shown_input(s.input) + ": " + both + ": every job reads " +
+                                                  mention(Setting::kInput) + " from its start, so " +
+                                                  mention(Setting::kInput) + " must be a file, not '-' or a pipe");
     if (s.sort == SortPolicy::kAlways)
         throw io::OptionError(Setting::kSort, both + ": " + mention(Setting::kSort) + " always" +
                                                   " decimates a sorted stream in one job; sort first (meshstream sort "
