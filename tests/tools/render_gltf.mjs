@@ -13,33 +13,18 @@
 // /opt/meshstream-tools/node_modules (tools/bootstrap.sh installs it there); Chromium is
 // $CHROMIUM, else `chromium` on the PATH (Debian's package).
 import fs from 'node:fs';
-import http from 'node:http';
-import os from 'node:os';
 import path from 'node:path';
-import { spawn, spawnSync } from 'node:child_process';
+import { below, modulesDir, requireTools, runPage } from './headless.mjs';
 
 const args = process.argv.slice(2);
-let modules = path.join(process.env.MESHSTREAM_TOOLS_DIR || '/opt/meshstream-tools', 'node_modules');
-const m = args.indexOf('--modules');
-if (m >= 0) {
-    modules = args[m + 1];
-    args.splice(m, 2);
-}
+const modules = modulesDir(args);
 const [outDir, ...files] = args;
 if (!outDir || files.length === 0) {
     console.error('usage: node render_gltf.mjs OUT_DIR FILE... [--modules NODE_MODULES_DIR]');
     process.exit(2);
 }
+const chromium = requireTools('render_gltf', modules, [['three', 'build/three.module.js']]);
 const three = path.join(modules, 'three');
-if (!fs.existsSync(path.join(three, 'build', 'three.module.js'))) {
-    console.error(`render_gltf: three.js not found in ${modules} (run tools/bootstrap.sh)`);
-    process.exit(2);
-}
-const chromium = process.env.CHROMIUM || 'chromium';
-if (spawnSync(chromium, ['--version']).status !== 0) {
-    console.error(`render_gltf: cannot run ${chromium} (Debian package 'chromium'; run tools/bootstrap.sh)`);
-    process.exit(2);
-}
 fs.mkdirSync(outDir, { recursive: true });
 
 const page = `<!doctype html><html><head><meta charset="utf-8">
@@ -118,79 +103,33 @@ for (let n = 0; n < count; ++n) {
 }
 </script></body></html>`;
 
-const types = { '.js': 'text/javascript', '.mjs': 'text/javascript', '.wasm': 'application/wasm', '.html': 'text/html' };
 const results = new Array(files.length).fill(null);
 let done = 0;
-let finish;
-const finished = new Promise((resolve) => (finish = resolve));
-
-const server = http.createServer((req, res) => {
-    const url = decodeURIComponent(req.url.split('?')[0]);
-    if (req.method === 'POST' && url.startsWith('/result/')) {
-        let body = '';
-        req.on('data', (d) => (body += d));
-        req.on('end', () => {
-            const n = Number(url.slice(8));
-            const r = JSON.parse(body);
-            if (r.png) {
-                fs.writeFileSync(path.join(outDir, `${n}.png`), Buffer.from(r.png.split(',')[1], 'base64'));
-                delete r.png;
-            }
-            results[n] = { file: files[n], ...r };
-            res.end('ok');
-            if (++done === files.length) finish();
-        });
-        return;
-    }
-    let file;
-    if (url === '/' || url === '/index.html') {
-        res.setHeader('Content-Type', 'text/html');
-        res.end(page);
-        return;
-    } else if (url.startsWith('/file/')) {
-        // /file/<n>/<path>: file n's directory (its own name, or what its URIs name).
-        const slash = url.indexOf('/', 6);
-        const n = Number(url.slice(6, slash));
-        const rest = path.normalize(url.slice(slash + 1));
-        if (slash > 6 && n >= 0 && n < files.length && !rest.startsWith('..')) file = path.join(path.dirname(files[n]), rest);
-    } else if (url.startsWith('/three/')) {
-        const rest = path.normalize(url.slice(7));
-        if (!rest.startsWith('..')) file = path.join(three, rest);
-    }
-    if (!file || !fs.existsSync(file) || !fs.statSync(file).isFile()) {
-        res.statusCode = 404;
-        res.end();
-        return;
-    }
-    res.setHeader('Content-Type', types[path.extname(file)] || 'application/octet-stream');
-    fs.createReadStream(file).pipe(res);
+const outcome = await runPage({
+    chromium, name: 'render_gltf', timeoutMs: 90000, page,
+    serve(url) {
+        if (url.startsWith('/file/')) {
+            // /file/<n>/<path>: file n's directory (its own name, or what its URIs name).
+            const slash = url.indexOf('/', 6);
+            const n = Number(url.slice(6, slash));
+            if (slash > 6 && n >= 0 && n < files.length) return below(path.dirname(files[n]), url.slice(slash + 1));
+        } else if (url.startsWith('/three/')) {
+            return below(three, url.slice(7));
+        }
+        return undefined;
+    },
+    post(url, body, finish) {
+        if (!url.startsWith('/result/')) return;
+        const n = Number(url.slice(8));
+        const r = JSON.parse(body);
+        if (r.png) {
+            fs.writeFileSync(path.join(outDir, `${n}.png`), Buffer.from(r.png.split(',')[1], 'base64'));
+            delete r.png;
+        }
+        results[n] = { file: files[n], ...r };
+        if (++done === files.length) finish('done');
+    },
 });
-await new Promise((resolve) => server.listen(0, '127.0.0.1', resolve));
-const port = server.address().port;
-
-const profile = fs.mkdtempSync(path.join(os.tmpdir(), 'render-gltf-'));
-const browser = spawn(chromium, [
-    '--headless=new', '--no-sandbox', '--no-first-run', '--disable-extensions', '--mute-audio',
-    '--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--ignore-gpu-blocklist',
-    `--user-data-dir=${profile}`, `http://127.0.0.1:${port}/index.html`,
-], { stdio: ['ignore', 'ignore', 'pipe'], detached: true });  // its own process group, ended whole below
-const exited = new Promise((resolve) => browser.on('exit', resolve));
-let browserLog = '';
-browser.stderr.on('data', (d) => (browserLog = (browserLog + d).slice(-4000)));
-const timer = setTimeout(() => finish('timeout'), 90000);
-const outcome = await finished;
-clearTimeout(timer);
-try {
-    process.kill(-browser.pid, 'SIGKILL');  // Chromium's renderer and GPU processes too
-} catch (e) {
-    // already gone
-}
-await exited;
-server.close();
-fs.rmSync(profile, { recursive: true, force: true, maxRetries: 5, retryDelay: 200 });
-if (outcome === 'timeout') {
-    console.error(`render_gltf: no report from the page within 90 s (${done} of ${files.length}); chromium said:\n${browserLog}`);
-    process.exit(2);
-}
+if (outcome === 'timeout') process.exit(2);
 console.log(JSON.stringify(results, null, 2));
 process.exit(0);
