@@ -201,9 +201,9 @@ py::array_t<T> owning_array(std::vector<T>&& values, std::vector<py::ssize_t> sh
     return py::array_t<T>(shape, held->data(), owner);
 }
 
-// A view of `count` values at `data`, shaped `shape`, kept alive by `base`.
+// A numpy view of the values at `data`, shaped `shape` (C order), kept alive by `base`.
 template <class T>
-py::array_t<T> view(const T* data, std::vector<py::ssize_t> shape, py::handle base) {
+py::object view(const T* data, std::vector<py::ssize_t> shape, py::handle base) {
     return py::array_t<T>(shape, data, base);
 }
 
@@ -296,22 +296,31 @@ py::dict channels_dict(const io::Channels& c) {
 
 // ---- reading ------------------------------------------------------------------------------
 
-// The read flags of info (--from, --memory, --tmpdir, --strict) and --drop.
-struct ReadCall {
+// The flags of a call that reads (--from, --memory, --tmpdir, --strict, --drop) or writes
+// (--to, --gzip-level, --compress, --normals, --draco-*, and --memory, --tmpdir, --strict for
+// the writer), from its keyword arguments.
+struct FlagsCall {
     CLI::App app;
-    tools::ReadFlags flags;
-    ReadCall(const std::string& call, const py::kwargs& kwargs) {
-        CLI::App* cmd = app.add_subcommand("read");
-        tools::add_read_flags(cmd, flags);
-        tools::add_drop_flag(cmd, flags);
-        apply_flags(cmd, call, kwargs);
+    tools::ReadFlags read;
+    tools::WriteFlags write;
+    enum Kind { kRead, kWrite };
+    FlagsCall(Kind kind, const std::string& call, const py::kwargs& kwargs) {
+        CLI::App* cmd = app.add_subcommand(call);
+        tools::add_read_flags(cmd, read);
+        if (kind == kRead) {
+            tools::add_drop_flag(cmd, read);
+            apply_flags(cmd, call, kwargs);
+        } else {
+            tools::add_write_flags(cmd, write);
+            apply_flags(cmd, call, kwargs, {"from", "no-draco", "drop"});
+        }
     }
 };
 
 py::dict read_mesh(const std::string& path, const py::kwargs& kwargs) {
-    ReadCall call("read", kwargs);
+    FlagsCall call(FlagsCall::kRead, "read", kwargs);
     PythonProgress progress{py::none()};
-    io::IndexedFile file = run_job(progress, [&] { return io::read_indexed(path, call.flags.options(), call.flags.from); });
+    io::IndexedFile file = run_job(progress, [&] { return io::read_indexed(path, call.read.options(), call.read.from); });
     io::IndexedMesh& mesh = file.mesh;
     const py::ssize_t n = py::ssize_t(mesh.vertex_count()), m = py::ssize_t(mesh.triangle_count());
     py::dict d;
@@ -363,16 +372,28 @@ struct ChunkView {
     }
 };
 
+// A Chunk property: `get(chunk, triangles, self)` makes its arrays, views kept alive by self
+// (a default py::object is None).
+template <class Get>
+auto chunk_array(Get get) {
+    return [get](py::handle self) -> py::object {
+        const ChunkView& c = self.cast<const ChunkView&>();
+        c.check();
+        py::object out = get(static_cast<const io::TriangleChunk&>(*c.chunk), py::ssize_t(c.chunk->size()), self);
+        return out ? out : py::none();
+    };
+}
+
 class ChunkReader {
 public:
     ChunkReader(const std::string& path, size_t capacity, const py::kwargs& kwargs)
-        : call_("chunks", kwargs), progress_(py::none()) {
+        : call_(FlagsCall::kRead, "chunks", kwargs), progress_(py::none()) {
         if (capacity == 0) throw py::value_error("capacity: must be at least 1 triangle");
         input_.emplace(run_job(progress_, [&] {
-            return io::TriangleInput(io::open_input(path, call_.flags.from, call_.flags.options()),
+            return io::TriangleInput(io::open_input(path, call_.read.from, call_.read.options()),
                                      io::BadTriangles::kKeep);
         }));
-        const io::ReadOptions options = call_.flags.options();
+        const io::ReadOptions options = call_.read.options();
         chunk_ = std::make_shared<io::TriangleChunk>(capacity, options.channels.of(input_->header().channels));
     }
     ChunkView next() {
@@ -390,7 +411,7 @@ public:
     const io::Channels& channels() const { return chunk_->channels(); }
 
 private:
-    ReadCall call_;
+    FlagsCall call_;
     PythonProgress progress_;
     std::optional<io::TriangleInput> input_;
     io::MeshHeader header_;  // once the input is closed
@@ -399,20 +420,6 @@ private:
 };
 
 // ---- writing ------------------------------------------------------------------------------
-
-// The write flags of convert (--to, --gzip-level, --compress, --normals, --draco-*) and
-// --memory, --tmpdir, --strict for the writer.
-struct WriteCall {
-    CLI::App app;
-    tools::ReadFlags read;
-    tools::WriteFlags write;
-    WriteCall(const std::string& call, const py::kwargs& kwargs) {
-        CLI::App* cmd = app.add_subcommand("write");
-        tools::add_write_flags(cmd, write);
-        tools::add_read_flags(cmd, read);
-        apply_flags(cmd, call, kwargs, {"from", "no-draco"});
-    }
-};
 
 template <class T>
 using carray = py::array_t<T, py::array::c_style | py::array::forcecast>;
@@ -459,7 +466,7 @@ io::Channels channels_of(const ArraysIn& in, const std::string& color_type, bool
 class StreamWriter {
 public:
     StreamWriter(std::string path, std::vector<io::Material> materials, const py::kwargs& kwargs)
-        : path_(std::move(path)), materials_(std::move(materials)), call_("Writer", kwargs), progress_(py::none()) {
+        : path_(std::move(path)), materials_(std::move(materials)), call_(FlagsCall::kWrite, "Writer", kwargs), progress_(py::none()) {
         format_ = &run_job(progress_, [&]() -> const io::Format& { return tools::resolve_output_format(path_, call_.write); });
     }
     // Opens the output for chunks of `channels` (once); returns the channels the writer keeps.
@@ -520,7 +527,7 @@ public:
 private:
     std::string path_;
     std::vector<io::Material> materials_;
-    WriteCall call_;
+    FlagsCall call_;
     PythonProgress progress_;
     const io::Format* format_ = nullptr;
     io::Channels in_channels_, kept_;
@@ -716,75 +723,43 @@ PYBIND11_MODULE(_meshstream, m) {
           py::arg("colors"), py::arg("color_type"), py::arg("color_alpha"), py::arg("uvs"), py::arg("scalars"),
           py::arg("scalar_types"), py::arg("face_materials"), py::arg("materials"));
 
+    using Chunk = io::TriangleChunk;
     py::class_<ChunkView>(m, "Chunk", "One chunk of a stream: views valid until the reader's next chunk")
         .def("__len__", [](const ChunkView& c) { return c.chunk->size(); })
-        .def_property_readonly("positions",
-                               [](py::handle self) {
-                                   const ChunkView& c = self.cast<const ChunkView&>();
-                                   c.check();
-                                   return view(c.chunk->xyz().data(), {py::ssize_t(c.chunk->size()), 3, 3}, self);
-                               })
-        .def_property_readonly("normals",
-                               [](py::handle self) -> py::object {
-                                   const ChunkView& c = self.cast<const ChunkView&>();
-                                   c.check();
-                                   if (!c.chunk->channels().normal) return py::none();
-                                   return view(c.chunk->normals().data(), {py::ssize_t(c.chunk->size()), 3, 3}, self);
-                               })
-        .def_property_readonly("colors",
-                               [](py::handle self) -> py::object {
-                                   const ChunkView& c = self.cast<const ChunkView&>();
-                                   c.check();
-                                   if (!c.chunk->channels().color) return py::none();
-                                   return view(c.chunk->colors().data(), {py::ssize_t(c.chunk->size()), 3, 4}, self);
-                               })
-        .def_property_readonly("uvs",
-                               [](py::handle self) {
-                                   const ChunkView& c = self.cast<const ChunkView&>();
-                                   c.check();
+        .def_property_readonly("positions", chunk_array([](const Chunk& k, py::ssize_t t, py::handle self) {
+                                   return view(k.xyz().data(), {t, 3, 3}, self);
+                               }))
+        .def_property_readonly("normals", chunk_array([](const Chunk& k, py::ssize_t t, py::handle self) {
+                                   return k.channels().normal ? view(k.normals().data(), {t, 3, 3}, self) : py::object();
+                               }))
+        .def_property_readonly("colors", chunk_array([](const Chunk& k, py::ssize_t t, py::handle self) {
+                                   return k.channels().color ? view(k.colors().data(), {t, 3, 4}, self) : py::object();
+                               }))
+        .def_property_readonly("uvs", chunk_array([](const Chunk& k, py::ssize_t t, py::handle self) {
                                    py::list out;
-                                   for (int s = 0; s < c.chunk->channels().uv_sets; ++s)
-                                       out.append(view(static_cast<const io::TriangleChunk&>(*c.chunk).uv_at(0, s),
-                                                       {py::ssize_t(c.chunk->size()), 3, 2}, self));
-                                   return out;
-                               })
-        .def_property_readonly("vertex_scalars",
-                               [](py::handle self) {
-                                   const ChunkView& c = self.cast<const ChunkView&>();
-                                   c.check();
+                                   for (int s = 0; s < k.channels().uv_sets; ++s) out.append(view(k.uv_at(0, s), {t, 3, 2}, self));
+                                   return py::object(out);
+                               }))
+        .def_property_readonly("vertex_scalars", chunk_array([](const Chunk& k, py::ssize_t t, py::handle self) {
                                    py::dict out;
-                                   const auto& list = c.chunk->channels().vertex_scalars;
-                                   for (size_t k = 0; k < list.size(); ++k)
-                                       out[py::str(list[k].name)] =
-                                           view(static_cast<const io::TriangleChunk&>(*c.chunk).vertex_scalar_at(0, k),
-                                                {py::ssize_t(c.chunk->size()), 3}, self);
-                                   return out;
-                               })
-        .def_property_readonly("face_scalars",
-                               [](py::handle self) {
-                                   const ChunkView& c = self.cast<const ChunkView&>();
-                                   c.check();
+                                   const auto& list = k.channels().vertex_scalars;
+                                   for (size_t c = 0; c < list.size(); ++c)
+                                       out[py::str(list[c].name)] = view(k.vertex_scalar_at(0, c), {t, 3}, self);
+                                   return py::object(out);
+                               }))
+        .def_property_readonly("face_scalars", chunk_array([](const Chunk& k, py::ssize_t t, py::handle self) {
                                    py::dict out;
-                                   const auto& list = c.chunk->channels().face_scalars;
-                                   for (size_t k = 0; k < list.size(); ++k)
-                                       out[py::str(list[k].name)] =
-                                           view(static_cast<const io::TriangleChunk&>(*c.chunk).face_scalar_at(0, k),
-                                                {py::ssize_t(c.chunk->size())}, self);
-                                   return out;
-                               })
-        .def_property_readonly("materials",
-                               [](py::handle self) -> py::object {
-                                   const ChunkView& c = self.cast<const ChunkView&>();
-                                   c.check();
-                                   if (!c.chunk->channels().material) return py::none();
-                                   return view(c.chunk->materials().data(), {py::ssize_t(c.chunk->size())}, self);
-                               })
-        .def_property_readonly("vertex_ids", [](py::handle self) -> py::object {
-            const ChunkView& c = self.cast<const ChunkView&>();
-            c.check();
-            if (!c.chunk->channels().vertex_id) return py::none();
-            return view(c.chunk->vertex_ids().data(), {py::ssize_t(c.chunk->size()), 3}, self);
-        });
+                                   const auto& list = k.channels().face_scalars;
+                                   for (size_t c = 0; c < list.size(); ++c)
+                                       out[py::str(list[c].name)] = view(k.face_scalar_at(0, c), {t}, self);
+                                   return py::object(out);
+                               }))
+        .def_property_readonly("materials", chunk_array([](const Chunk& k, py::ssize_t t, py::handle self) {
+                                   return k.channels().material ? view(k.materials().data(), {t}, self) : py::object();
+                               }))
+        .def_property_readonly("vertex_ids", chunk_array([](const Chunk& k, py::ssize_t t, py::handle self) {
+                                   return k.channels().vertex_id ? view(k.vertex_ids().data(), {t, 3}, self) : py::object();
+                               }));
 
     py::class_<ChunkReader>(m, "ChunkReader", "The chunks of a mesh file, one at a time (meshstream.chunks)")
         .def(py::init<const std::string&, size_t, const py::kwargs&>(), py::arg("path"),

@@ -319,10 +319,7 @@ CLI::App* compare_command(CLI::App& app, CompareCliOptions& options) {
 
 void add_compare(CLI::App& app) {
     auto opt = std::make_shared<CompareCliOptions>();
-    compare_command(app, *opt)->callback([opt] {
-        const nlohmann::ordered_json report = compare_job(*opt);
-        if (opt->json) std::printf("%s\n", report.dump(2).c_str());
-    });
+    run_when_parsed(compare_command(app, *opt), opt, [](CompareCliOptions& o) { return compare_job(o); }, 2);
 }
 
 }  // namespace meshstream::tools

@@ -31,15 +31,8 @@ nlohmann::ordered_json convert_job(const ConvertOptions& opt, engine::ProgressSi
     Warnings warnings = result.warnings;
     note_unused_write_flags(opt.write, out_format, opt.output, warnings);
     print_warnings(warnings);
-    RunReport report;
-    report.command = "convert";
-    report.inputs = {{opt.input, result.input_format, result.input_gzip}};
-    report.outputs = {{opt.output, result.output_format, result.output_gzip}};
-    report.triangles_in = result.triangles_in;
-    report.triangles_out = result.triangles_out;
-    report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    report.peak_rss_bytes = peak_rss_bytes();
-    return run_report_json(report, warnings);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return run_report_json(run_report_of("convert", opt.input, opt.output, result, seconds), warnings);
 }
 
 CLI::App* convert_command(CLI::App& app, ConvertOptions& options) {
@@ -64,10 +57,7 @@ CLI::App* convert_command(CLI::App& app, ConvertOptions& options) {
 
 void add_convert(CLI::App& app) {
     auto opt = std::make_shared<ConvertOptions>();
-    convert_command(app, *opt)->callback([opt] {
-        const nlohmann::ordered_json report = convert_job(*opt);
-        if (opt->json) print_json(report);
-    });
+    run_when_parsed(convert_command(app, *opt), opt, [](ConvertOptions& o) { return convert_job(o); });
 }
 
 }  // namespace meshstream::tools

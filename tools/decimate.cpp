@@ -255,14 +255,7 @@ nlohmann::ordered_json decimate_job(const DecimateOptions& opt, RangeProcesses* 
     note_decimate_warnings(facts, warnings);
     print_warnings(warnings);
 
-    RunReport report;
-    report.command = "decimate";
-    report.inputs = {{opt.input, result.input_format, result.input_gzip}};
-    report.outputs = {{opt.output, result.output_format, result.output_gzip}};
-    report.triangles_in = result.triangles_in;
-    report.triangles_out = result.triangles_out;
-    report.seconds = seconds;
-    report.peak_rss_bytes = peak_rss_bytes();
+    RunReport report = run_report_of("decimate", opt.input, opt.output, result, seconds);
     report.details = decimate_details_json(facts);
     if (part) {
         nlohmann::ordered_json files = nlohmann::ordered_json::array();
@@ -385,10 +378,9 @@ void add_decimate(CLI::App& app, RangeProcesses* processes) {
     auto opt = std::make_shared<DecimateOptions>();
     CLI::App* cmd = decimate_command(app, *opt, processes);
     const CLI::Option* threads = cmd->get_option_no_throw("--threads");
-    cmd->callback([opt, processes, threads] {
-        opt->threads_given = threads && threads->count() > 0;
-        const nlohmann::ordered_json report = decimate_job(*opt, processes);
-        if (opt->json && !report.is_null()) print_json(report);
+    run_when_parsed(cmd, opt, [processes, threads](DecimateOptions& o) {
+        o.threads_given = threads && threads->count() > 0;
+        return decimate_job(o, processes);
     });
 }
 

@@ -323,10 +323,7 @@ CLI::App* info_command(CLI::App& app, InfoOptions& options) {
 
 void add_info(CLI::App& app) {
     auto opt = std::make_shared<InfoOptions>();
-    info_command(app, *opt)->callback([opt] {
-        const nlohmann::ordered_json report = info_job(*opt);
-        if (opt->json) std::printf("%s\n", report.dump(2).c_str());
-    });
+    run_when_parsed(info_command(app, *opt), opt, [](InfoOptions& o) { return info_job(o); }, 2);
 }
 
 }  // namespace meshstream::tools

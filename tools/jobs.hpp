@@ -14,6 +14,8 @@
 #include <nlohmann/json.hpp>
 
 #include <cstdint>
+#include <cstdio>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -39,15 +41,10 @@ CLI::App* convert_command(CLI::App& app, ConvertOptions& opt);
 // The --json object of convert (tools/run_report.hpp).
 nlohmann::ordered_json convert_job(const ConvertOptions& opt, engine::ProgressSink* progress = nullptr);
 
-struct SortOptions {
-    std::string input, output;
+// sort's options: convert's and these.
+struct SortOptions : ConvertOptions {
     std::string axis = "auto";  // x, y, z or auto
     bool stats = false;         // --stats' line on stderr
-    bool clean = false;
-    bool json = false;
-    unsigned threads = every_core();
-    ReadFlags read;
-    WriteFlags write;
 };
 CLI::App* sort_command(CLI::App& app, SortOptions& opt);
 nlohmann::ordered_json sort_job(const SortOptions& opt, engine::ProgressSink* progress = nullptr);
@@ -101,5 +98,15 @@ CLI::App* compare_command(CLI::App& app, CompareCliOptions& opt);
 // compare's --json object (null without `json`: the text is printed instead). A sink's
 // cancelled() is looked at between the comparison's progress steps.
 nlohmann::ordered_json compare_job(const CompareCliOptions& opt, engine::ProgressSink* progress = nullptr);
+
+// Sets `cmd`'s callback: runs `job` on the parsed options and prints its report with --json
+// (`indent` as nlohmann's dump(): -1 one line, as convert, sort and decimate print it).
+template <class Options, class Job>
+void run_when_parsed(CLI::App* cmd, std::shared_ptr<Options> opt, Job job, int indent = -1) {
+    cmd->callback([opt, job, indent] {
+        const nlohmann::ordered_json report = job(*opt);
+        if (opt->json && !report.is_null()) std::printf("%s\n", report.dump(indent).c_str());
+    });
+}
 
 }  // namespace meshstream::tools

@@ -81,14 +81,7 @@ nlohmann::ordered_json sort_job(const SortOptions& opt, engine::ProgressSink* pr
                      sort_stats_line(result.stats, result.axis, seconds_since(t0), result.input_seconds,
                                      result.sort_seconds, peak_rss_bytes())
                          .c_str());
-    RunReport report;
-    report.command = "sort";
-    report.inputs = {{opt.input, result.input_format, result.input_gzip}};
-    report.outputs = {{opt.output, result.output_format, result.output_gzip}};
-    report.triangles_in = result.triangles_in;
-    report.triangles_out = result.triangles_out;
-    report.seconds = seconds_since(t0);
-    report.peak_rss_bytes = peak_rss_bytes();
+    RunReport report = run_report_of("sort", opt.input, opt.output, result, seconds_since(t0));
     const sort::SortStats& st = result.stats;
     report.details = {{"axis", kAxisNames[result.axis]},
                       {"runs", st.runs},
@@ -135,10 +128,7 @@ CLI::App* sort_command(CLI::App& app, SortOptions& options) {
 
 void add_sort(CLI::App& app) {
     auto opt = std::make_shared<SortOptions>();
-    sort_command(app, *opt)->callback([opt] {
-        const nlohmann::ordered_json report = sort_job(*opt);
-        if (opt->json) print_json(report);
-    });
+    run_when_parsed(sort_command(app, *opt), opt, [](SortOptions& o) { return sort_job(o); });
 }
 
 }  // namespace meshstream::tools
