@@ -84,7 +84,12 @@ public:
     void update(uint64_t done, uint64_t, std::optional<uint64_t>) override { update(done); }
     void status(const std::string& text) override { phase(text, std::nullopt); }
     bool cancelled() const override { return cancelled_.load(); }
-    // Rethrows the kept Python exception (the caller holds the GIL).
+    // Raises the kept Python exception, if any: one the progress raised after the job last
+    // looked at cancelled() (the caller holds the GIL).
+    void raise_kept() {
+        if (error_) rethrow();
+    }
+    // Rethrows the kept Python exception, or KeyboardInterrupt (the caller holds the GIL).
     [[noreturn]] void rethrow() {
         if (error_) {
             error_->restore();
@@ -124,10 +129,14 @@ private:
 
 // Runs `job` without the GIL, its errors turned into Python's.
 template <class Job>
-decltype(auto) run_job(PythonProgress& progress, Job&& job) {
+auto run_job(PythonProgress& progress, Job&& job) {
     try {
-        py::gil_scoped_release nogil;
-        return job();
+        auto result = [&] {
+            py::gil_scoped_release nogil;
+            return job();
+        }();
+        progress.raise_kept();
+        return result;
     } catch (const engine::Cancelled&) {
         progress.rethrow();
     } catch (const tools::UsageError& e) {
@@ -467,7 +476,7 @@ class StreamWriter {
 public:
     StreamWriter(std::string path, std::vector<io::Material> materials, const py::kwargs& kwargs)
         : path_(std::move(path)), materials_(std::move(materials)), call_(FlagsCall::kWrite, "Writer", kwargs), progress_(py::none()) {
-        format_ = &run_job(progress_, [&]() -> const io::Format& { return tools::resolve_output_format(path_, call_.write); });
+        format_ = run_job(progress_, [&] { return &tools::resolve_output_format(path_, call_.write); });
     }
     // Opens the output for chunks of `channels` (once); returns the channels the writer keeps.
     const io::Channels& open(const io::Channels& channels, std::optional<uint64_t> triangles) {
