@@ -196,7 +196,8 @@ std::set<const CLI::Option*> apply_flags(CLI::App* cmd, const std::string& call,
     // What the command line refuses at the end of parsing: options that exclude each other.
     for (const CLI::Option* option : given)
         for (const CLI::Option* other : option->get_excludes())
-            if (given.count(other)) throw py::value_error(CLI::ExcludesError(option->get_name(), other->get_name()).what());
+            if (given.count(other))
+                throw py::value_error(CLI::ExcludesError(option->get_name(), other->get_name()).what());
     return given;
 }
 
@@ -233,8 +234,8 @@ const char* type_name(io::ScalarType t) {
 io::ScalarType scalar_type(const std::string& name, const std::string& what) {
     for (int t = 0; t <= int(io::ScalarType::kFloat64); ++t)
         if (name == type_name(io::ScalarType(t))) return io::ScalarType(t);
-    throw py::value_error(what + ": must be one of int8, uint8, int16, uint16, int32, uint32, float32, float64, found '" +
-                          name + "'");
+    throw py::value_error(
+        what + ": must be one of int8, uint8, int16, uint16, int32, uint32, float32, float64, found '" + name + "'");
 }
 
 py::list materials_list(const std::vector<io::Material>& materials) {
@@ -329,7 +330,8 @@ struct FlagsCall {
 py::dict read_mesh(const std::string& path, const py::kwargs& kwargs) {
     FlagsCall call(FlagsCall::kRead, "read", kwargs);
     PythonProgress progress{py::none()};
-    io::IndexedFile file = run_job(progress, [&] { return io::read_indexed(path, call.read.options(), call.read.from); });
+    io::IndexedFile file =
+        run_job(progress, [&] { return io::read_indexed(path, call.read.options(), call.read.from); });
     io::IndexedMesh& mesh = file.mesh;
     const py::ssize_t n = py::ssize_t(mesh.vertex_count()), m = py::ssize_t(mesh.triangle_count());
     py::dict d;
@@ -447,9 +449,11 @@ void need_shape(const py::array& a, std::vector<py::ssize_t> shape, const std::s
     for (size_t k = 0; ok && k < shape.size(); ++k) ok = shape[k] < 0 || a.shape(k) == shape[k];
     if (ok) return;
     std::string want, got;
-    for (size_t k = 0; k < shape.size(); ++k) want += (k ? "×" : "") + (shape[k] < 0 ? std::string("n") : std::to_string(shape[k]));
+    for (size_t k = 0; k < shape.size(); ++k)
+        want += (k ? "×" : "") + (shape[k] < 0 ? std::string("n") : std::to_string(shape[k]));
     for (py::ssize_t k = 0; k < a.ndim(); ++k) got += (k ? "×" : "") + std::to_string(a.shape(k));
-    throw py::value_error(what + ": expected an array of shape " + want + ", found " + (got.empty() ? "a scalar" : got));
+    throw py::value_error(what + ": expected an array of shape " + want + ", found " +
+                          (got.empty() ? "a scalar" : got));
 }
 
 // The Channels the arrays carry.
@@ -475,7 +479,10 @@ io::Channels channels_of(const ArraysIn& in, const std::string& color_type, bool
 class StreamWriter {
 public:
     StreamWriter(std::string path, std::vector<io::Material> materials, const py::kwargs& kwargs)
-        : path_(std::move(path)), materials_(std::move(materials)), call_(FlagsCall::kWrite, "Writer", kwargs), progress_(py::none()) {
+        : path_(std::move(path)),
+          materials_(std::move(materials)),
+          call_(FlagsCall::kWrite, "Writer", kwargs),
+          progress_(py::none()) {
         format_ = run_job(progress_, [&] { return &tools::resolve_output_format(path_, call_.write); });
     }
     // Opens the output for chunks of `channels` (once); returns the channels the writer keeps.
@@ -495,9 +502,8 @@ public:
         options.materials = materials_;
         options.strict = call_.read.strict;
         options.triangle_count = triangles;
-        output_.emplace(run_job(progress_, [&] {
-            return io::open_output(path_, format_->name, options, call_.write.gzip_level);
-        }));
+        output_.emplace(
+            run_job(progress_, [&] { return io::open_output(path_, format_->name, options, call_.write.gzip_level); }));
         chunk_.emplace(io::TriangleChunk::kDefaultCapacity, kept_);
         return kept_;
     }
@@ -579,7 +585,8 @@ void write_triangles(StreamWriter& w, const ArraysIn& in, const uint32_t* faces,
                                               " vertices");
                 }
                 std::memcpy(&chunk.xyz()[9 * i + 3 * size_t(k)], pos + 3 * row, 3 * sizeof(float));
-                if (kept.normal) std::memcpy(chunk.normal_at(i) + 3 * k, in.normals->data() + 3 * row, 3 * sizeof(float));
+                if (kept.normal)
+                    std::memcpy(chunk.normal_at(i) + 3 * k, in.normals->data() + 3 * row, 3 * sizeof(float));
                 if (kept.color) std::memcpy(chunk.color_at(i) + 4 * k, in.colors->data() + 4 * row, 4 * sizeof(float));
                 for (int s = 0; s < kept.uv_sets; ++s)
                     std::memcpy(chunk.uv_at(i, s) + 2 * k, in.uvs[size_t(s)].data() + 2 * row, 2 * sizeof(float));
@@ -693,9 +700,7 @@ std::string path_of(const py::object& path) {
     return py::str(py::module_::import("os").attr("fspath")(path)).cast<std::string>();
 }
 
-py::object to_python(const nlohmann::ordered_json& j) {
-    return py::module_::import("json").attr("loads")(j.dump());
-}
+py::object to_python(const nlohmann::ordered_json& j) { return py::module_::import("json").attr("loads")(j.dump()); }
 
 template <class Options, class Register, class Job>
 py::object command_call(const std::string& name, Options& opt, Register&& register_options, Job&& job,
@@ -738,15 +743,17 @@ PYBIND11_MODULE(_meshstream, m) {
         .def_property_readonly("positions", chunk_array([](const Chunk& k, py::ssize_t t, py::handle self) {
                                    return view(k.xyz().data(), {t, 3, 3}, self);
                                }))
-        .def_property_readonly("normals", chunk_array([](const Chunk& k, py::ssize_t t, py::handle self) {
-                                   return k.channels().normal ? view(k.normals().data(), {t, 3, 3}, self) : py::object();
-                               }))
+        .def_property_readonly(
+            "normals", chunk_array([](const Chunk& k, py::ssize_t t, py::handle self) {
+                return k.channels().normal ? view(k.normals().data(), {t, 3, 3}, self) : py::object();
+            }))
         .def_property_readonly("colors", chunk_array([](const Chunk& k, py::ssize_t t, py::handle self) {
                                    return k.channels().color ? view(k.colors().data(), {t, 3, 4}, self) : py::object();
                                }))
         .def_property_readonly("uvs", chunk_array([](const Chunk& k, py::ssize_t t, py::handle self) {
                                    py::list out;
-                                   for (int s = 0; s < k.channels().uv_sets; ++s) out.append(view(k.uv_at(0, s), {t, 3, 2}, self));
+                                   for (int s = 0; s < k.channels().uv_sets; ++s)
+                                       out.append(view(k.uv_at(0, s), {t, 3, 2}, self));
                                    return py::object(out);
                                }))
         .def_property_readonly("vertex_scalars", chunk_array([](const Chunk& k, py::ssize_t t, py::handle self) {
@@ -766,9 +773,10 @@ PYBIND11_MODULE(_meshstream, m) {
         .def_property_readonly("materials", chunk_array([](const Chunk& k, py::ssize_t t, py::handle self) {
                                    return k.channels().material ? view(k.materials().data(), {t}, self) : py::object();
                                }))
-        .def_property_readonly("vertex_ids", chunk_array([](const Chunk& k, py::ssize_t t, py::handle self) {
-                                   return k.channels().vertex_id ? view(k.vertex_ids().data(), {t, 3}, self) : py::object();
-                               }));
+        .def_property_readonly(
+            "vertex_ids", chunk_array([](const Chunk& k, py::ssize_t t, py::handle self) {
+                return k.channels().vertex_id ? view(k.vertex_ids().data(), {t, 3}, self) : py::object();
+            }));
 
     py::class_<ChunkReader>(m, "ChunkReader", "The chunks of a mesh file, one at a time (meshstream.chunks)")
         .def(py::init<const std::string&, size_t, const py::kwargs&>(), py::arg("path"),
@@ -793,17 +801,18 @@ PYBIND11_MODULE(_meshstream, m) {
                  if (kept == chunk.channels()) return w.write(chunk);
                  w.write(narrowed(chunk, w.scratch(chunk.size())));
              })
-        .def("write_arrays",
-             [](StreamWriter& w, const py::object& positions, const py::object& normals, const py::object& colors,
-                const std::string& color_type, bool color_alpha, const py::object& uvs, const py::object& vertex_scalars,
-                const py::dict& scalar_types, const py::object& face_scalars, const py::object& materials) {
-                 ArraysIn in = arrays_in(positions, normals, colors, uvs, vertex_scalars, face_scalars, materials);
-                 need_shape(in.positions, {-1, 3, 3}, "positions");
-                 const py::ssize_t t = in.positions.shape(0);
-                 check_shapes(in, {t, 3}, t);
-                 w.open(channels_of(in, color_type, color_alpha, scalar_types), std::nullopt);
-                 write_triangles(w, in, nullptr, size_t(t), 0);
-             })
+        .def(
+            "write_arrays",
+            [](StreamWriter& w, const py::object& positions, const py::object& normals, const py::object& colors,
+               const std::string& color_type, bool color_alpha, const py::object& uvs, const py::object& vertex_scalars,
+               const py::dict& scalar_types, const py::object& face_scalars, const py::object& materials) {
+                ArraysIn in = arrays_in(positions, normals, colors, uvs, vertex_scalars, face_scalars, materials);
+                need_shape(in.positions, {-1, 3, 3}, "positions");
+                const py::ssize_t t = in.positions.shape(0);
+                check_shapes(in, {t, 3}, t);
+                w.open(channels_of(in, color_type, color_alpha, scalar_types), std::nullopt);
+                write_triangles(w, in, nullptr, size_t(t), 0);
+            })
         .def("close", &StreamWriter::close)
         .def("abandon", &StreamWriter::abandon)
         .def_property_readonly("notes", &StreamWriter::notes);
@@ -813,8 +822,9 @@ PYBIND11_MODULE(_meshstream, m) {
         [](const py::object& src, const py::object& dst, const py::object& progress, const py::kwargs& kwargs) {
             tools::ConvertOptions opt;
             opt.input = path_of(src), opt.output = path_of(dst);
-            return command_call("convert", opt, tools::convert_command, [](auto& o, auto* s) { return tools::convert_job(o, s); },
-                                progress, kwargs);
+            return command_call(
+                "convert", opt, tools::convert_command, [](auto& o, auto* s) { return tools::convert_job(o, s); },
+                progress, kwargs);
         },
         py::arg("src"), py::arg("dst"), py::kw_only(), py::arg("progress") = py::none());
     m.def(
@@ -822,8 +832,8 @@ PYBIND11_MODULE(_meshstream, m) {
         [](const py::object& src, const py::object& dst, const py::object& progress, const py::kwargs& kwargs) {
             tools::SortOptions opt;
             opt.input = path_of(src), opt.output = path_of(dst);
-            return command_call("sort", opt, tools::sort_command, [](auto& o, auto* s) { return tools::sort_job(o, s); },
-                                progress, kwargs, {"stats"});
+            return command_call("sort", opt, tools::sort_command,
+                                [](auto& o, auto* s) { return tools::sort_job(o, s); }, progress, kwargs, {"stats"});
         },
         py::arg("src"), py::arg("dst"), py::kw_only(), py::arg("progress") = py::none());
     m.def(
@@ -832,7 +842,8 @@ PYBIND11_MODULE(_meshstream, m) {
             tools::DecimateOptions opt;
             opt.input = path_of(src), opt.output = path_of(dst);
             return command_call(
-                "decimate", opt, [](CLI::App& app, tools::DecimateOptions& o) { return tools::decimate_command(app, o); },
+                "decimate", opt,
+                [](CLI::App& app, tools::DecimateOptions& o) { return tools::decimate_command(app, o); },
                 [](auto& o, auto* s) { return tools::decimate_job(o, nullptr, s); }, progress, kwargs);
         },
         py::arg("src"), py::arg("dst"), py::kw_only(), py::arg("progress") = py::none());
@@ -841,8 +852,9 @@ PYBIND11_MODULE(_meshstream, m) {
         [](const py::object& path, const py::object& progress, const py::kwargs& kwargs) {
             tools::InfoOptions opt;
             opt.input = path_of(path);
-            return command_call("info", opt, tools::info_command, [](auto& o, auto* s) { return tools::info_job(o, s); },
-                                progress, kwargs);
+            return command_call(
+                "info", opt, tools::info_command, [](auto& o, auto* s) { return tools::info_job(o, s); }, progress,
+                kwargs);
         },
         py::arg("path"), py::kw_only(), py::arg("progress") = py::none());
     m.def(
@@ -850,8 +862,9 @@ PYBIND11_MODULE(_meshstream, m) {
         [](const py::object& a, const py::object& b, const py::object& progress, const py::kwargs& kwargs) {
             tools::CompareCliOptions opt;
             opt.a = path_of(a), opt.b = path_of(b);
-            return command_call("compare", opt, tools::compare_command,
-                                [](auto& o, auto* s) { return tools::compare_job(o, s); }, progress, kwargs);
+            return command_call(
+                "compare", opt, tools::compare_command, [](auto& o, auto* s) { return tools::compare_job(o, s); },
+                progress, kwargs);
         },
         py::arg("a"), py::arg("b"), py::kw_only(), py::arg("progress") = py::none());
 }

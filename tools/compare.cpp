@@ -319,7 +319,8 @@ CLI::App* compare_command(CLI::App& app, CompareCliOptions& options) {
 
 void add_compare(CLI::App& app) {
     auto opt = std::make_shared<CompareCliOptions>();
-    run_when_parsed(compare_command(app, *opt), opt, [](CompareCliOptions& o) { return compare_job(o); }, 2);
+    run_when_parsed(
+        compare_command(app, *opt), opt, [](CompareCliOptions& o) { return compare_job(o); }, 2);
 }
 
 }  // namespace meshstream::tools

@@ -323,7 +323,8 @@ CLI::App* info_command(CLI::App& app, InfoOptions& options) {
 
 void add_info(CLI::App& app) {
     auto opt = std::make_shared<InfoOptions>();
-    run_when_parsed(info_command(app, *opt), opt, [](InfoOptions& o) { return info_job(o); }, 2);
+    run_when_parsed(
+        info_command(app, *opt), opt, [](InfoOptions& o) { return info_job(o); }, 2);
 }
 
 }  // namespace meshstream::tools

@@ -76,8 +76,8 @@ nlohmann::ordered_json decimate_job(const DecimateOptions& opt, engine::RangePro
 struct InfoOptions {
     std::string input;
     bool json = false;
-    bool topology = false;  // --topology: vertex and edge counts (compare/topology.hpp)
-    bool order = false;     // --order: measure the stream's width (compare/order.hpp)
+    bool topology = false;                                // --topology: vertex and edge counts (compare/topology.hpp)
+    bool order = false;                                   // --order: measure the stream's width (compare/order.hpp)
     uint64_t buffer = decimate::kDefaultBufferTriangles;  // --buffer: decimation buffer to judge against the width
     double ratio = 0.1;                                   // --ratio: the decimation ratio it is judged for
     ReadFlags read;

@@ -38,8 +38,8 @@ nlohmann::ordered_json run_report_json(const RunReport& report, const Warnings& 
 // result (engine::ConvertResult, SortResult or DecimateResult), its time, and this process's
 // peak RSS.
 template <class Result>
-RunReport run_report_of(std::string command, const std::string& input, const std::string& output,
-                        const Result& result, double seconds) {
+RunReport run_report_of(std::string command, const std::string& input, const std::string& output, const Result& result,
+                        double seconds) {
     RunReport report;
     report.command = std::move(command);
     report.inputs = {{input, result.input_format, result.input_gzip}};
