@@ -719,6 +719,21 @@ py::object command_call(const std::string& name, Options& opt, Register&& regist
     return to_python(report);
 }
 
+// meshstream.<name>(src, dst, *, progress=None, **flags): a job that reads src and writes dst.
+template <class Options, class Register, class Job>
+void def_file_job(py::module_& m, const char* name, Register register_options, Job job,
+                  std::set<std::string> refused = {}) {
+    m.def(
+        name,
+        [name, register_options, job, refused](const py::object& src, const py::object& dst, const py::object& progress,
+                                               const py::kwargs& kwargs) {
+            Options opt;
+            opt.input = path_of(src), opt.output = path_of(dst);
+            return command_call(name, opt, register_options, job, progress, kwargs, refused);
+        },
+        py::arg("src"), py::arg("dst"), py::kw_only(), py::arg("progress") = py::none());
+}
+
 }  // namespace
 
 PYBIND11_MODULE(_meshstream, m) {
@@ -817,36 +832,13 @@ PYBIND11_MODULE(_meshstream, m) {
         .def("abandon", &StreamWriter::abandon)
         .def_property_readonly("notes", &StreamWriter::notes);
 
-    m.def(
-        "convert",
-        [](const py::object& src, const py::object& dst, const py::object& progress, const py::kwargs& kwargs) {
-            tools::ConvertOptions opt;
-            opt.input = path_of(src), opt.output = path_of(dst);
-            return command_call(
-                "convert", opt, tools::convert_command, [](auto& o, auto* s) { return tools::convert_job(o, s); },
-                progress, kwargs);
-        },
-        py::arg("src"), py::arg("dst"), py::kw_only(), py::arg("progress") = py::none());
-    m.def(
-        "sort",
-        [](const py::object& src, const py::object& dst, const py::object& progress, const py::kwargs& kwargs) {
-            tools::SortOptions opt;
-            opt.input = path_of(src), opt.output = path_of(dst);
-            return command_call("sort", opt, tools::sort_command,
-                                [](auto& o, auto* s) { return tools::sort_job(o, s); }, progress, kwargs, {"stats"});
-        },
-        py::arg("src"), py::arg("dst"), py::kw_only(), py::arg("progress") = py::none());
-    m.def(
-        "decimate",
-        [](const py::object& src, const py::object& dst, const py::object& progress, const py::kwargs& kwargs) {
-            tools::DecimateOptions opt;
-            opt.input = path_of(src), opt.output = path_of(dst);
-            return command_call(
-                "decimate", opt,
-                [](CLI::App& app, tools::DecimateOptions& o) { return tools::decimate_command(app, o); },
-                [](auto& o, auto* s) { return tools::decimate_job(o, nullptr, s); }, progress, kwargs);
-        },
-        py::arg("src"), py::arg("dst"), py::kw_only(), py::arg("progress") = py::none());
+    def_file_job<tools::ConvertOptions>(m, "convert", tools::convert_command,
+                                        [](auto& o, auto* sink) { return tools::convert_job(o, sink); });
+    def_file_job<tools::SortOptions>(m, "sort", tools::sort_command,
+                                     [](auto& o, auto* sink) { return tools::sort_job(o, sink); }, {"stats"});
+    def_file_job<tools::DecimateOptions>(
+        m, "decimate", [](CLI::App& app, tools::DecimateOptions& o) { return tools::decimate_command(app, o); },
+        [](auto& o, auto* sink) { return tools::decimate_job(o, nullptr, sink); });
     m.def(
         "info",
         [](const py::object& path, const py::object& progress, const py::kwargs& kwargs) {
