@@ -21,9 +21,11 @@ as_root() { if [ "$(id -u)" = 0 ]; then "$@"; else sudo "$@"; fi; }
 
 # Debian packages: build tools, libraries, and the real clients the tests check output with
 # (draco_decoder; Chromium renders the GLBs the tests write with three.js); OpenMPI for
-# meshstream-mpi and its tests (mpirun).
+# meshstream-mpi and its tests (mpirun); pybind11, numpy and pytest for the Python package
+# (python/), Open3D and meshio for its interop tests.
 packages="cmake g++ make pkg-config libgtest-dev zlib1g-dev libdraco-dev draco libtinygltf-dev \
-nlohmann-json3-dev libcli11-dev libmeshoptimizer-dev chromium libopenmpi-dev openmpi-bin"
+nlohmann-json3-dev libcli11-dev libmeshoptimizer-dev chromium libopenmpi-dev openmpi-bin \
+pybind11-dev python3-dev python3-numpy python3-pytest python3-open3d python3-meshio"
 command -v node >/dev/null 2>&1 || packages="$packages nodejs"
 command -v npm >/dev/null 2>&1 || packages="$packages npm"
 missing=""

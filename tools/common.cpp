@@ -508,6 +508,7 @@ std::string describe_error(const std::exception& e) {
 }
 
 void print_warnings(const Warnings& warnings) {
+    if (global().silent) return;
     for (const std::string& line : warnings.lines(flag_name))
         std::fprintf(stderr, "%s: warning: %s\n", global().program.c_str(), line.c_str());
 }

@@ -148,6 +148,9 @@ using engine::note_input_changes;
 // Global flags (set by main before a subcommand runs).
 struct Global {
     bool quiet = false;
+    // Nothing on stderr, warnings included: a caller that reports them itself (the Python
+    // module returns them in its reports).
+    bool silent = false;
     std::string program = "meshstream";  // the name diagnostics start with
 };
 Global& global();

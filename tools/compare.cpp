@@ -8,6 +8,7 @@
 #include "tools/common.hpp"
 #include "tools/help.hpp"
 #include "tools/input_filter.hpp"
+#include "tools/jobs.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -36,15 +37,6 @@ using compare::NoSharedAttributes;
 // point, 3 floats each): 1.06 GB against 571 MB on another such mesh with both.
 constexpr int kSampleBytes = 60;
 constexpr int kSampleBytesWithAttributes = 108;
-
-struct CompareCliOptions {
-    std::string a, b;
-    std::optional<uint64_t> samples;
-    uint64_t seed = 1;
-    bool json = false;
-    bool attributes = false;
-    ReadFlags read;
-};
 
 nlohmann::ordered_json mesh_json(const MeshSummary& m) {
     nlohmann::ordered_json j;
@@ -167,7 +159,9 @@ void print_attributes(const CompareResult& r) {
     }
 }
 
-void run_compare(const CompareCliOptions& opt) {
+}  // namespace
+
+nlohmann::ordered_json compare_job(const CompareCliOptions& opt, engine::ProgressSink* progress) {
     if (is_stream(opt.a) && is_stream(opt.b))
         throw UsageError("compare cannot read both A and B from stdin or pipes: one of them is read twice");
     // What compare prints must not land in a file it reads (`compare a.stl b.stl >> a.stl`).
@@ -188,14 +182,17 @@ void run_compare(const CompareCliOptions& opt) {
     co.memory_budget_bytes = read.memory_budget_bytes;
     co.tmpdir = read.tmpdir;
     co.attributes = opt.attributes;
-    Progress progress("comparing", std::nullopt);
+    std::optional<Progress> bar;
+    if (!progress) bar.emplace("comparing", std::nullopt);
+    engine::ProgressSink& sink = progress ? *progress : *bar;
     std::string last_phase;
     co.progress = [&](std::string_view phase, uint64_t done, std::optional<uint64_t> total) {
         if (phase != last_phase) {
             last_phase = std::string(phase);
-            progress.phase(last_phase, total);
+            sink.phase(last_phase, total);
         }
-        progress.update(done);
+        sink.update(done);
+        engine::throw_if_cancelled(sink);
     };
     CompareResult r;
     try {
@@ -203,7 +200,7 @@ void run_compare(const CompareCliOptions& opt) {
     } catch (const NoSharedAttributes& e) {
         throw UsageError(std::string("--attributes: ") + e.describe(flag_name));
     }
-    progress.done();
+    if (bar) bar->done();
 
     double diag = r.diagonal;
     // A mesh of zero area (degenerate triangles only), or --samples too small for it, gets no
@@ -242,8 +239,7 @@ void run_compare(const CompareCliOptions& opt) {
         }
         j["symmetric"] = s;
         j["diagonal"] = diag;
-        std::printf("%s\n", j.dump(2).c_str());
-        return;
+        return j;
     }
     auto mesh_line = [](const char* label, const MeshSummary& m) {
         std::printf("%s %s\n", label, m.name.c_str());
@@ -284,12 +280,11 @@ void run_compare(const CompareCliOptions& opt) {
     else
         row("symmetric", r.hausdorff(), r.mean(), r.rms(), std::nullopt);
     if (r.attributes) print_attributes(r);
+    return nullptr;
 }
 
-}  // namespace
-
-void add_compare(CLI::App& app) {
-    auto opt = std::make_shared<CompareCliOptions>();
+CLI::App* compare_command(CLI::App& app, CompareCliOptions& options) {
+    CompareCliOptions* opt = &options;
     CLI::App* cmd = app.add_subcommand(
         "compare",
         "Hausdorff, mean and RMS surface error between two meshes (Metro)\n"
@@ -319,7 +314,13 @@ void add_compare(CLI::App& app) {
     strict_reports_bad_triangles(cmd);
     cmd->footer(
         "  meshstream compare scan.ply scan_1.glb\n  meshstream compare --attributes coloured.ply coloured_10.ply");
-    cmd->callback([opt] { run_compare(*opt); });
+    return cmd;
+}
+
+void add_compare(CLI::App& app) {
+    auto opt = std::make_shared<CompareCliOptions>();
+    run_when_parsed(
+        compare_command(app, *opt), opt, [](CompareCliOptions& o) { return compare_job(o); }, 2);
 }
 
 }  // namespace meshstream::tools

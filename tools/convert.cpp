@@ -6,6 +6,7 @@
 #include "tools/common.hpp"
 #include "tools/help.hpp"
 #include "tools/input_filter.hpp"
+#include "tools/jobs.hpp"
 #include "tools/run_report.hpp"
 
 #include <chrono>
@@ -14,18 +15,8 @@
 #include <optional>
 
 namespace meshstream::tools {
-namespace {
 
-struct ConvertOptions {
-    std::string input, output;
-    bool clean = false;
-    bool json = false;
-    unsigned threads = every_core();
-    ReadFlags read;
-    WriteFlags write;
-};
-
-void run_convert(const ConvertOptions& opt) {
+nlohmann::ordered_json convert_job(const ConvertOptions& opt, engine::ProgressSink* progress) {
     const auto start = std::chrono::steady_clock::now();
     if (opt.json) refuse_json_with_stdout_output(opt.output);
     const io::Format& out_format = resolve_output_format(opt.output, opt.write);
@@ -34,29 +25,18 @@ void run_convert(const ConvertOptions& opt) {
     settings.threads = opt.threads;
     engine::ConvertResult result;
     {
-        Progress progress("converting", std::nullopt);
-        result = engine::convert_file(settings, progress);
+        std::optional<Progress> bar;
+        result = engine::convert_file(settings, progress ? *progress : bar.emplace("converting", std::nullopt));
     }
     Warnings warnings = result.warnings;
     note_unused_write_flags(opt.write, out_format, opt.output, warnings);
     print_warnings(warnings);
-    if (opt.json) {
-        RunReport report;
-        report.command = "convert";
-        report.inputs = {{opt.input, result.input_format, result.input_gzip}};
-        report.outputs = {{opt.output, result.output_format, result.output_gzip}};
-        report.triangles_in = result.triangles_in;
-        report.triangles_out = result.triangles_out;
-        report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        report.peak_rss_bytes = peak_rss_bytes();
-        print_json(run_report_json(report, warnings));
-    }
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return run_report_json(run_report_of("convert", opt.input, opt.output, result, seconds), warnings);
 }
 
-}  // namespace
-
-void add_convert(CLI::App& app) {
-    auto opt = std::make_shared<ConvertOptions>();
+CLI::App* convert_command(CLI::App& app, ConvertOptions& options) {
+    ConvertOptions* opt = &options;
     CLI::App* cmd = app.add_subcommand(
         "convert", "any format to any other, every triangle and channel the output can hold kept\n" + kInOutText);
     cmd->add_option("IN", opt->input, "input mesh ('-' = stdin)")->required();
@@ -72,7 +52,12 @@ void add_convert(CLI::App& app) {
     cmd->footer(
         "  meshstream convert scan.ply scan.glb --compress meshopt\n"
         "  meshstream convert scan.stl - --to ply | gzip > scan.ply.gz");
-    cmd->callback([opt] { run_convert(*opt); });
+    return cmd;
+}
+
+void add_convert(CLI::App& app) {
+    auto opt = std::make_shared<ConvertOptions>();
+    run_when_parsed(convert_command(app, *opt), opt, [](ConvertOptions& o) { return convert_job(o); });
 }
 
 }  // namespace meshstream::tools

@@ -12,6 +12,7 @@
 #include "tools/decimate_report.hpp"
 #include "tools/help.hpp"
 #include "tools/input_filter.hpp"
+#include "tools/jobs.hpp"
 #include "tools/run_report.hpp"
 
 #include <chrono>
@@ -33,26 +34,6 @@ using compare::compare_meshes;
 using compare::CompareOptions;
 using compare::CompareResult;
 using compare::file_source;
-
-struct DecimateOptions {
-    std::string input, output;
-    std::optional<double> ratio;
-    std::optional<uint64_t> target;
-    size_t buffer = decimate::kDefaultBufferTriangles;
-    uint64_t seed = 1;
-    std::string weld;  // "" / "0.001" / "0.01%"
-    std::optional<int> sorted_axis;
-    std::string sort = "auto";  // --sort auto|always|never
-    unsigned threads = every_core();
-    bool threads_given = false;      // --threads given (else every core)
-    std::string part;                // --part k/K
-    std::vector<std::string> merge;  // --merge PART ... (the merge job, --part K/K)
-    std::string weights;             // --weights normal=W,color=W,uv=W,NAME=W
-    bool report = false;
-    bool json = false;
-    ReadFlags read;
-    WriteFlags write;
-};
 
 // --weld EPS: absolute, or "P%" of the bounding-box diagonal.
 engine::Weld parse_weld(const std::string& text) {
@@ -175,15 +156,15 @@ engine::DecimateSettings settings_of(const DecimateOptions& opt, const io::Forma
 // --part k/K with k < K: range k-1 of the plan --threads K makes, decimated into the part file
 // OUT. The channels carried are the ones the merge's output keeps: --to's format's, else every
 // channel of the input (less --drop).
-void decimate_part(const DecimateOptions& opt) {
+nlohmann::ordered_json decimate_part(const DecimateOptions& opt, engine::ProgressSink* progress) {
     const auto start = std::chrono::steady_clock::now();
     if (opt.json) refuse_json_with_stdout_output(opt.output);
     const io::Format* out_format = opt.write.to.empty() ? nullptr : &resolve_output_format(opt.output, opt.write);
     const engine::DecimateSettings settings = settings_of(opt, out_format, nullptr);
     engine::PartResult part;
     {
-        Progress progress("decimating", std::nullopt);
-        part = engine::decimate_part(settings, progress);
+        std::optional<Progress> bar;
+        part = engine::decimate_part(settings, progress ? *progress : bar.emplace("decimating", std::nullopt));
     }
     const double seconds = seconds_since(start);
     // The range's figures; the merge reports the whole decimation (its warnings included).
@@ -197,22 +178,20 @@ void decimate_part(const DecimateOptions& opt) {
         std::fprintf(stderr, "  time %.3f s, peak RSS %s; merge with --part %u/%u\n", seconds,
                      human_bytes(double(peak_rss_bytes())).c_str(), settings.part->parts, settings.part->parts);
     }
-    if (opt.json) {
-        RunReport report;
-        report.command = "decimate";
-        report.inputs = {{opt.input, part.input_format, part.input_gzip}};
-        report.outputs = {{opt.output, "part", false}};
-        report.triangles_in = part.triangles_in;
-        report.triangles_out = part.triangles_out;
-        report.seconds = seconds;
-        report.peak_rss_bytes = peak_rss_bytes();
-        report.details = {{"part", settings.part->k},
-                          {"parts", settings.part->parts},
-                          {"range_first", part.range_first},
-                          {"range_end", part.range_end},
-                          {"part_file_bytes", part.part_file_bytes}};
-        print_json(run_report_json(report, Warnings{}));
-    }
+    RunReport report;
+    report.command = "decimate";
+    report.inputs = {{opt.input, part.input_format, part.input_gzip}};
+    report.outputs = {{opt.output, "part", false}};
+    report.triangles_in = part.triangles_in;
+    report.triangles_out = part.triangles_out;
+    report.seconds = seconds;
+    report.peak_rss_bytes = peak_rss_bytes();
+    report.details = {{"part", settings.part->k},
+                      {"parts", settings.part->parts},
+                      {"range_first", part.range_first},
+                      {"range_end", part.range_end},
+                      {"part_file_bytes", part.part_file_bytes}};
+    return run_report_json(report, Warnings{});
 }
 
 // The checks of flags that go together only on the command line (the library refuses the rest
@@ -228,17 +207,21 @@ void refuse_flag_combinations(const DecimateOptions& opt, const std::optional<Pa
         throw UsageError(both + " writes a part file, not a mesh: give --report to the merge job");
 }
 
-void run_decimate(const DecimateOptions& opt, RangeProcesses* processes) {
+}  // namespace
+
+nlohmann::ordered_json decimate_job(const DecimateOptions& opt, RangeProcesses* processes,
+                                    engine::ProgressSink* progress) {
     std::optional<PartIndex> part;
     if (!opt.part.empty()) part = parse_part(opt.part);  // checked by the option
     if (processes && processes->rank() > 0) {
         const io::Format& out_format = resolve_output_format(opt.output, opt.write);
-        return engine::run_remote_range(settings_of(opt, &out_format, processes), *processes);
+        engine::run_remote_range(settings_of(opt, &out_format, processes), *processes);
+        return nullptr;
     }
     refuse_flag_combinations(opt, part);
     if (part && !part->merge()) {
         // The library checks the rest of the part job's settings; these go first as before.
-        return decimate_part(opt);
+        return decimate_part(opt, progress);
     }
     const auto start = std::chrono::steady_clock::now();
     if (opt.json) refuse_json_with_stdout_output(opt.output);
@@ -256,8 +239,11 @@ void run_decimate(const DecimateOptions& opt, RangeProcesses* processes) {
     engine::DecimateResult result;
     double seconds = 0;
     {
-        Progress progress(settings.sort == engine::SortPolicy::kAlways ? "reading" : "decimating", std::nullopt);
-        result = engine::decimate_file(settings, progress);
+        std::optional<Progress> bar;
+        result = engine::decimate_file(
+            settings, progress ? *progress
+                               : bar.emplace(settings.sort == engine::SortPolicy::kAlways ? "reading" : "decimating",
+                                             std::nullopt));
         seconds = seconds_since(start);
     }
     DecimateFacts& facts = result.facts;
@@ -269,14 +255,7 @@ void run_decimate(const DecimateOptions& opt, RangeProcesses* processes) {
     note_decimate_warnings(facts, warnings);
     print_warnings(warnings);
 
-    RunReport report;
-    report.command = "decimate";
-    report.inputs = {{opt.input, result.input_format, result.input_gzip}};
-    report.outputs = {{opt.output, result.output_format, result.output_gzip}};
-    report.triangles_in = result.triangles_in;
-    report.triangles_out = result.triangles_out;
-    report.seconds = seconds;
-    report.peak_rss_bytes = peak_rss_bytes();
+    RunReport report = run_report_of("decimate", opt.input, opt.output, result, seconds);
     report.details = decimate_details_json(facts);
     if (part) {
         nlohmann::ordered_json files = nlohmann::ordered_json::array();
@@ -286,13 +265,11 @@ void run_decimate(const DecimateOptions& opt, RangeProcesses* processes) {
         report.details["part_files"] = files;
     }
     if (opt.report) report.details["error"] = report_error(opt, facts);
-    if (opt.json) print_json(run_report_json(report, warnings));
+    return run_report_json(report, warnings);
 }
 
-}  // namespace
-
-void add_decimate(CLI::App& app, RangeProcesses* processes) {
-    auto opt = std::make_shared<DecimateOptions>();
+CLI::App* decimate_command(CLI::App& app, DecimateOptions& options, RangeProcesses* processes) {
+    DecimateOptions* opt = &options;
     CLI::App* cmd = app.add_subcommand(
         "decimate", "decimate a mesh of any size in one streaming pass, in fixed memory\n" + kInOutText);
     cmd->add_option("IN", opt->input, "input mesh ('-' = stdin)")->required();
@@ -338,12 +315,10 @@ void add_decimate(CLI::App& app, RangeProcesses* processes) {
     cmd->add_flag("--report", opt->report,
                   "measure the output's error against the input at the end\n"
                   "Hausdorff, mean and RMS distance, as compare does");
-    CLI::Option* threads = nullptr;
     if (!processes) {
         add_threads_option(cmd, opt->threads, "decimate a file in N ranges at once",
                            "Each range of at least --buffer triangles is decimated with its own --buffer, and the "
                            "seams between them are joined by one more pass; the output depends on N, not on timing");
-        threads = cmd->get_option("--threads");
         cmd->add_option("--part", opt->part,
                         "one of K jobs: k < K writes range k to the part file OUT, K/K merges them\n"
                         "The ranges of --threads K as separate jobs, every one with the same options: job k (1 .. "
@@ -396,9 +371,16 @@ void add_decimate(CLI::App& app, RangeProcesses* processes) {
     cmd->footer(
         "  meshstream decimate scan.ply scan.glb -r 0.01\n"
         "  meshstream sort big.stl - | meshstream decimate - out.glb -r 0.01");
-    cmd->callback([opt, processes, threads] {
-        opt->threads_given = threads && threads->count() > 0;
-        run_decimate(*opt, processes);
+    return cmd;
+}
+
+void add_decimate(CLI::App& app, RangeProcesses* processes) {
+    auto opt = std::make_shared<DecimateOptions>();
+    CLI::App* cmd = decimate_command(app, *opt, processes);
+    const CLI::Option* threads = cmd->get_option_no_throw("--threads");
+    run_when_parsed(cmd, opt, [processes, threads](DecimateOptions& o) {
+        o.threads_given = threads && threads->count() > 0;
+        return decimate_job(o, processes);
     });
 }
 

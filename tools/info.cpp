@@ -11,6 +11,7 @@
 #include "tools/common.hpp"
 #include "tools/help.hpp"
 #include "tools/input_filter.hpp"
+#include "tools/jobs.hpp"
 #include "tools/order_text.hpp"
 
 #include <nlohmann/json.hpp>
@@ -31,16 +32,6 @@ using compare::OrderMeter;
 using compare::OrderReport;
 using compare::TopologyCounter;
 using compare::TopologyReport;
-
-struct InfoOptions {
-    std::string input;
-    bool json = false;
-    bool topology = false;     // --topology: vertex and edge counts (tools/topology.hpp)
-    bool order = false;        // --order: measure the stream's width (compare/order.hpp)
-    uint64_t buffer = decimate::kDefaultBufferTriangles;  // --buffer: decimation buffer to judge against the width
-    double ratio = 0.1;        // --ratio: the decimation ratio it is judged for
-    ReadFlags read;
-};
 
 struct InfoStats {
     uint64_t triangles = 0;
@@ -120,7 +111,9 @@ std::string color_values(const std::array<float, 4>& rgba) {
     return buf;
 }
 
-void run_info(const InfoOptions& opt) {
+}  // namespace
+
+nlohmann::ordered_json info_job(const InfoOptions& opt, engine::ProgressSink* progress) {
     // info reports bad triangles; --strict makes the first one an error instead. It looks at
     // positions (and vertex ids, for --topology) only: the reader stores no attribute values,
     // and the header still lists every channel.
@@ -140,12 +133,18 @@ void run_info(const InfoOptions& opt) {
     std::optional<OrderMeter> meter;
     if (opt.order) meter.emplace(opt.read.options().memory_budget_bytes);
     {
-        Progress progress("reading", header.triangle_count);
+        std::optional<Progress> bar;
+        if (progress)
+            progress->phase("reading", header.triangle_count);
+        else
+            bar.emplace("reading", header.triangle_count);
+        engine::ProgressSink& sink = progress ? *progress : *bar;
         while (in.next(chunk)) {
             accumulate(chunk, stats);
             if (topology) topology->add(chunk);
             if (meter) meter->add(chunk);
-            progress.update(stats.triangles, in.source());
+            sink.update(stats.triangles, in.source().stored_offset(), in.source().stored_size());
+            engine::throw_if_cancelled(sink);
         }
     }
     // The size on disk (compressed for gzip input, whose decoded size is reported beside it).
@@ -225,8 +224,7 @@ void run_info(const InfoOptions& opt) {
                                                                    : nlohmann::json(nullptr);
             o["key_descents"] = {{"x", r.descents[0]}, {"y", r.descents[1]}, {"z", r.descents[2]}};
         }
-        std::printf("%s\n", j.dump(2).c_str());
-        return;
+        return j;
     }
     std::printf("file:        %s\n", opt.input.c_str());
     std::printf("format:      %s%s%s%s\n", std::string(in.format().name).c_str(), header.variant.empty() ? "" : " (",
@@ -289,12 +287,11 @@ void run_info(const InfoOptions& opt) {
                     (unsigned long long)t.non_manifold_edges);
     }
     if (meter) std::printf("%s", format_order_text(meter->finish(), opt.buffer, opt.ratio, header.sorted_axis).c_str());
+    return nullptr;
 }
 
-}  // namespace
-
-void add_info(CLI::App& app) {
-    auto opt = std::make_shared<InfoOptions>();
+CLI::App* info_command(CLI::App& app, InfoOptions& options) {
+    InfoOptions* opt = &options;
     CLI::App* cmd = app.add_subcommand("info",
                                        "format, counts, bounding box, degenerate triangles, channels, order\n"
                                        "FILE: a mesh file, '-' for stdin; gzip is detected");
@@ -321,7 +318,13 @@ void add_info(CLI::App& app) {
     add_read_flags(cmd, opt->read);
     strict_reports_bad_triangles(cmd);
     cmd->footer("  meshstream info scan.ply --order");
-    cmd->callback([opt] { run_info(*opt); });
+    return cmd;
+}
+
+void add_info(CLI::App& app) {
+    auto opt = std::make_shared<InfoOptions>();
+    run_when_parsed(
+        info_command(app, *opt), opt, [](InfoOptions& o) { return info_job(o); }, 2);
 }
 
 }  // namespace meshstream::tools

@@ -49,6 +49,4 @@ void refuse_json_with_stdout_output(const std::string& output) {
                          ": --json prints its report on stdout, so the mesh cannot go there too: write it to a file");
 }
 
-void print_json(const nlohmann::ordered_json& j) { std::printf("%s\n", j.dump().c_str()); }
-
 }  // namespace meshstream::tools

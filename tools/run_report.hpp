@@ -34,12 +34,27 @@ struct RunReport {
 
 nlohmann::ordered_json run_report_json(const RunReport& report, const Warnings& warnings);
 
+// The report of a job that read `input` and wrote `output`: formats, gzip and counts from its
+// result (engine::ConvertResult, SortResult or DecimateResult), its time, and this process's
+// peak RSS.
+template <class Result>
+RunReport run_report_of(std::string command, const std::string& input, const std::string& output, const Result& result,
+                        double seconds) {
+    RunReport report;
+    report.command = std::move(command);
+    report.inputs = {{input, result.input_format, result.input_gzip}};
+    report.outputs = {{output, result.output_format, result.output_gzip}};
+    report.triangles_in = result.triangles_in;
+    report.triangles_out = result.triangles_out;
+    report.seconds = seconds;
+    report.peak_rss_bytes = peak_rss_bytes();
+    return report;
+}
+
 // --json on a writing command; its help says that stdout then holds the object only.
 void add_json_flag(CLI::App* cmd, bool& json);
 // Refuses (UsageError, exit 2) an output that goes to stdout ("-", /dev/stdout, a file stdout
 // is redirected into) when --json would print there too.
 void refuse_json_with_stdout_output(const std::string& output);
-// Prints `j` as one line on stdout.
-void print_json(const nlohmann::ordered_json& j);
 
 }  // namespace meshstream::tools

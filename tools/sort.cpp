@@ -10,6 +10,7 @@
 #include "tools/common.hpp"
 #include "tools/help.hpp"
 #include "tools/input_filter.hpp"
+#include "tools/jobs.hpp"
 #include "tools/run_report.hpp"
 
 #include <unistd.h>
@@ -23,17 +24,6 @@
 
 namespace meshstream::tools {
 namespace {
-
-struct SortOptions {
-    std::string input, output;
-    std::string axis = "auto";
-    bool stats = false;
-    bool clean = false;
-    bool json = false;
-    unsigned threads = every_core();
-    ReadFlags read;
-    WriteFlags write;
-};
 
 const char* const kAxisNames[] = {"x", "y", "z"};
 
@@ -62,7 +52,9 @@ std::string sort_stats_line(const sort::SortStats& s, int axis, double seconds, 
     return line;
 }
 
-void run_sort(const SortOptions& opt) {
+}  // namespace
+
+nlohmann::ordered_json sort_job(const SortOptions& opt, engine::ProgressSink* progress) {
     const auto t0 = std::chrono::steady_clock::now();
     if (opt.json) refuse_json_with_stdout_output(opt.output);
     const io::Format& out_format = resolve_output_format(opt.output, opt.write);
@@ -77,8 +69,8 @@ void run_sort(const SortOptions& opt) {
     settings.memory_text = opt.read.memory.empty() ? std::string("256M") : opt.read.memory;
     engine::SortResult result;
     {
-        Progress progress("run generation", std::nullopt);
-        result = engine::sort_file(settings, progress);
+        std::optional<Progress> bar;
+        result = engine::sort_file(settings, progress ? *progress : bar.emplace("run generation", std::nullopt));
     }
     Warnings warnings = result.warnings;
     note_unused_write_flags(opt.write, out_format, opt.output, warnings);
@@ -89,29 +81,18 @@ void run_sort(const SortOptions& opt) {
                      sort_stats_line(result.stats, result.axis, seconds_since(t0), result.input_seconds,
                                      result.sort_seconds, peak_rss_bytes())
                          .c_str());
-    if (opt.json) {
-        RunReport report;
-        report.command = "sort";
-        report.inputs = {{opt.input, result.input_format, result.input_gzip}};
-        report.outputs = {{opt.output, result.output_format, result.output_gzip}};
-        report.triangles_in = result.triangles_in;
-        report.triangles_out = result.triangles_out;
-        report.seconds = seconds_since(t0);
-        report.peak_rss_bytes = peak_rss_bytes();
-        const sort::SortStats& st = result.stats;
-        report.details = {{"axis", kAxisNames[result.axis]},
-                          {"runs", st.runs},
-                          {"merge_passes", st.merge_passes},
-                          {"temp_bytes_written", st.temp_bytes_written},
-                          {"peak_temp_bytes", st.peak_temp_bytes}};
-        print_json(run_report_json(report, warnings));
-    }
+    RunReport report = run_report_of("sort", opt.input, opt.output, result, seconds_since(t0));
+    const sort::SortStats& st = result.stats;
+    report.details = {{"axis", kAxisNames[result.axis]},
+                      {"runs", st.runs},
+                      {"merge_passes", st.merge_passes},
+                      {"temp_bytes_written", st.temp_bytes_written},
+                      {"peak_temp_bytes", st.peak_temp_bytes}};
+    return run_report_json(report, warnings);
 }
 
-}  // namespace
-
-void add_sort(CLI::App& app) {
-    auto opt = std::make_shared<SortOptions>();
+CLI::App* sort_command(CLI::App& app, SortOptions& options) {
+    SortOptions* opt = &options;
     CLI::App* cmd = app.add_subcommand(
         "sort", "sort triangles along an axis, out of core, so that decimate can stream them\n" + kInOutText +
                     "\nA stable sort by each triangle's minimum coordinate; the output "
@@ -142,7 +123,12 @@ void add_sort(CLI::App& app) {
     cmd->footer(
         "  meshstream sort scan.stl sorted.stl\n"
         "  cat scan.stl | meshstream sort --axis z --to stl - - > sorted.stl");
-    cmd->callback([opt] { run_sort(*opt); });
+    return cmd;
+}
+
+void add_sort(CLI::App& app) {
+    auto opt = std::make_shared<SortOptions>();
+    run_when_parsed(sort_command(app, *opt), opt, [](SortOptions& o) { return sort_job(o); });
 }
 
 }  // namespace meshstream::tools
