@@ -26,5 +26,6 @@
 #include "io/draco.hpp"
 #endif
 #if MESHSTREAM_WITH_GLTF
+#include "engine/tiles.hpp"
 #include "io/gltf.hpp"
 #endif

@@ -72,6 +72,9 @@ std::string_view setting_words(Setting setting) {
         "the part files",
         "the attributes compared",
         "the output chunk size",
+        "the tile triangle budget",
+        "the origin",
+        "the overwrite setting",
     };
     const int i = int(setting);
     return i >= 0 && i < kSettingCount ? kWords[i] : std::string_view("a setting");

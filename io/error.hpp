@@ -56,9 +56,12 @@ enum class Setting : uint8_t {
     kPart,         // a part job's index
     kMerge,        // the part files a merge reads
     kAttributes,   // what compare measures besides geometry
-    kOutputChunk,  // the decimator's output chunk size
+    kOutputChunk,    // the decimator's output chunk size
+    kTileTriangles,  // a tile's triangle budget (tiles)
+    kOrigin,         // where a tileset's origin is put on the globe
+    kOverwrite,      // replacing a non-empty output directory
 };
-inline constexpr int kSettingCount = int(Setting::kOutputChunk) + 1;
+inline constexpr int kSettingCount = int(Setting::kOverwrite) + 1;
 
 // The setting in a library user's words: "the memory budget", "strict mode".
 std::string_view setting_words(Setting setting);

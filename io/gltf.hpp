@@ -63,7 +63,20 @@ struct GltfSettings {
     // --compress: KHR_draco_mesh_compression, EXT_meshopt_compression with
     // KHR_mesh_quantization, or plain accessors.
     enum class Compression : uint8_t { kDraco, kMeshopt, kNone };
+    GltfSettings() = default;
+    explicit GltfSettings(Compression c) : compression(c) {}
     Compression compression = Compression::kDraco;
+    // meshopt: the positions' quantization grid, when the caller gives one: `origin` and the
+    // cube's `extent`, in 2^bits - 1 steps (bits 1-16). Meshes written on one grid (the tiles of
+    // a tileset) put a position shared by two of them on the same integer and the same node
+    // transform, so both decode it to the same float. None: each mesh's own bounding cube at
+    // 14 bits.
+    struct Grid {
+        float origin[3] = {0, 0, 0};
+        float extent = 1;
+        int bits = 16;
+    };
+    std::optional<Grid> grid;
 };
 
 // True for the GLB magic "glTF".

@@ -345,7 +345,7 @@ std::vector<Stream> vertex_streams(const PartData& d, const Channels& ch, bool n
         Stream s;
         s.semantic = "POSITION";
         if (meshopt) {
-            // Unsigned 14-bit integers (KHR_mesh_quantization), padded to 8 bytes as gltfpack does.
+            // Unsigned integers of q.bits (KHR_mesh_quantization), padded to 8 bytes as gltfpack does.
             s.component_type = kUnsignedShort;
             s.element_bytes = 6;
             s.stride = 8;
@@ -482,6 +482,7 @@ public:
           budget_(sink.name(), options, kWhy) {
         draco_ = writer_compression(options_) == GltfSettings::Compression::kDraco;
         meshopt_ = writer_compression(options_) == GltfSettings::Compression::kMeshopt;
+        grid_ = options_.format_options.get<GltfSettings>().grid;
 #if MESHSTREAM_WITH_DRACO
         if (draco_) draco_settings_ = check_draco_settings(sink.name(), options_);
 #endif
@@ -534,6 +535,7 @@ private:
     WriteOptions options_;
     bool binary_;
     bool draco_ = false, meshopt_ = false;
+    std::optional<GltfSettings::Grid> grid_;  // meshopt's common quantization grid
 #if MESHSTREAM_WITH_DRACO
     DracoSettings draco_settings_;  // checked, when draco_
 #endif
@@ -697,7 +699,11 @@ void GltfWriter::finish_output() {
         std::vector<MeshPart> parts = mesh.parts();
         add_materials(doc, parts, image_files);
         Quantization q;
-        if (meshopt_) {
+        if (meshopt_ && grid_) {
+            for (int a = 0; a < 3; ++a) q.offset[a] = grid_->origin[a];
+            q.scale = grid_->extent;
+            q.bits = grid_->bits;
+        } else if (meshopt_) {
             const Bounds b = mesh.bounds();
             float extent = 0;
             for (int a = 0; a < 3; ++a) q.offset[a] = b.min[a], extent = std::max(extent, b.max[a] - b.min[a]);

@@ -132,7 +132,7 @@ private:
     uint32_t key_at(const Cursor& c) const {
         float xyz[9];
         std::memcpy(xyz, c.buf + c.pos, sizeof xyz);  // records are not float-aligned with colours
-        return triangle_key(xyz, owner_.options_.axis);
+        return owner_.key_of(xyz);
     }
 
     // Reads the cursor's next block; false when its run is exhausted. Releases the consumed one.
@@ -183,6 +183,10 @@ ExternalSorter::ExternalSorter(SorterOptions options)
 
 ExternalSorter::~ExternalSorter() = default;
 
+uint32_t ExternalSorter::key_of(const float* xyz) const {
+    return options_.key ? options_.key(xyz) : triangle_key(xyz, options_.axis);
+}
+
 void ExternalSorter::add(const io::TriangleChunk& chunk) {
     assert(!input_done_);
     assert(chunk.channels() == options_.channels);
@@ -198,7 +202,7 @@ void ExternalSorter::add(const io::TriangleChunk& chunk) {
     for (size_t i = 0; i < chunk.size(); ++i) {
         if (run_size_ == capacity) spill_run();
         codec_.encode(chunk, i, records_.get() + run_size_ * record_bytes_);
-        items_[run_size_] = uint64_t{triangle_key(&xyz[9 * i], options_.axis)} << 32 | run_size_;
+        items_[run_size_] = uint64_t{key_of(&xyz[9 * i])} << 32 | run_size_;
         ++run_size_;
     }
     stats_.triangles += chunk.size();

@@ -34,6 +34,9 @@ namespace meshstream::sort {
 
 struct SorterOptions {
     int axis = 2;                                        // 0 = x, 1 = y, 2 = z
+    // A key of the caller's instead of the axis key: a triangle's 9 coordinates to its 32-bit
+    // key (e.g. an octree cell's Morton code). Must be deterministic.
+    std::function<uint32_t(const float* xyz)> key;
     uint64_t memory_budget_bytes = uint64_t{192} << 20;  // runs + merge buffers (see above)
     std::string tmpdir;                                  // empty: $TMPDIR or /tmp
     io::Channels channels;                               // channels carried through the sort
@@ -89,6 +92,7 @@ private:
     struct Cursor;
     class Merger;
 
+    uint32_t key_of(const float* xyz) const;  // options_.key, else the axis key
     void spill_run();
     void sort_run();
     void merge_pass(int pass, int pass_count, size_t fan_in);

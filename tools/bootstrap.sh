@@ -51,6 +51,14 @@ for pkg in gltf-validator@2.0.0-dev.3.10 three@0.170.0 3d-tiles-renderer@0.5.3 g
   fi
 done
 
+# The official 3D Tiles validator, which the tests run on the tilesets `meshstream tiles` writes:
+# from its source beside the checkout (../shared/peers, on development and CI machines), built
+# from npm packages alone; its setup does nothing when it is already there.
+validator_source=../shared/peers/3d-tiles-validator
+if [ "$mode" = test ] && [ -x "$validator_source/setup.sh" ]; then
+  as_root bash "$validator_source/setup.sh" "$tools_dir/3d-tiles-validator" >/dev/null
+fi
+
 if [ ! -f "$build_dir/CMakeCache.txt" ]; then
   # shellcheck disable=SC2086  # MESHSTREAM_CMAKE_ARGS is a list of options
   cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release -DMESHSTREAM_TOOLS_DIR="$tools_dir" \

@@ -18,5 +18,6 @@ void add_convert(CLI::App& app);
 void add_decimate(CLI::App& app, RangeProcesses* processes = nullptr);
 void add_sort(CLI::App& app);
 void add_compare(CLI::App& app);
+void add_tiles(CLI::App& app);
 
 }  // namespace meshstream::tools

@@ -497,6 +497,9 @@ std::string flag_name(io::Setting setting) {
         "--merge",
         "--attributes",
         "the output chunk size",  // no flag: the commands write chunks of the default size
+        "--tile-triangles",
+        "--origin",
+        "--overwrite",
     };
     const int i = int(setting);
     return i >= 0 && i < io::kSettingCount ? kFlags[i] : std::string(io::setting_words(setting));

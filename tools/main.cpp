@@ -22,6 +22,9 @@ int main(int argc, char** argv) {
     tools::add_decimate(app);
     tools::add_sort(app);
     tools::add_compare(app);
+#if MESHSTREAM_WITH_GLTF
+    tools::add_tiles(app);
+#endif
     app.footer(
         "  meshstream decimate scan.ply scan.glb -r 0.01\n"
         "  meshstream COMMAND --help   (the command's options; docs/cli.md has the details)");

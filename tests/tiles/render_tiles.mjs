@@ -164,7 +164,8 @@ async function show(name, camera, errorTarget, dress) {
     tiles.setResolutionFromRenderer(camera, renderer);
     camera.updateMatrixWorld();
     let idle = 0;
-    for (let frame = 0; frame < 6000 && idle < 10; ++frame) {
+    const until = performance.now() + 20000;
+    for (let frame = 0; idle < 10 && performance.now() < until; ++frame) {
         tiles.update();
         renderer.render(scene, camera);
         await new Promise((r) => setTimeout(r, 5));
@@ -177,7 +178,7 @@ async function show(name, camera, errorTarget, dress) {
         new THREE.Matrix4().multiplyMatrices(camera.projectionMatrix, camera.matrixWorldInverse));
     const inView = leaves.filter((l) => frustum.intersectsBox(new THREE.Box3().setFromPoints(
         l.corners.map((c) => new THREE.Vector3(...c).applyMatrix4(tiles.group.matrixWorld))))).map((l) => l.path);
-    await post('/drawn/' + name, { drawn, inView, failed: tiles.stats.failed || 0 });
+    await post('/drawn/' + name, { drawn, inView, failed: tiles.stats.failed || 0, settled: idle >= 10, stats: { ...tiles.stats } });
     return { tiles, scene };
 }
 
@@ -267,7 +268,7 @@ const report = {
 let phase = null;
 const fetched = {};
 const outcome = await runPage({
-    chromium, name: 'render_tiles', timeoutMs: 180000, page,
+    chromium, name: 'render_tiles', timeoutMs: Number(process.env.RENDER_TILES_TIMEOUT || 180000), page,
     serve(url) {
         if (url === '/reference.glb') return path.resolve(referenceGlb);
         if (url.startsWith('/tiles/')) return below(tilesetDir, url.slice(7));
@@ -282,6 +283,7 @@ const outcome = await runPage({
         const value = JSON.parse(body);
         if (url.startsWith('/phase/')) {
             phase = url.slice(7);
+            if (process.env.RENDER_TILES_TRACE) console.error('render_tiles: phase ' + phase);
             fetched[phase] = [];
         } else if (url.startsWith('/png/')) {
             fs.writeFileSync(path.join(outDir, `${url.slice(5)}.png`), Buffer.from(value.split(',')[1], 'base64'));
@@ -311,6 +313,8 @@ const outcome = await runPage({
                 leaves_in_view: inView.size,
                 fetched_leaves_out_of_view: fetchedLeaves.filter((p) => !inView.has(p)).length,
                 failed: value.failed,
+                settled: value.settled,
+                stats: value.stats,
             };
         } else if (url === '/match') {
             report.match = value;

@@ -1,0 +1,674 @@
+// 3D Tiles out of core: see tiles.hpp for the method, docs/tiles.md for the format's details.
+#include "engine/tiles.hpp"
+
+#include "compare/metro.hpp"
+#include "engine/convert.hpp"
+#include "engine/decimate.hpp"
+#include "engine/files.hpp"
+#include "engine/units.hpp"
+#include "io/gltf.hpp"
+#include "io/triangle_input.hpp"
+#include "sort/external_sort.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <functional>
+#include <numbers>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <unistd.h>
+#include <unordered_map>
+
+namespace meshstream::engine {
+
+namespace {
+
+namespace fs = std::filesystem;
+using io::mention;
+using io::Setting;
+using Json = nlohmann::json;
+
+constexpr int kMaxDepth = 10;  // cell keys: 3 bits a depth, 30 bits
+constexpr uint64_t kMinTileTriangles = 256;
+
+// The bounding cube and the cell key of a point: the Morton code of its depth-10 cell.
+struct Cube {
+    double origin[3] = {0, 0, 0};
+    double extent = 1;
+
+    uint32_t key(const float* p) const {
+        uint32_t cell[3];
+        for (int a = 0; a < 3; ++a) {
+            const double t = (double(p[a]) - origin[a]) / extent * (1 << kMaxDepth);
+            cell[a] = t <= 0 || !std::isfinite(t) ? 0 : uint32_t(std::min(t, double((1 << kMaxDepth) - 1)));
+        }
+        uint32_t k = 0;
+        for (int bit = kMaxDepth - 1; bit >= 0; --bit)
+            for (int a = 0; a < 3; ++a) k = k << 1 | ((cell[a] >> bit) & 1);
+        return k;
+    }
+    uint32_t triangle_key(const float* xyz) const {
+        const float c[3] = {(xyz[0] + xyz[3] + xyz[6]) / 3, (xyz[1] + xyz[4] + xyz[7]) / 3,
+                            (xyz[2] + xyz[5] + xyz[8]) / 3};
+        return key(c);
+    }
+};
+
+// The octant of depth `depth` (1-based) in a key.
+int octant(uint32_t key, int depth) { return int(key >> (3 * (kMaxDepth - depth))) & 7; }
+
+// An axis-aligned box in the model's coordinates (empty: min > max).
+struct Box {
+    double min[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, max[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+    bool empty() const { return min[0] > max[0]; }
+    void add(const float* p) {
+        for (int a = 0; a < 3; ++a) min[a] = std::min(min[a], double(p[a])), max[a] = std::max(max[a], double(p[a]));
+    }
+    void add(const Box& b) {
+        for (int a = 0; a < 3; ++a) min[a] = std::min(min[a], b.min[a]), max[a] = std::max(max[a], b.max[a]);
+    }
+    double diagonal() const {
+        if (empty()) return 0;
+        double d = 0;
+        for (int a = 0; a < 3; ++a) d += (max[a] - min[a]) * (max[a] - min[a]);
+        return std::sqrt(d);
+    }
+};
+
+struct Node {
+    uint32_t prefix = 0;  // the key's bits above this depth (the rest 0)
+    int depth = 0;
+    uint64_t count = 0;  // input triangles with their centroid here
+    bool leaf = true;
+    std::array<int, 8> child{-1, -1, -1, -1, -1, -1, -1, -1};
+    // Filled as the tiles are written.
+    Box box;  // the content's
+    uint64_t triangles = 0, bytes = 0;
+    double error = 0;
+    std::string uri;  // relative to the tileset; empty: no content
+};
+
+struct Tree {
+    std::vector<Node> nodes;  // nodes[0] the root
+    int max_depth = 0;
+
+    // Builds the cells of [lo, hi) of the sorted (key, count) list under `prefix` at `depth`.
+    int build(const std::vector<std::pair<uint32_t, uint64_t>>& cells, size_t lo, size_t hi, uint32_t prefix,
+              int depth, uint64_t budget) {
+        const int id = int(nodes.size());
+        nodes.emplace_back();
+        uint64_t count = 0;
+        for (size_t i = lo; i < hi; ++i) count += cells[i].second;
+        nodes[id].prefix = prefix;
+        nodes[id].depth = depth;
+        nodes[id].count = count;
+        max_depth = std::max(max_depth, depth);
+        if (count <= budget || depth == kMaxDepth) return id;
+        nodes[id].leaf = false;
+        size_t i = lo;
+        for (int o = 0; o < 8; ++o) {
+            size_t j = i;
+            while (j < hi && octant(cells[j].first, depth + 1) == o) ++j;
+            if (j > i) {
+                const int c = build(cells, i, j, prefix | uint32_t(o) << (3 * (kMaxDepth - depth - 1)), depth + 1, budget);
+                nodes[id].child[o] = c;
+            }
+            i = j;
+        }
+        return id;
+    }
+
+    // The node a key falls in at `depth`, or the leaf above it; -1 when no cell holds it.
+    int at(uint32_t key, int depth) const {
+        int n = 0;
+        while (!nodes[n].leaf && nodes[n].depth < depth) {
+            n = nodes[n].child[octant(key, nodes[n].depth + 1)];
+            if (n < 0) return -1;
+        }
+        return n;
+    }
+};
+
+// A directory removed with everything in it unless kept.
+class DirectoryGuard {
+public:
+    explicit DirectoryGuard(std::string path) : path_(std::move(path)) {}
+    ~DirectoryGuard() {
+        if (!path_.empty()) {
+            std::error_code ec;
+            fs::remove_all(path_, ec);
+        }
+    }
+    DirectoryGuard(const DirectoryGuard&) = delete;
+    DirectoryGuard& operator=(const DirectoryGuard&) = delete;
+    const std::string& path() const { return path_; }
+    void keep() { path_.clear(); }
+
+private:
+    std::string path_;
+};
+
+std::string make_directory_beside(const std::string& target, const std::string& tag) {
+    std::string pattern = target + "." + tag + "-XXXXXX";
+    if (::mkdtemp(pattern.data()) == nullptr)
+        throw io::Error(target, "cannot create a directory beside it: " + std::string(std::strerror(errno)));
+    return pattern;
+}
+
+// The forwarding sink of a step: its phases labelled "tiles: <step>: <phase>".
+class StepProgress final : public ProgressSink {
+public:
+    StepProgress(ProgressSink& out, std::string step) : out_(out), step_(std::move(step)) {}
+    void phase(std::string label, std::optional<uint64_t> total) override {
+        out_.phase("tiles: " + step_ + ": " + label, total);
+    }
+    void update(uint64_t done) override { out_.update(done); }
+    void update(uint64_t done, uint64_t bytes_read, std::optional<uint64_t> file_bytes) override {
+        out_.update(done, bytes_read, file_bytes);
+    }
+    void status(const std::string& text) override { out_.status("tiles: " + step_ + ": " + text); }
+    bool cancelled() const override { return out_.cancelled(); }
+
+private:
+    ProgressSink& out_;
+    std::string step_;
+};
+
+io::GltfSettings::Compression gltf_compression(TileCompression c) {
+    switch (c) {
+        case TileCompression::kDraco: return io::GltfSettings::Compression::kDraco;
+        case TileCompression::kNone: return io::GltfSettings::Compression::kNone;
+        case TileCompression::kMeshopt: break;
+    }
+    return io::GltfSettings::Compression::kMeshopt;
+}
+
+// The column-major 4 × 4 transform from east-north-up at `o` to Earth-centred, Earth-fixed
+// coordinates (WGS84).
+std::array<double, 16> enu_to_ecef(const GeoOrigin& o) {
+    constexpr double kA = 6378137.0, kF = 1 / 298.257223563;
+    constexpr double kE2 = kF * (2 - kF);
+    const double lon = o.longitude * std::numbers::pi / 180, lat = o.latitude * std::numbers::pi / 180;
+    const double sl = std::sin(lat), cl = std::cos(lat), so = std::sin(lon), co = std::cos(lon);
+    const double n = kA / std::sqrt(1 - kE2 * sl * sl);
+    const double x = (n + o.height) * cl * co, y = (n + o.height) * cl * so, z = (n * (1 - kE2) + o.height) * sl;
+    return {-so, co, 0, 0,                 // east
+            -sl * co, -sl * so, cl, 0,     // north
+            cl * co, cl * so, sl, 0,       // up
+            x, y, z, 1};
+}
+
+// One level's tiles written from a mesh file: its triangles sorted by cell key, each run of a
+// tile's cell written as that tile's GLB.
+class TileWriter {
+public:
+    TileWriter(const TilesSettings& s, Tree& tree, const Cube& cube, const std::string& root)
+        : s_(s), tree_(tree), cube_(cube), root_(root) {}
+
+    // Writes the tiles of `mesh` whose cell `select` picks (a node id, or -1 to skip the
+    // triangle); counts in `region[d]` the triangles whose node at depth d is not a leaf.
+    void write_level(const std::string& mesh, std::string_view format, const std::function<int(uint32_t)>& select,
+                     std::vector<uint64_t>* region, ProgressSink& progress, Warnings* warnings, TilesResult* result) {
+        io::TriangleInput in(io::open_input(mesh, format, s_.read), io::BadTriangles::kDrop);
+        const io::MeshHeader& header = in.header();
+        const io::Format& glb = io::output_format("x.glb", "glb");
+        io::WriteOptions wo;
+        wo.tmpdir = s_.read.tmpdir;
+        wo.memory_budget_bytes = s_.read.memory_budget_bytes;
+        io::GltfSettings gs;
+        gs.compression = gltf_compression(s_.compression);
+        if (gs.compression == io::GltfSettings::Compression::kMeshopt) {
+            io::GltfSettings::Grid grid;
+            // The cube turned y-up, as the positions are: (x, z, -y).
+            grid.origin[0] = float(cube_.origin[0]);
+            grid.origin[1] = float(cube_.origin[2]);
+            grid.origin[2] = float(-(cube_.origin[1] + cube_.extent));
+            grid.extent = float(cube_.extent);
+            gs.grid = grid;
+        }
+        wo.format_options.set(gs);
+        const io::Channels wanted = s_.read.channels.of(header.channels);
+        wo.channels = io::writable_channels(glb, wanted, wo);
+        wo.channels.vertex_id = false;
+        if (wo.channels.material) wo.materials = header.materials;
+        if (warnings != nullptr) {
+            if (const std::string dropped = io::describe_missing(wanted, wo.channels); !dropped.empty())
+                warnings->note("channels_dropped", dropped_channels_text(dropped, glb, wo.channels));
+        }
+
+        sort::SorterOptions so;
+        so.memory_budget_bytes = s_.read.memory_budget_bytes / 2;
+        so.tmpdir = s_.read.tmpdir;
+        so.channels = wo.channels;
+        so.key = [this](const float* xyz) { return cube_.triangle_key(xyz); };
+        sort::ExternalSorter sorter(so);
+        io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, wo.channels);
+        progress.phase("sorting by cell", header.triangle_count);
+        while (in.next(chunk)) {
+            sorter.add(chunk);
+            progress.update(in.count().read, in.source().stored_offset(), in.source().stored_size());
+            throw_if_cancelled(progress);
+        }
+        sorter.finish_input();
+        if (warnings != nullptr) {
+            note_dropped_triangles(dropped_triangles(in), "left out", *warnings);
+            note_input_changes(in.header(), in.name(), *warnings);
+        }
+        if (result != nullptr) {
+            result->input_name = in.name();
+            result->input_format = std::string(in.format().name);
+            result->triangles_in = in.count().read;
+        }
+
+        progress.phase("writing tiles", sorter.triangle_count());
+        io::TriangleChunk out(io::TriangleChunk::kDefaultCapacity, wo.channels);
+        int current = -1;
+        std::optional<io::Output> tile;
+        uint64_t done = 0;
+        auto flush = [&] {
+            if (!out.empty()) tile->write(out), out.clear();
+        };
+        auto close = [&] {
+            if (current < 0) return;
+            flush();
+            if (wo.channels.material) tile->writer->update_materials(in.header().materials);
+            tile->finish();
+            Node& n = tree_.nodes[size_t(current)];
+            n.bytes = fs::file_size(fs::path(root_) / n.uri);
+            tile.reset();
+            current = -1;
+        };
+        while (sorter.next(chunk)) {
+            for (size_t i = 0; i < chunk.size(); ++i) {
+                const float* xyz = &chunk.xyz()[9 * i];
+                const uint32_t key = cube_.triangle_key(xyz);
+                if (region != nullptr)
+                    for (int n = 0; n >= 0 && !tree_.nodes[size_t(n)].leaf;) {
+                        const Node& node = tree_.nodes[size_t(n)];
+                        if (size_t(node.depth) < region->size()) ++(*region)[size_t(node.depth)];
+                        n = node.child[octant(key, node.depth + 1)];
+                    }
+                const int target = select(key);
+                if (target < 0) continue;
+                if (target != current) {
+                    close();
+                    current = target;
+                    Node& n = tree_.nodes[size_t(current)];
+                    n.uri = "tiles/" + std::to_string(n.depth) + "/" + std::to_string(n.prefix >> (3 * (kMaxDepth - n.depth))) + ".glb";
+                    fs::create_directories(fs::path(root_) / "tiles" / std::to_string(n.depth));
+                    wo.expected_triangle_count = n.count ? n.count : std::optional<uint64_t>();
+                    tile.emplace(io::open_output((fs::path(root_) / n.uri).string(), "glb", wo));
+                }
+                Node& n = tree_.nodes[size_t(current)];
+                for (int c = 0; c < 3; ++c) n.box.add(xyz + 3 * c);
+                ++n.triangles;
+                // y-up for glTF: (x, y, z) → (x, z, -y).
+                out.push_copy(chunk, i);
+                float* p = &out.xyz()[9 * (out.size() - 1)];
+                for (int c = 0; c < 3; ++c) {
+                    const float y = p[3 * c + 1];
+                    p[3 * c + 1] = p[3 * c + 2];
+                    p[3 * c + 2] = -y;
+                }
+                if (float* nrm = out.normal_at(out.size() - 1))
+                    for (int c = 0; c < 3; ++c) {
+                        const float y = nrm[3 * c + 1];
+                        nrm[3 * c + 1] = nrm[3 * c + 2];
+                        nrm[3 * c + 2] = -y;
+                    }
+                if (out.full()) flush();
+            }
+            done += chunk.size();
+            progress.update(done);
+            throw_if_cancelled(progress);
+        }
+        close();
+    }
+
+private:
+    const TilesSettings& s_;
+    Tree& tree_;
+    const Cube& cube_;
+    std::string root_;
+};
+
+// A tile's triangles as read back from its GLB (positions as stored: y-up).
+std::vector<float> tile_positions(const std::string& path) {
+    std::vector<float> xyz;
+    io::TriangleInput in(io::open_input(path, "glb", {}), io::BadTriangles::kKeep);
+    io::TriangleChunk chunk;
+    while (in.next(chunk)) xyz.insert(xyz.end(), chunk.xyz().begin(), chunk.xyz().end());
+    return xyz;
+}
+
+Json box_json(const Box& b, double pad) {
+    Json j = Json::array();
+    double c[3], h[3];
+    for (int a = 0; a < 3; ++a) c[a] = (b.min[a] + b.max[a]) / 2, h[a] = (b.max[a] - b.min[a]) / 2 + pad;
+    j = {c[0], c[1], c[2], h[0], 0, 0, 0, h[1], 0, 0, 0, h[2]};
+    return Json{{"box", j}};
+}
+
+}  // namespace
+
+TilesResult tile_file(const TilesSettings& s, ProgressSink& progress) {
+    if (s.tile_triangles < kMinTileTriangles)
+        throw io::OptionError(Setting::kTileTriangles, mention(Setting::kTileTriangles) + " must be at least " +
+                                                            std::to_string(kMinTileTriangles) + ", got " +
+                                                            std::to_string(s.tile_triangles));
+    if (s.origin && (!(std::fabs(s.origin->latitude) <= 90) || !(std::fabs(s.origin->longitude) <= 180) ||
+                     !std::isfinite(s.origin->height) || std::fabs(s.origin->height) > 1e7))
+        throw io::OptionError(Setting::kOrigin, mention(Setting::kOrigin) +
+                                                    " must be a longitude in -180..180, a latitude in -90..90 and a "
+                                                    "height within 10 000 km, got " +
+                                                    std::to_string(s.origin->longitude) + "," +
+                                                    std::to_string(s.origin->latitude) + "," +
+                                                    std::to_string(s.origin->height));
+    const fs::path outdir = fs::path(s.outdir).lexically_normal();
+    if (outdir.empty() || s.outdir == "-")
+        throw io::OptionError(Setting::kOutput, "the output must be a directory, got '" + s.outdir + "'");
+    std::error_code ec;
+    const bool exists = fs::exists(outdir, ec);
+    if (exists && !fs::is_directory(outdir, ec))
+        throw io::OptionError(Setting::kOutput, outdir.string() + ": exists and is not a directory");
+    if (exists && !fs::is_empty(outdir, ec) && !s.overwrite)
+        throw io::OptionError(Setting::kOverwrite, outdir.string() + ": the directory is not empty; its files are kept "
+                                                   "unless " + mention(Setting::kOverwrite) + " is given");
+    if (fs::path parent = outdir.has_parent_path() ? outdir.parent_path() : fs::path(".");
+        ::access(parent.c_str(), W_OK) != 0)
+        throw io::Error(outdir.string(), "cannot write here: directory '" + parent.string() +
+                                             "' does not exist or is not writable");
+
+    TilesResult result;
+    // The tileset is built here, renamed to outdir when complete.
+    DirectoryGuard building(make_directory_beside(outdir.string(), "building"));
+    // The level meshes and a spooled stdin.
+    std::string tmp = s.read.tmpdir.empty() ? (std::getenv("TMPDIR") ? std::getenv("TMPDIR") : "/tmp") : s.read.tmpdir;
+    DirectoryGuard work(make_directory_beside((fs::path(tmp) / "meshstream-tiles").string(), "work"));
+
+    std::string input = s.input;
+    std::string input_format = s.input_format;
+    if (!is_regular_file(input)) {
+        // Read more than once: a pipe is spooled first.
+        StepProgress step(progress, "spooling the input");
+        ConvertSettings cs;
+        cs.input = s.input;
+        cs.input_format = s.input_format;
+        cs.output = (fs::path(work.path()) / "input.mstream").string();
+        cs.output_format = "stream";
+        cs.read = s.read;
+        convert_file(cs, step);
+        input = cs.output;
+        input_format = "stream";
+    }
+
+    // The bounding cube, and the cells' counts.
+    Cube cube;
+    Tree tree;
+    {
+        StepProgress step(progress, "counting");
+        const io::Bounds b = input_bounds(input, input_format, s.read, step);
+        double extent = 0;
+        for (int a = 0; a < 3; ++a) {
+            cube.origin[a] = b.min[a];
+            extent = std::max(extent, double(b.max[a]) - double(b.min[a]));
+        }
+        if (!(extent >= 0) || !std::isfinite(extent))
+            throw io::Error(s.input, "no triangle with finite coordinates: nothing to tile");
+        cube.extent = extent > 0 ? extent * (1 + 1e-6) : 1;
+        std::unordered_map<uint32_t, uint64_t> counts;
+        io::TriangleInput in(io::open_input(input, input_format, s.read), io::BadTriangles::kDrop);
+        io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, {});
+        step.phase("cells", in.header().triangle_count);
+        while (in.next(chunk)) {
+            for (size_t i = 0; i < chunk.size(); ++i) ++counts[cube.triangle_key(&chunk.xyz()[9 * i])];
+            step.update(in.count().read, in.source().stored_offset(), in.source().stored_size());
+            throw_if_cancelled(progress);
+        }
+        if (counts.empty()) throw io::Error(s.input, "no triangle to tile");
+        std::vector<std::pair<uint32_t, uint64_t>> cells(counts.begin(), counts.end());
+        counts = {};
+        std::sort(cells.begin(), cells.end());
+        tree.build(cells, 0, cells.size(), 0, 0, s.tile_triangles);
+    }
+    const int deepest = tree.max_depth;
+
+    // The leaves: the input at full resolution.
+    TileWriter writer(s, tree, cube, building.path());
+    std::vector<uint64_t> region(size_t(std::max(deepest, 1)), 0);
+    {
+        StepProgress step(progress, "leaves");
+        writer.write_level(
+            input, input_format,
+            [&](uint32_t key) {
+                const int n = tree.at(key, kMaxDepth);
+                return n >= 0 && tree.nodes[size_t(n)].leaf ? n : -1;
+            },
+            &region, step, &result.warnings, &result);
+    }
+
+    // The levels above, each decimated from the one below as one mesh.
+    std::string below = input, below_format = input_format;
+    uint64_t below_count = result.triangles_in;
+    for (int depth = deepest - 1; depth >= 0; --depth) {
+        uint64_t cells_here = 0;
+        for (const Node& n : tree.nodes) cells_here += n.depth == depth && !n.leaf;
+        const double share = region[size_t(depth)] > 0 ? double(s.tile_triangles * cells_here) / double(region[size_t(depth)]) : 1;
+        const uint64_t target = std::max<uint64_t>(1, uint64_t(std::llround(share * double(below_count))));
+        std::string level = below, level_format = below_format;
+        if (target < below_count) {
+            StepProgress step(progress, "level " + std::to_string(depth));
+            DecimateSettings ds;
+            ds.input = below;
+            ds.input_format = below_format;
+            ds.output = (fs::path(work.path()) / ("level" + std::to_string(depth) + ".mstream")).string();
+            ds.output_format = "stream";
+            ds.target = target;
+            ds.threads = s.threads;
+            ds.seed = s.seed;
+            ds.read = s.read;
+            ds.write.tmpdir = s.read.tmpdir;
+            const DecimateResult d = decimate_file(ds, step);
+            level = ds.output;
+            level_format = "stream";
+            below_count = d.triangles_out;
+        }
+        std::fill(region.begin(), region.end(), 0);
+        StepProgress step(progress, "level " + std::to_string(depth) + " tiles");
+        writer.write_level(
+            level, level_format,
+            [&](uint32_t key) {
+                const int n = tree.at(key, depth);
+                return n >= 0 && !tree.nodes[size_t(n)].leaf && tree.nodes[size_t(n)].depth == depth ? n : -1;
+            },
+            &region, step, nullptr, nullptr);
+        // The level below is no longer needed (the input stays).
+        if (below != input) fs::remove(below, ec);
+        below = level, below_format = level_format;
+
+        // The errors of this depth's tiles: to their children's content, plus the children's own.
+        step.phase("measuring errors", cells_here);
+        uint64_t measured = 0;
+        for (Node& n : tree.nodes) {
+            if (n.depth != depth || n.leaf) continue;
+            std::vector<float> children;
+            double child_error = 0;
+            Box child_box;
+            for (int c : n.child) {
+                if (c < 0) continue;
+                const Node& ch = tree.nodes[size_t(c)];
+                child_error = std::max(child_error, ch.error);
+                if (!ch.uri.empty()) {
+                    std::vector<float> xyz = tile_positions((fs::path(building.path()) / ch.uri).string());
+                    children.insert(children.end(), xyz.begin(), xyz.end());
+                }
+            }
+            double distance = 0;
+            if (!n.uri.empty() && !children.empty()) {
+                std::vector<float> own = tile_positions((fs::path(building.path()) / n.uri).string());
+                compare::CompareOptions co;
+                co.samples = std::max<uint64_t>(10000, std::max(own.size(), children.size()) / 9);
+                co.seed = s.seed;
+                co.tmpdir = s.read.tmpdir;
+                const compare::CompareResult r = compare::compare_meshes(compare::memory_source("tile", std::move(own)),
+                                                                         compare::memory_source("children", std::move(children)), co);
+                distance = r.hausdorff();
+            } else if (n.uri.empty()) {
+                distance = 0;  // no content: nothing drawn instead of the children
+            }
+            n.error = distance + child_error;
+            step.update(++measured);
+            throw_if_cancelled(progress);
+        }
+    }
+
+    // The boxes: each tile's content and its children's.
+    for (int i = int(tree.nodes.size()) - 1; i >= 0; --i) {
+        Node& n = tree.nodes[size_t(i)];
+        for (int c : n.child)
+            if (c >= 0) n.box.add(tree.nodes[size_t(c)].box);
+    }
+    // Boxes cover the quantized positions too: a quantization step beyond the exact ones (the
+    // common grid's with meshopt; Draco's 14 bits over the tile's own box).
+    auto pad = [&](const Box& b) {
+        if (s.compression == TileCompression::kMeshopt) return cube.extent / 65535.0;
+        double extent = 0;
+        for (int a = 0; a < 3; ++a) extent = std::max(extent, b.max[a] - b.min[a]);
+        return s.compression == TileCompression::kDraco ? extent / 16383.0 : cube.extent * 1e-7;
+    };
+
+    std::function<Json(int)> tile_json = [&](int id) {
+        const Node& n = tree.nodes[size_t(id)];
+        Json t;
+        t["boundingVolume"] = box_json(n.box, pad(n.box));
+        t["geometricError"] = n.error;
+        if (!n.uri.empty()) t["content"] = {{"uri", n.uri}};
+        Json children = Json::array();
+        for (int c : n.child)
+            if (c >= 0 && !tree.nodes[size_t(c)].box.empty()) children.push_back(tile_json(c));
+        if (!children.empty()) t["children"] = children;
+        return t;
+    };
+    Json root = tile_json(0);
+    root["refine"] = "REPLACE";
+    if (s.origin) {
+        const std::array<double, 16> m = enu_to_ecef(*s.origin);
+        root["transform"] = Json(std::vector<double>(m.begin(), m.end()));
+    }
+    const Node& top = tree.nodes[0];
+    result.geometric_error = std::max(top.box.diagonal(), top.error);
+    Json tileset = {{"asset", {{"version", "1.1"}, {"generator", std::string("meshstream tiles")}}},
+                    {"geometricError", result.geometric_error},
+                    {"root", root}};
+    {
+        const std::string path = (fs::path(building.path()) / "tileset.json").string();
+        std::ofstream f(path);
+        f << tileset.dump(1) << '\n';
+        f.close();
+        if (!f) throw io::Error(path, "cannot write: " + std::string(std::strerror(errno)));
+    }
+
+    // The figures per depth.
+    result.levels.assign(size_t(deepest + 1), TileLevel{});
+    for (int d = 0; d <= deepest; ++d) result.levels[size_t(d)].depth = d, result.levels[size_t(d)].min_error = HUGE_VAL;
+    for (const Node& n : tree.nodes) {
+        if (n.uri.empty()) continue;
+        TileLevel& l = result.levels[size_t(n.depth)];
+        ++l.tiles;
+        l.leaves += n.leaf;
+        l.triangles += n.triangles;
+        l.bytes += n.bytes;
+        l.min_error = std::min(l.min_error, n.error);
+        l.max_error = std::max(l.max_error, n.error);
+        ++result.tiles;
+        result.bytes += n.bytes;
+        if (n.leaf) result.leaf_bytes += n.bytes;
+    }
+    for (TileLevel& l : result.levels)
+        if (l.tiles == 0) l.min_error = 0;
+    result.bytes += fs::file_size(fs::path(building.path()) / "tileset.json");
+
+    // Into place: an existing outdir (allowed by `overwrite`) goes only once the new one is whole.
+    throw_if_cancelled(progress);
+    if (exists) {
+        const std::string old = make_directory_beside(outdir.string(), "replaced");
+        DirectoryGuard replaced(old);
+        fs::rename(outdir, fs::path(old) / "old");
+        fs::rename(building.path(), outdir);
+    } else {
+        fs::rename(building.path(), outdir);
+    }
+    building.keep();
+    return result;
+}
+
+TilesetSummary summarize_tileset(const std::string& tileset_json) {
+    TilesetSummary out;
+    std::function<void(const fs::path&, const Json&, int)> walk_tile;
+    auto load = [&](const fs::path& file) {
+        std::ifstream f(file);
+        if (!f) throw io::Error(file.string(), "cannot open: " + std::string(std::strerror(errno)));
+        Json j;
+        try {
+            j = Json::parse(f);
+        } catch (const Json::exception& e) {
+            throw io::Error(file.string(), std::string("not a tileset: ") + e.what());
+        }
+        if (!j.is_object() || !j.contains("root") || !j["root"].is_object())
+            throw io::Error(file.string(), "not a tileset: no root tile");
+        ++out.json_files;
+        out.bytes += fs::file_size(file);
+        return j;
+    };
+    walk_tile = [&](const fs::path& file, const Json& t, int depth) {
+        int child_depth = depth;
+        if (t.contains("content") && t["content"].contains("uri")) {
+            const fs::path target = file.parent_path() / t["content"]["uri"].get<std::string>();
+            if (target.extension() == ".json") {
+                const Json sub = load(target);
+                walk_tile(target, sub["root"], depth);
+            } else {
+                if (out.levels.size() <= size_t(depth)) {
+                    out.levels.resize(size_t(depth) + 1);
+                    out.levels[size_t(depth)].depth = depth;
+                    out.levels[size_t(depth)].min_error = HUGE_VAL;
+                }
+                TileLevel& l = out.levels[size_t(depth)];
+                uint64_t triangles = 0;
+                {
+                    io::Input in = io::open_input(target.string(), {}, {});
+                    triangles = in.reader->header().triangle_count.value_or(0);
+                }
+                const double e = t.value("geometricError", 0.0);
+                ++l.tiles;
+                l.leaves += !t.contains("children") || t["children"].empty();
+                l.triangles += triangles;
+                l.bytes += fs::file_size(target);
+                l.min_error = std::min(l.min_error, e);
+                l.max_error = std::max(l.max_error, e);
+                ++out.tiles;
+                out.triangles += triangles;
+                out.bytes += fs::file_size(target);
+                child_depth = depth + 1;
+            }
+        }
+        if (t.contains("children"))
+            for (const Json& c : t["children"]) walk_tile(file, c, child_depth);
+    };
+    const fs::path file(tileset_json);
+    const Json j = load(file);
+    out.version = j.contains("asset") ? j["asset"].value("version", "") : "";
+    out.geometric_error = j.value("geometricError", 0.0);
+    out.placed = j["root"].contains("transform");
+    walk_tile(file, j["root"], 0);
+    for (TileLevel& l : out.levels)
+        if (l.tiles == 0) l.min_error = 0;
+    return out;
+}
+
+}  // namespace meshstream::engine

@@ -1,0 +1,50 @@
+#!/bin/bash
+# The official 3D Tiles validator on tilesets `meshstream tiles` writes from the bunny fixture:
+# meshopt, Draco and plain content, placed on the globe or not, each with 0 errors and 0
+# warnings (validate.sh --strict). Also the command's refusal of a non-empty OUTDIR (exit 2, the
+# directory kept).
+#   validate_tilesets.sh MESHSTREAM FIXTURES_DIR VALIDATOR_SOURCE VALIDATOR_DIR
+# Exit 77 (ctest's skip) with the reason when the validator's source (../shared) or node is
+# absent; the validator is set up into VALIDATOR_DIR when it is not there yet.
+set -u
+meshstream=$1 fixtures=$2 source=$3 validator=$4
+if [ ! -x "$source/validate.sh" ]; then
+  echo "SKIPPED: the 3D Tiles validator's source is not at $source (../shared/peers beside the checkout)"
+  exit 77
+fi
+if ! command -v node >/dev/null; then
+  echo "SKIPPED: node is not installed (tools/bootstrap.sh installs it)"
+  exit 77
+fi
+if [ ! -d "$validator" ] || ! bash "$source/setup.sh" "$validator" >/dev/null 2>&1; then
+  bash "$source/setup.sh" "$validator" || { echo "FAILED: cannot set up the validator in $validator"; exit 1; }
+fi
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+status=0
+for case in "meshopt" "draco" "none" "meshopt --origin 7.4474,46.9480,540"; do
+  name=${case// /_}
+  name=${name//[,.-]/_}
+  # shellcheck disable=SC2086  # the case's words are options
+  if ! "$meshstream" -q tiles "$fixtures/bunny_from_draco.bin.stl" "$work/$name" --tile-triangles 5000 --compress $case; then
+    echo "FAILED: meshstream tiles --compress $case"
+    status=1
+    continue
+  fi
+  if bash "$source/validate.sh" --strict "$work/$name/tileset.json" "$validator" > "$work/$name.report" 2>&1; then
+    echo "ok: --compress $case: $(grep numErrors "$work/$name.report")"
+  else
+    echo "FAILED: --compress $case:"
+    grep -E "numErrors|ERROR|WARNING" "$work/$name.report" | head -20
+    status=1
+  fi
+done
+# A non-empty OUTDIR: exit 2, nothing touched.
+mkdir -p "$work/full" && echo mine > "$work/full/keep.txt"
+"$meshstream" -q tiles "$fixtures/bunny_from_draco.bin.stl" "$work/full" 2> "$work/full.err"
+rc=$?
+if [ $rc -ne 2 ] || ! grep -q "the directory is not empty" "$work/full.err" || [ "$(ls "$work/full")" != keep.txt ]; then
+  echo "FAILED: a non-empty OUTDIR gave exit $rc: $(cat "$work/full.err")"
+  status=1
+fi
+exit $status
