@@ -445,8 +445,9 @@ void HalfEdgeBuffer::finalize_vertex(uint32_t v) {
             --pinned_face_count_;
             enter_interior(face_of(c));
         }
-    // A vertex where two fans touch must not move (it is not a manifold vertex); finding out
-    // now, once, spares every collapse the walk.
+    // A vertex where two fans touch is no manifold vertex: it moves only when every fan is open
+    // (boundary loops touching there, collapse.hpp). Finding out now, once, spares every
+    // collapse the walks.
     if (!one_fan(v)) x.flags |= open_fans(v) ? kManyFans | kOpenFans : kManyFans;
     mark_pending(v);
 }

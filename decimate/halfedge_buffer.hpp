@@ -72,11 +72,11 @@ inline constexpr uint16_t kHasPartner = 32;   // partner_position() holds a coll
 inline constexpr uint16_t kPending = 64;      // listed for take_pending()
 inline constexpr uint16_t kBlocked = 128;     // a collapse at it was refused (collapse.hpp)
 inline constexpr uint16_t kManyFans = 256;    // its faces are not one fan (two fans touch here)
+inline constexpr uint16_t kSeam = 512;        // its corners disagree in attributes (attribute_store.hpp)
+inline constexpr uint16_t kHasValues = 1024;  // its attribute record is set up (attribute_store.hpp)
 // With kManyFans: every fan is open, so the fans meet at this vertex only (boundary loops that
 // touch here), and the vertex may slide along a boundary edge (collapse.hpp).
 inline constexpr uint16_t kOpenFans = 2048;
-inline constexpr uint16_t kSeam = 512;        // its corners disagree in attributes (attribute_store.hpp)
-inline constexpr uint16_t kHasValues = 1024;  // its attribute record is set up (attribute_store.hpp)
 
 struct Vertex {
     float pos[3];           // input position, moved by collapses and once when written (§4.4)
