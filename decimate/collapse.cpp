@@ -454,6 +454,10 @@ void apply_collapse(HalfEdgeBuffer& buffer, uint32_t h) {
     join(o1, o2);
     if (!e.boundary) join(u1, u2);
 
+    // Boundary loops that touched at p (all its fans open: collapse_eligible) touch at q now. q,
+    // on one of them, was in one open fan, or in several with or without kOpenFans, which holds.
+    uint16_t& q_flags = buffer.vertex(e.q).flags;
+    if ((buffer.vertex(e.p).flags & kManyFans) && (q_flags & kManyFans) == 0) q_flags |= kManyFans | kOpenFans;
     buffer.move_corners(e.p, e.q);
     buffer.quadric(e.q) += buffer.quadric(e.p);
     if ((buffer.vertex(e.q).flags & kFrozen) == 0) buffer.set_partner(e.q, buffer.vertex(e.p).pos);

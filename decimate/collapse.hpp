@@ -26,7 +26,10 @@ inline constexpr uint32_t kMaxMovedFaces = 32;
 // p interior (one closed fan, not on P_in/P_out, manifold), q manifold and not on P_in.
 // Beyond the paper: a true-boundary p (a hole, off P_in and P_out, one open fan) may also
 // collapse along its outgoing boundary edge (twin kOpenEdge), as in Garland & Heckbert; its
-// quadric holds the boundary planes added when it left P_in, which keep the hole's outline.
+// quadric holds the boundary planes added when it left P_in, which keep the hole's outline. So
+// may a p where boundary loops touch (kManyFans with kOpenFans: several fans, all open): its
+// quadric holds the boundary planes of every loop through it, which price moving it off any of
+// them, and the link condition over all its faces keeps the edges manifold.
 // With channels (attribute_store.hpp): a seam vertex p collapses only along its seam (seam_slides),
 // and a seam vertex q takes any other collapse only where its corners on the edge's two faces
 // agree (seam_allows).
@@ -34,14 +37,16 @@ bool seam_allows(const HalfEdgeBuffer& buffer, uint32_t h);
 bool seam_slides(const HalfEdgeBuffer& buffer, uint32_t h);
 inline bool collapse_eligible(const HalfEdgeBuffer& buffer, uint32_t h) {
     const Vertex& p = buffer.vertex(buffer.corner_vertex(h));
-    if ((p.flags & (kInHash | kFrozen | kNonManifold | kManyFans)) != 0) return false;
+    if ((p.flags & (kInHash | kFrozen | kNonManifold)) != 0) return false;
+    const bool touching = (p.flags & kManyFans) != 0;
+    if (touching && (p.flags & (kOpenFans | kSeam)) != kOpenFans) return false;
     if (p.flags & kSeam) {
         const Vertex& q = buffer.vertex(buffer.corner_vertex(next_in_face(h)));
         return p.open_edges == 0 && (q.flags & (kInHash | kNonManifold)) == 0 && seam_slides(buffer, h);
     }
     if (p.open_edges == 0) {
         if (!is_half_edge(buffer.twin(h))) return false;
-    } else if (p.open_edges != 2 || buffer.twin(h) != kOpenEdge) {
+    } else if ((p.open_edges != 2 && !touching) || buffer.twin(h) != kOpenEdge) {
         return false;
     }
     const Vertex& q = buffer.vertex(buffer.corner_vertex(next_in_face(h)));
@@ -97,7 +102,9 @@ CollapsePlacement singular_merge(const HalfEdgeBuffer& buffer, const Quadric& su
 //    output, where the link condition, which sees only in-core edges, cannot find it;
 //  - a remaining face of p (or of q, when q moves) would flip, fold or degenerate
 //    (moves_keep_faces_valid).
-// p's faces are one fan (kManyFans is found when p leaves P_in), so nothing else can pinch.
+// p's faces are one fan (kManyFans is found when p leaves P_in), or several open fans
+// (kOpenFans), whose faces the link condition walks all of: a face of another fan on p and q
+// would have a third corner next to both.
 bool shares_apex(const HalfEdgeBuffer& buffer, uint32_t h);
 bool collapses_tetrahedron(const HalfEdgeBuffer& buffer, uint32_t h);
 bool pinches_link(HalfEdgeBuffer& buffer, uint32_t h);

@@ -51,8 +51,11 @@ void rate_edge(HalfEdgeBuffer& buffer, CollapseQueue& queue, uint32_t h) {
         return (from.flags & (kNoSource & ~kSeam)) == 0 && (from.flags & kSeam) && from.open_edges == 0 &&
                (to.flags & kNoTarget) == 0 && seam_slides(buffer, along);
     };
-    const bool forward = ((vp.flags & kNoSource) == 0 && (vq.flags & kNoTarget) == 0 &&
-                          (vp.open_edges == 0 ? twin_real : vp.open_edges == 2 && t == kOpenEdge) &&
+    // Boundary loops touching at p (kOpenFans): p slides along an open edge, as on one loop.
+    const bool touching = (vp.flags & (kManyFans | kOpenFans | kSeam)) == (kManyFans | kOpenFans);
+    const bool forward = ((vp.flags & (touching ? kNoSource & ~kManyFans : kNoSource)) == 0 &&
+                          (vq.flags & kNoTarget) == 0 &&
+                          (vp.open_edges == 0 ? twin_real : (vp.open_edges == 2 || touching) && t == kOpenEdge) &&
                           ((vq.flags & kSeam) == 0 || seam_allows(buffer, h))) ||
                          ((vp.flags & kSeam) && slides(vp, vq, h));
     const bool backward = twin_real && (((vq.flags & kNoSource) == 0 && (vp.flags & kNoTarget) == 0 &&

@@ -266,6 +266,21 @@ bool HalfEdgeBuffer::one_fan(uint32_t v) const {
     return count == x.face_count;
 }
 
+bool HalfEdgeBuffer::open_fans(uint32_t v) const {
+    // A fan starts at the face whose edge into v (prev→v) has no partner and is walked the other
+    // way (e → next(twin(e))), as in one_fan().
+    const Vertex& x = slots_[v].vertex;
+    uint32_t count = 0;
+    for (uint32_t c = x.first_corner; c != kNoIndex; c = next_corner(c)) {
+        if (is_half_edge(twin(prev_in_face(c)))) continue;
+        for (uint32_t e = c;; e = next_in_face(twin(e))) {
+            if (++count > x.face_count) return false;
+            if (!is_half_edge(twin(e))) break;
+        }
+    }
+    return count == x.face_count;
+}
+
 bool HalfEdgeBuffer::take_written_stub(uint32_t a, uint32_t b) {
     if (stub_count_ == 0) return false;
     const uint32_t ga = slots_[a].vertex.generation, gb = slots_[b].vertex.generation;
@@ -430,9 +445,10 @@ void HalfEdgeBuffer::finalize_vertex(uint32_t v) {
             --pinned_face_count_;
             enter_interior(face_of(c));
         }
-    // A vertex where two fans touch must not move (it is not a manifold vertex); finding out
-    // now, once, spares every collapse the walk.
-    if (!one_fan(v)) x.flags |= kManyFans;
+    // A vertex where two fans touch is no manifold vertex: it moves only when every fan is open
+    // (boundary loops touching there, collapse.hpp). Finding out now, once, spares every
+    // collapse the walks.
+    if (!one_fan(v)) x.flags |= open_fans(v) ? kManyFans | kOpenFans : kManyFans;
     mark_pending(v);
 }
 

@@ -74,6 +74,9 @@ inline constexpr uint16_t kBlocked = 128;     // a collapse at it was refused (c
 inline constexpr uint16_t kManyFans = 256;    // its faces are not one fan (two fans touch here)
 inline constexpr uint16_t kSeam = 512;        // its corners disagree in attributes (attribute_store.hpp)
 inline constexpr uint16_t kHasValues = 1024;  // its attribute record is set up (attribute_store.hpp)
+// With kManyFans: every fan is open, so the fans meet at this vertex only (boundary loops that
+// touch here), and the vertex may slide along a boundary edge (collapse.hpp).
+inline constexpr uint16_t kOpenFans = 2048;
 
 struct Vertex {
     float pos[3];           // input position, moved by collapses and once when written (§4.4)
@@ -358,6 +361,9 @@ private:
     double weld_cell(float x) const;  // grid index (an integral double) of a coordinate
     bool take_written_stub(uint32_t a, uint32_t b);
     bool one_fan(uint32_t v) const;
+    // True when every fan round v is open: the faces reached from each open edge into v,
+    // walking round v, are all of v's faces.
+    bool open_fans(uint32_t v) const;
     void enter_interior(uint32_t f);
 
     size_t face_capacity_, vertex_capacity_;

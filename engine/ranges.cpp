@@ -46,6 +46,24 @@ public:
         changed_.notify_all();
     }
     void progress(uint64_t decimated) override { decimated_ = decimated; }
+    // A range that reads from where it assumes its triangles start (RangeRun) holds its chunks
+    // back from the seam pass until its start is confirmed, or drops them (reset) and starts
+    // again.
+    void hold() {
+        const std::lock_guard lock(mutex_);
+        confirmed_ = false;
+    }
+    void confirm() {
+        const std::lock_guard lock(mutex_);
+        confirmed_ = true;
+        changed_.notify_all();
+    }
+    void reset() {
+        const std::lock_guard lock(mutex_);
+        chunks_.clear();  // their bytes stay in the file, unread
+        for (size_t& i : cursor_) i = 0;
+        decimated_ = 0;
+    }
     void close(const RangeOutcome& outcome, std::exception_ptr error) override {
         const std::lock_guard lock(mutex_);
         done_ = true;
@@ -64,9 +82,11 @@ public:
             std::unique_lock lock(mutex_);
             size_t& i = cursor_[size_t(piece)];
             for (;;) {
-                while (i < chunks_.size() && chunks_[i].piece != piece) ++i;
                 if (stop) return false;
-                if (i < chunks_.size()) break;
+                if (confirmed_) {
+                    while (i < chunks_.size() && chunks_[i].piece != piece) ++i;
+                    if (i < chunks_.size()) break;
+                }
                 if (done_) return false;
                 changed_.wait_for(lock, std::chrono::milliseconds(100));
                 lock.unlock();
@@ -126,6 +146,7 @@ private:
     std::vector<Chunk> chunks_;
     uint64_t written_ = 0;
     bool done_ = false;
+    bool confirmed_ = true;
     RangeOutcome outcome_;
     std::exception_ptr error_;
     std::atomic<uint64_t> decimated_{0};
@@ -135,10 +156,29 @@ private:
 // One range and, for the last one, what its read loop found.
 struct Range {
     std::unique_ptr<RangeSpool> spool;
-    // The last range reads the whole input: its read loop's figures are the input's.
     io::InputCount count;
     DroppedTriangles dropped;
     io::MeshHeader end_header;
+};
+
+// What the ranges on threads of decimate_in_ranges share.
+struct SharedCut {
+    explicit SharedCut(unsigned ranges)
+        : first_failed(ranges), first_drop(ranges), read_done(std::make_unique<std::atomic<bool>[]>(ranges)) {}
+    // The lowest range that failed: a range stops once a range before it failed, and runs on
+    // when one after it did, so that the error rethrown is the first in the file's order.
+    std::atomic<unsigned> first_failed;
+    // The lowest range but the last that read its own records (select_triangles) and met one
+    // the read loop drops: the ranges after it start elsewhere than they assumed.
+    std::atomic<unsigned> first_drop;
+    std::unique_ptr<std::atomic<bool>[]> read_done;  // range k has read its last triangle
+};
+
+// How a range on a thread of decimate_in_ranges runs besides the job.
+struct RangeRun {
+    Range* last = nullptr;         // the last range: its read loop's figures
+    RangeSpool* spool = nullptr;   // its sink
+    SharedCut* shared = nullptr;   // null for a range run elsewhere
 };
 
 // Range k's triangles: [start, end) of the read loop's passed triangles.
@@ -147,97 +187,146 @@ std::pair<uint64_t, uint64_t> range_bounds(const RangesJob& job, unsigned k) {
             k + 1 == job.ranges ? std::numeric_limits<uint64_t>::max() : job.cut_triangles * (k + 1) / job.ranges};
 }
 
-// run_range() with the last range's read loop figures kept.
-void run_range(const RangesJob& job, unsigned k, RangeSink& sink, std::atomic<bool>& stop, Range* last);
+void run_range(const RangesJob& job, unsigned k, RangeSink& sink, std::atomic<bool>& stop, const RangeRun& run);
 
 }  // namespace
 
 void run_range(const RangesJob& job, unsigned k, RangeSink& sink, std::atomic<bool>& stop) {
-    run_range(job, k, sink, stop, nullptr);
+    run_range(job, k, sink, stop, RangeRun{});
 }
 
 namespace {
 
-void run_range(const RangesJob& job, unsigned k, RangeSink& sink, std::atomic<bool>& stop, Range* last) {
+void run_range(const RangesJob& job, unsigned k, RangeSink& sink, std::atomic<bool>& stop, const RangeRun& run) {
     std::exception_ptr error;
     RangeOutcome outcome;
-    uint64_t decimated = 0;  // triangles of the range pushed so far
-    const auto [start, end] = range_bounds(job, k);
-    try {
-        io::TriangleInput in = job.open();
-        decimate::Options options = job.options;
-        options.part = decimate::Part::kRange;
-        // The triangles before the range are read past (no format has to seek); on sorted input
-        // their span along the axis tells the sweep which vertices an earlier range may share.
-        const int axis = options.sorted_axis.value_or(-1);
-        double span_lo = std::numeric_limits<double>::infinity(), span_hi = -span_lo;
-        io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, job.channels);
-        io::TriangleChunk part(io::TriangleChunk::kDefaultCapacity, job.channels);
-        uint64_t passed = 0;  // passed triangles of the read loop seen so far
-        size_t first = 0;     // the range begins at this triangle of `chunk`
-        bool straddles = false;
-        while (passed < start && !stop) {
-            if (!in.next(chunk)) break;
-            const size_t skip = size_t(std::min<uint64_t>(chunk.size(), start - passed));
-            if (axis >= 0)
-                for (size_t i = 0; i < 3 * skip; ++i) {
-                    const double v = chunk.xyz()[3 * i + size_t(axis)];
-                    span_lo = std::min(span_lo, v);
-                    span_hi = std::max(span_hi, v);
-                }
-            passed += skip;
-            if (skip < chunk.size()) {
-                first = skip;
-                straddles = true;
+    SharedCut* const shared = run.shared;
+    const auto halted = [&] { return stop || (shared && shared->first_failed < k); };
+    // A range of an unsorted binary STL on a thread here goes straight to the record where its
+    // triangles start when none before it is dropped (the cut counts the triangles the read loop
+    // passes on), and reads on from there; it confirms that assumption once the ranges before it
+    // have read theirs, or, as soon as one of them met a dropped triangle, starts again reading
+    // its way from the input's start. Any other range reads its way to its range.
+    bool may_select = shared != nullptr && !job.options.sorted_axis;
+    const bool is_last = k + 1 == job.ranges;
+    for (;;) {
+        outcome = {};
+        bool again = false;
+        uint64_t decimated = 0;  // triangles of the range pushed so far
+        const auto [start, end] = range_bounds(job, k);
+        try {
+            io::TriangleInput in = job.open();
+            decimate::Options options = job.options;
+            options.part = decimate::Part::kRange;
+            bool selected = false;
+            if (may_select && in.count().promised && start <= *in.count().promised) {
+                selected = in.select_triangles(start, *in.count().promised);
+                if (selected && k > 0) run.spool->hold();
             }
-        }
-        if (axis >= 0 && k > 0) options.earlier_span = std::array<double, 2>{span_lo, span_hi};
-        const std::unique_ptr<decimate::StreamDecimator> decimator = job.make_decimator(options);
-        const double weight = 1.0 / decimator->ratio();
-        const decimate::Emit interior = [&](const io::TriangleChunk& c) { sink.append(c, weight, Piece::kInterior); };
-        const decimate::Emit first_seam = [&](const io::TriangleChunk& c) { sink.append(c, 1.0, Piece::kFirstSeam); };
-        const decimate::Emit last_seam = [&](const io::TriangleChunk& c) { sink.append(c, 1.0, Piece::kLastSeam); };
-        // Pushes `c`; false at a forced write that stops the job.
-        auto push = [&](const io::TriangleChunk& c) {
-            decimator->push(c, interior);
-            decimated += c.size();
-            sink.progress(decimated);
-            if (!job.stop_at_forced_write || decimator->stats().forced_writes == 0) return true;
-            outcome.forced_at = decimated;
-            outcome.forced = true;
-            stop = true;
-            return false;
-        };
-        bool going = !stop;
-        if (straddles && going) {
-            part.clear();
-            for (size_t i = first; i < chunk.size() && passed < end; ++i, ++passed) part.push_copy(chunk, i);
-            going = push(part);
-        }
-        while (going && passed < end && !stop && in.next(chunk)) {
-            if (chunk.size() <= end - passed) {
-                passed += chunk.size();
-                going = push(chunk);
-            } else {
+            // A range assumed to start at its record starts again once a range before it dropped one.
+            const auto misplaced = [&] { return selected && shared->first_drop < k; };
+            // The triangles before the range are read past; on sorted input their span along the
+            // axis tells the sweep which vertices an earlier range may share.
+            const int axis = options.sorted_axis.value_or(-1);
+            double span_lo = std::numeric_limits<double>::infinity(), span_hi = -span_lo;
+            io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, job.channels);
+            io::TriangleChunk part(io::TriangleChunk::kDefaultCapacity, job.channels);
+            uint64_t passed = selected ? start : 0;  // passed triangles of the read loop seen so far
+            size_t first = 0;                        // the range begins at this triangle of `chunk`
+            bool straddles = false;
+            while (passed < start && !halted()) {
+                if (!in.next(chunk)) break;
+                const size_t skip = size_t(std::min<uint64_t>(chunk.size(), start - passed));
+                if (axis >= 0)
+                    for (size_t i = 0; i < 3 * skip; ++i) {
+                        const double v = chunk.xyz()[3 * i + size_t(axis)];
+                        span_lo = std::min(span_lo, v);
+                        span_hi = std::max(span_hi, v);
+                    }
+                passed += skip;
+                if (skip < chunk.size()) {
+                    first = skip;
+                    straddles = true;
+                }
+            }
+            if (axis >= 0 && k > 0) options.earlier_span = std::array<double, 2>{span_lo, span_hi};
+            const std::unique_ptr<decimate::StreamDecimator> decimator = job.make_decimator(options);
+            const double weight = 1.0 / decimator->ratio();
+            const decimate::Emit interior = [&](const io::TriangleChunk& c) { sink.append(c, weight, Piece::kInterior); };
+            const decimate::Emit first_seam = [&](const io::TriangleChunk& c) { sink.append(c, 1.0, Piece::kFirstSeam); };
+            const decimate::Emit last_seam = [&](const io::TriangleChunk& c) { sink.append(c, 1.0, Piece::kLastSeam); };
+            // Pushes `c`; false at a forced write that stops the job.
+            auto push = [&](const io::TriangleChunk& c) {
+                decimator->push(c, interior);
+                decimated += c.size();
+                sink.progress(decimated);
+                if (!job.stop_at_forced_write || decimator->stats().forced_writes == 0) return true;
+                outcome.forced_at = decimated;
+                outcome.forced = true;
+                stop = true;
+                return false;
+            };
+            bool going = !halted();
+            if (straddles && going) {
                 part.clear();
-                for (size_t i = 0; passed < end; ++i, ++passed) part.push_copy(chunk, i);
+                for (size_t i = first; i < chunk.size() && passed < end; ++i, ++passed) part.push_copy(chunk, i);
                 going = push(part);
             }
-        }
-        if (going && !stop) {
-            decimator->finish_range(interior, first_seam, last_seam);
-            outcome.stats = decimator->stats();
-            if (last) {
-                last->count = in.count();
-                last->dropped = dropped_triangles(in);
-                last->end_header = in.header();
+            while (going && passed < end && !halted() && !misplaced() && in.next(chunk)) {
+                if (selected && !is_last && in.count().dropped > 0) {
+                    unsigned dropping = shared->first_drop;
+                    while (k < dropping && !shared->first_drop.compare_exchange_weak(dropping, k)) {}
+                }
+                if (chunk.size() <= end - passed) {
+                    passed += chunk.size();
+                    going = push(chunk);
+                } else {
+                    part.clear();
+                    for (size_t i = 0; passed < end; ++i, ++passed) part.push_copy(chunk, i);
+                    going = push(part);
+                }
+            }
+            if (shared) shared->read_done[k] = true;
+            // Confirmed once every range before has read its triangles without a drop.
+            for (unsigned j = 0; selected && j < k && going && !halted() && !misplaced(); ++j)
+                while (!shared->read_done[j] && !halted() && !misplaced())
+                    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+            if (going && !halted() && misplaced()) {
+                again = true;
+            } else if (going && !halted()) {
+                if (selected && k > 0) run.spool->confirm();
+                decimator->finish_range(interior, first_seam, last_seam);
+                outcome.stats = decimator->stats();
+                if (selected) {
+                    outcome.selected = true;
+                    outcome.read = is_last ? in.count().read - start : end - start;
+                    outcome.non_finite = in.non_finite();
+                    outcome.degenerate = in.degenerate();
+                }
+                if (Range* last = run.last) {
+                    last->count = in.count();
+                    last->dropped = dropped_triangles(in);
+                    last->end_header = in.header();
+                }
+            }
+        } catch (...) {
+            // The first bad input in the file's order: with `shared`, the ranges before this one
+            // run on to their own errors, if any; without it (a range run elsewhere), every range
+            // reads the file from its start, so each range that fails fails at the first error
+            // before its end.
+            error = std::current_exception();
+            if (shared) {
+                unsigned failed = shared->first_failed;
+                while (k < failed && !shared->first_failed.compare_exchange_weak(failed, k)) {}
+            } else {
+                stop = true;
             }
         }
-    } catch (...) {
-        // The first bad input in the file's order: every range reads the file from its start,
-        // so each range that fails fails at the first error before its end.
-        error = std::current_exception();
-        stop = true;
+        if (!again) break;
+        if (shared) shared->read_done[k] = false;
+        run.spool->reset();
+        run.spool->confirm();
+        may_select = false;
     }
     sink.close(outcome, error);
 }
@@ -269,6 +358,7 @@ RangesResult decimate_in_ranges(const RangesJob& job, const decimate::Emit& emit
     const std::unique_ptr<decimate::StreamDecimator> seams = job.make_decimator(seam_options);
 
     std::atomic<bool> stop{false};
+    SharedCut shared(job.ranges);
     std::vector<std::thread> threads;
     // Every thread is joined before this function returns or throws (stopped first on a throw).
     struct Joiner {
@@ -295,9 +385,12 @@ RangesResult decimate_in_ranges(const RangesJob& job, const decimate::Emit& emit
         });
     }
     for (unsigned k = job.remote_ranges; k < job.ranges; ++k) {
-        Range* last = k + 1 == job.ranges ? ranges[k].get() : nullptr;
+        // The ranges read their own records only when every one runs here: ranges run elsewhere
+        // cannot confirm where theirs start.
+        const RangeRun run{k + 1 == job.ranges ? ranges[k].get() : nullptr, ranges[k]->spool.get(),
+                           job.remote_ranges == 0 ? &shared : nullptr};
         threads.emplace_back(
-            [&job, k, &stop, last, sink = ranges[k]->spool.get()] { run_range(job, k, *sink, stop, last); });
+            [&job, k, &stop, run, sink = ranges[k]->spool.get()] { run_range(job, k, *sink, stop, run); });
     }
 
     bool cancelled = false;
@@ -311,7 +404,7 @@ RangesResult decimate_in_ranges(const RangesJob& job, const decimate::Emit& emit
     double weight = 1;
     if (job.seams_after_ranges)
         for (const auto& r : ranges) r->spool->wait_closed(stop, tick);
-    for (unsigned k = 0; k < job.ranges && !stop; ++k) {
+    for (unsigned k = 0; k < job.ranges && k <= shared.first_failed && !stop; ++k) {
         for (const Piece piece : {Piece::kInterior, Piece::kFirstSeam, Piece::kLastSeam})
             while (ranges[k]->spool->next(piece, chunk, weight, stop, tick)) {
                 seams->push(chunk, weight, emit);
@@ -347,6 +440,19 @@ RangesResult decimate_in_ranges(const RangesJob& job, const decimate::Emit& emit
     result.count = last.count;
     result.dropped = last.dropped;
     result.end_header = last.end_header;
+    if (outcomes.back().selected) {
+        // Each range read its own triangles: the input's figures are their sums.
+        result.count.read = result.count.dropped = 0;
+        result.dropped = {};
+        for (const RangeOutcome& o : outcomes) {
+            if (!o.selected) throw std::logic_error("decimate_in_ranges: ranges cut two ways");
+            result.count.read += o.read;
+            result.count.dropped += o.non_finite + o.degenerate;
+            result.dropped.non_finite += o.non_finite;
+            result.dropped.degenerate += o.degenerate;
+        }
+        result.dropped.read = result.count.read;
+    }
     return result;
 }
 

@@ -12,8 +12,15 @@
 // A range runs on a thread of this process, or in another process (`meshstream-mpi`, one range
 // per MPI rank: RangeProcesses) that sends its pieces here as it makes them.
 //
-// Each range re-opens the input and reads its way to its range (no format has to seek): the
-// reading before a range is the serial part besides the seam pass. Memory: N decimators of the
+// Each range re-opens the input. On threads of this process, a range of an unsorted binary STL
+// (fixed-size records in a file that can seek) goes straight to the record where its triangles
+// start if no triangle before it is dropped, and reads on from there; once the ranges before it
+// have read theirs without a drop it is confirmed (the seam pass reads none of its output before
+// that), else it starts again as below. Any other range (another input, a sorted one: a range
+// needs the span of the triangles before it, or a range run elsewhere) reads its way to its
+// range; that reading is the serial part besides the seam pass. Either way range k holds the same
+// triangles of the read loop.
+// Memory: N decimators of the
 // buffer's triangles, N readers, the seam pass's decimator of a quarter of the buffer
 // (decimate::seam_pass_buffer); the ranges' outputs wait on disk (36 bytes a triangle, plus the
 // channels carried: io::TriangleRecords), not in memory.
@@ -60,6 +67,13 @@ struct RangeOutcome {
     decimate::Stats stats;   // its decimator's, when it ran to its end
     bool forced = false;     // stopped at a forced write (RangesJob::stop_at_forced_write)
     uint64_t forced_at = 0;  // triangles of the range read by then
+    // Set when it ran to its end having read from its own record on (a binary STL's range:
+    // io::TriangleInput::select_triangles), with what its read loop read and dropped; when
+    // every range did, the ranges' sums are the input's.
+    bool selected = false;
+    uint64_t read = 0;        // the input's triangles in the range
+    uint64_t non_finite = 0;  // of those, dropped for a NaN or infinite coordinate
+    uint64_t degenerate = 0;  // dropped for two corners at the same position
 };
 
 // Where a range's output goes, wherever the range runs.
@@ -139,7 +153,8 @@ struct RangesResult {
     decimate::Stats stats;         // the ranges' and the seam pass's, summed as the summary shows them
     decimate::Stats seams;         // the seam pass's own
     double ratio = 0;
-    // The read loop over the whole input (the last range reads it all): counts, drops, header.
+    // The read loop over the whole input (the last range reads it all, or the ranges' figures
+    // summed when each read its own: RangeOutcome::selected): counts, drops, header.
     io::InputCount count;
     DroppedTriangles dropped;
     io::MeshHeader end_header;

@@ -45,6 +45,11 @@ public:
     }
     std::optional<uint64_t> size() const override { return size_; }
     uint64_t stored_offset() const override { return pos_; }
+    bool seek(uint64_t offset) override {
+        if (!size_ || ::lseek(fd_, off_t(offset), SEEK_SET) < 0) return false;
+        pos_ = offset;
+        return true;
+    }
 
 private:
     int fd_;
@@ -329,6 +334,14 @@ uint64_t ByteSource::skip(uint64_t n) {
         done += take;
     }
     return done;
+}
+
+bool ByteSource::seek(uint64_t offset) {
+    if (gzip_ || !raw_->seek(offset)) return false;
+    begin_ = end_ = 0;
+    offset_ = offset;
+    eof_ = false;
+    return true;
 }
 
 bool ByteSource::at_end() { return window().empty(); }

@@ -28,6 +28,11 @@ public:
     // gzip) and its size when it is a regular file (compressed or not).
     virtual uint64_t stored_offset() const { return 0; }
     virtual std::optional<uint64_t> stored_size() const { return size(); }
+    // Moves to byte `offset` when the input can seek (a regular file); false when it cannot.
+    virtual bool seek(uint64_t offset) {
+        (void)offset;
+        return false;
+    }
 };
 
 class ByteSource {
@@ -54,6 +59,9 @@ public:
     void consume(size_t n);
     // Skips n bytes; returns how many were skipped (fewer only at end of stream).
     uint64_t skip(uint64_t n);
+    // Moves to byte `offset` of a plain regular file (not gzip), dropping the buffered bytes,
+    // and returns true; returns false, moving nothing, for any other source.
+    bool seek(uint64_t offset);
     bool at_end();
 
     // Bytes consumed so far (of the decoded stream for gzip).

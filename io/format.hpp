@@ -109,6 +109,16 @@ public:
     // with (header().channels are those the reader can fill). Throws io::Error on bad input
     // and never emits a partial triangle.
     virtual bool next(TriangleChunk& chunk) = 0;
+    // Makes the reader deliver the triangles [first, end) of the input only, reading none
+    // before `first`, and returns true, when its records have a fixed size in a source that
+    // can seek (binary STL in a plain regular file) and its header at the end says of those
+    // triangles what it would of all of them (nothing counted while reading). Otherwise
+    // returns false and changes nothing. Call it before the first next(), with first <= end <=
+    // the header's triangle count.
+    virtual bool select_triangles(uint64_t first, uint64_t end) {
+        (void)first, (void)end;
+        return false;
+    }
     // Facts from the header; triangle_count is set when the format states it up front.
     const MeshHeader& header() const { return header_; }
     std::optional<uint64_t> triangle_count() const { return header_.triangle_count; }

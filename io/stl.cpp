@@ -128,6 +128,7 @@ public:
         count_ = load_le<uint32_t>(preamble.data() + kHeaderBytes);
         std::string text = header_text(preamble.first(kHeaderBytes));
         header_.triangle_count = count_;
+        end_ = count_;
         header_.variant = "binary";
         header_.sorted_axis = find_sort_marker(text);
         header_.notes.emplace_back("header", text);
@@ -149,10 +150,10 @@ public:
     bool next(TriangleChunk& chunk) override {
         chunk.clear();
         const bool plain = chunk.channels() == Channels{};
-        while (!chunk.full() && read_ < count_) {
+        while (!chunk.full() && read_ < end_) {
             auto window = source_.window();
             size_t facets =
-                std::min<uint64_t>({window.size() / kFacetBytes, chunk.capacity() - chunk.size(), count_ - read_});
+                std::min<uint64_t>({window.size() / kFacetBytes, chunk.capacity() - chunk.size(), end_ - read_});
             if (facets == 0) {
                 // A facet straddles the end of the buffer: peek makes it contiguous.
                 window = source_.peek(kFacetBytes);
@@ -174,7 +175,7 @@ public:
             read_ += facets;
         }
         // Without a known size the count is checked against the end of the stream instead.
-        if (read_ == count_ && !end_checked_) {
+        if (read_ == count_ && !end_checked_ && !selected_) {
             end_checked_ = true;
             if (!source_.at_end())
                 throw Error(source_.name(), source_.offset(), 0,
@@ -183,10 +184,24 @@ public:
         return !chunk.empty();
     }
 
+    // The constructor checked the file's size against the count, so the facets are where the
+    // count puts them.
+    bool select_triangles(uint64_t first, uint64_t end) override {
+        if (read_ > 0 || first > end || end > count_ || !source_.size() ||
+            !source_.seek(kPreambleBytes + kFacetBytes * first))
+            return false;
+        read_ = first;
+        end_ = end;
+        selected_ = true;
+        return true;
+    }
+
 private:
     ByteSource& source_;
     uint64_t count_ = 0;
     uint64_t read_ = 0;
+    uint64_t end_ = 0;  // next() stops before this triangle: count_, or select_triangles()'s end
+    bool selected_ = false;
     bool end_checked_ = false;
 };
 

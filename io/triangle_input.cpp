@@ -41,7 +41,10 @@ bool TriangleInput::next(TriangleChunk& chunk) {
     for (;;) {
         if (!input_.reader->next(chunk)) {
             at_end_ = true;
-            if (count_.promised && count_.read != *count_.promised)
+            if (end_ && count_.read != *end_)
+                throw Error(name(), "the input ends at triangle " + std::to_string(count_.read) +
+                                        ", before the end of the triangles read, " + std::to_string(*end_));
+            if (!end_ && count_.promised && count_.read != *count_.promised)
                 throw Error(name(), "header promises " + std::to_string(*count_.promised) + " triangles, read " +
                                         std::to_string(count_.read));
             return false;
@@ -52,6 +55,13 @@ bool TriangleInput::next(TriangleChunk& chunk) {
         count_.dropped += dropped;
         if (!chunk.empty()) return true;
     }
+}
+
+bool TriangleInput::select_triangles(uint64_t first, uint64_t end) {
+    if (at_end_ || count_.read > 0 || !input_.reader->select_triangles(first, end)) return false;
+    count_.read = first;
+    end_ = end;
+    return true;
 }
 
 size_t TriangleInput::apply_policy(TriangleChunk& chunk) {

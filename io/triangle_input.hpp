@@ -16,6 +16,7 @@
 #include "io/input_count.hpp"
 
 #include <cstdint>
+#include <optional>
 #include <string>
 
 namespace meshstream::io {
@@ -41,6 +42,12 @@ public:
     // count (if any) was checked against the triangles read. Throws io::Error: the reader's,
     // a broken promise ("header promises N triangles, read M"), or a refused triangle.
     bool next(TriangleChunk& chunk);
+    // Before the first next(): reads the triangles [first, end) of the input only, when the
+    // reader can go to `first` without reading what comes before (Reader::select_triangles),
+    // and returns true; count().read then counts from `first` (refused triangles are named by
+    // their ordinal in the file) and the header's promise is checked only by a selection that
+    // reaches the end. Returns false, changing nothing, when the reader cannot.
+    bool select_triangles(uint64_t first, uint64_t end);
 
     const InputCount& count() const { return count_; }
     uint64_t non_finite() const { return non_finite_; }  // dropped for a NaN/inf coordinate
@@ -67,6 +74,7 @@ private:
     InputCount count_;
     uint64_t non_finite_ = 0, degenerate_ = 0;
     bool at_end_ = false;
+    std::optional<uint64_t> end_;  // select_triangles()'s end
 };
 
 // What the policy looks for in one triangle (9 floats): 0 when it passes, else why not.

@@ -2,7 +2,10 @@
 // (Lorensen & Cline 1987) over an implicit solid — a gyroid network with bumps, clipped to a
 // ball, with random phases from --seed — marched slab by slab along z, so the triangle soup
 // comes out approximately sorted along z like a scanner pipeline's. --holes removes triangles
-// inside random spheres (scan occlusions); --shuffle writes the triangles in random order,
+// inside random spheres (scan occlusions); --touching-holes keeps, inside the same spheres, the
+// triangles of every other grid cell (a 3D checkerboard): cells that share a grid edge keep the
+// surface vertex on it, so the patches' boundary loops touch at shared vertices, as hand-made
+// and CAD-exported low-poly models' do; --shuffle writes the triangles in random order,
 // out of core (random buckets in temporary files, each shuffled in memory). --color gives every
 // corner an 8-bit RGB colour that is a function of its position (colour_at): smooth bands, and
 // one sharp border (a plane across the solid) where warm colours meet cool ones, so welded
@@ -184,9 +187,10 @@ void evaluate_plane(const AxisTable& X, const AxisTable& Y, const AxisTable& Z, 
 struct Hole {
     float c[3];
     float r2;
+    bool checker = false;  // keeps the cells whose i + j + k is even (--touching-holes)
 };
 
-std::vector<Hole> make_holes(uint64_t seed, int count) {
+std::vector<Hole> make_holes(uint64_t seed, int count, bool checker) {
     Rng rng{seed ^ 0x484f4c4553ull};
     std::vector<Hole> holes;
     for (int h = 0; h < count; ++h) {
@@ -194,6 +198,7 @@ std::vector<Hole> make_holes(uint64_t seed, int count) {
         for (float& x : hole.c) x = float(rng.uniform() * 1.6 - 0.8);
         double r = 0.03 + 0.05 * rng.uniform();
         hole.r2 = float(r * r);
+        hole.checker = checker;
         holes.push_back(hole);
     }
     return holes;
@@ -277,7 +282,7 @@ uint64_t march(const CaseTable& table, const Shape& shape, int n, const std::vec
                         bool inside = false;
                         for (const Hole& hole : holes) {
                             float dx = cx - hole.c[0], dy = cy - hole.c[1], dz = cz - hole.c[2];
-                            inside |= dx * dx + dy * dy + dz * dz < hole.r2;
+                            inside |= dx * dx + dy * dy + dz * dz < hole.r2 && (!hole.checker || ((i + j + k) & 1));
                         }
                         if (inside) continue;
                     }
@@ -384,7 +389,7 @@ struct GenOptions {
     std::string output, to;
     uint64_t triangles = 1'000'000;
     uint64_t seed = 1;
-    bool shuffle = false, holes = false, quiet = false, color = false;
+    bool shuffle = false, holes = false, touching_holes = false, quiet = false, color = false;
     unsigned threads = 0;  // 0: one per core
     std::string tmpdir;
 };
@@ -405,7 +410,8 @@ int run(const GenOptions& opt) {
     auto start = std::chrono::steady_clock::now();
     CaseTable table = build_case_table();
     Shape shape(opt.seed);
-    std::vector<Hole> holes = opt.holes ? make_holes(opt.seed, 40) : std::vector<Hole>{};
+    std::vector<Hole> holes;
+    if (opt.holes || opt.touching_holes) holes = make_holes(opt.seed, 40, opt.touching_holes);
     int n = resolution_for(table, shape, holes, opt.triangles);
     unsigned threads = opt.threads ? opt.threads : std::max(1u, std::thread::hardware_concurrency());
 
@@ -468,7 +474,8 @@ int run(const GenOptions& opt) {
     double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (!opt.quiet)
         std::fprintf(stderr, "meshstream-gen: %llu triangles (grid %d³%s%s%s) in %.2f s, %.2f M triangles/s -> %s\n",
-                     (unsigned long long)count, n, opt.holes ? ", holes" : "", opt.shuffle ? ", shuffled" : "",
+                     (unsigned long long)count, n, opt.touching_holes ? ", touching holes" : opt.holes ? ", holes" : "",
+                     opt.shuffle ? ", shuffled" : "",
                      opt.color ? ", coloured" : "", seconds, double(count) / seconds / 1e6, opt.output.c_str());
     return 0;
 }
@@ -511,6 +518,9 @@ int main(int argc, char** argv) {
         ->check(tools::whole_number(0, "a whole number"));
     app.add_flag("--shuffle", opt.shuffle, "write the triangles in random order (out of core)");
     app.add_flag("--holes", opt.holes, "punch 40 holes into the surface, like occlusions in a scan");
+    app.add_flag("--touching-holes", opt.touching_holes,
+                 "the holes of --holes keep every other grid cell: boundary loops that touch\n"
+                 "at shared vertices, as hand-made and CAD-exported low-poly models have them");
     app.add_flag("--color", opt.color,
                  "an 8-bit RGB colour per corner from its position: smooth bands, a sharp border\n"
                  "For formats that hold vertex colours (PLY, OBJ, Draco, glTF)");

@@ -1,5 +1,6 @@
-// Tests of decimate/collapse: the boundary rules of §4 (which half-edges may collapse), the
-// link condition, and that collapses keep the half-edge structure consistent.
+// Tests of decimate/collapse: the boundary rules of §4 (which half-edges may collapse), boundary
+// loops that touch at a vertex, the link condition, and that collapses keep the half-edge
+// structure consistent.
 #include "decimate/collapse.hpp"
 #include "decimate/greedy.hpp"
 
@@ -170,16 +171,76 @@ TEST(Collapse, SecondFanAtEitherEndIsSeen) {
     {
         // p = centre gets the second fan, reaching the rim: it has two open edges, like a hole's
         // rim vertex, but is no manifold vertex and must not move. Found once, when it left
-        // P_in (kManyFans): none of its half-edges is eligible.
+        // P_in (kManyFans, and one of its fans closed: no kOpenFans): none of its half-edges is
+        // eligible.
         HalfEdgeBuffer buffer(64, 0);
         build(buffer, centre_at, far_east_at);
         const uint32_t centre = vertex_at(buffer, {2, 2, 0}), far_east = vertex_at(buffer, {4, 2, 0.4f});
         const uint32_t h = half_edge(buffer, centre, far_east);
         ASSERT_EQ(buffer.vertex(centre).face_count, 7u);
         ASSERT_EQ(buffer.twin(h), kOpenEdge);
-        EXPECT_TRUE(buffer.vertex(centre).flags & kManyFans);
+        EXPECT_EQ(buffer.vertex(centre).flags & (kManyFans | kOpenFans), kManyFans);
         EXPECT_FALSE(collapse_eligible(buffer, h));
     }
+}
+
+// Boundary loops that touch at a vertex: a flat 5×3 vertex grid (x 0..4, y 0..2, z 0) and a
+// diamond (2,2) (3,3) (2,4) (1,3) above it, sharing the grid's top-middle vertex (2,2) only.
+// `diamond`: false leaves the grid alone.
+void add_touching_loops(HalfEdgeBuffer& buffer, bool diamond) {
+    std::vector<std::array<float, 3>> points;
+    std::vector<std::array<int, 3>> faces;
+    for (int y = 0; y < 3; ++y)
+        for (int x = 0; x < 5; ++x) points.push_back({float(x), float(y), 0});
+    for (int y = 0; y < 2; ++y)
+        for (int x = 0; x < 4; ++x) {
+            const int a = 5 * y + x;
+            faces.push_back({a, a + 1, a + 6});
+            faces.push_back({a, a + 6, a + 5});
+        }
+    if (diamond) {
+        points.insert(points.end(), {{3, 3, 0}, {2, 4, 0}, {1, 3, 0}});
+        faces.push_back({12, 15, 16});
+        faces.push_back({12, 16, 17});
+    }
+    add_indexed(buffer, points, faces);
+    buffer.finalize_all();
+}
+
+TEST(Collapse, BoundaryLoopsTouchingAtAVertexSlideAlongTheirEdges) {
+    HalfEdgeBuffer buffer(64, 0);
+    add_touching_loops(buffer, true);
+    const uint32_t junction = vertex_at(buffer, {2, 2, 0}), west = vertex_at(buffer, {1, 2, 0});
+    const uint32_t below = vertex_at(buffer, {2, 1, 0}), north_east = vertex_at(buffer, {3, 3, 0});
+    // Two fans, both open: four open edges.
+    EXPECT_EQ(buffer.vertex(junction).flags & (kManyFans | kOpenFans), kManyFans | kOpenFans);
+    EXPECT_EQ(buffer.vertex(junction).open_edges, 4u);
+    EXPECT_EQ(buffer.vertex(junction).face_count, 5u);
+    // Along each loop's outgoing open edge, as a vertex of one loop; never across the grid.
+    const uint32_t h = half_edge(buffer, junction, west);
+    EXPECT_TRUE(collapse_eligible(buffer, h));
+    EXPECT_TRUE(collapse_eligible(buffer, half_edge(buffer, junction, north_east)));
+    EXPECT_FALSE(collapse_eligible(buffer, half_edge(buffer, junction, below)));
+    // The grid's top edge is straight: alone, sliding costs nothing; the diamond's boundary
+    // planes price moving its corner.
+    HalfEdgeBuffer alone(64, 0);
+    add_touching_loops(alone, false);
+    const double free_slide =
+        collapse_placement(alone, half_edge(alone, vertex_at(alone, {2, 2, 0}), vertex_at(alone, {1, 2, 0}))).error;
+    EXPECT_NEAR(free_slide, 0, 1e-12);
+    EXPECT_GT(collapse_placement(buffer, h).error, 0.1);
+    // The collapse keeps the half-edges consistent; the loops touch at the west vertex now.
+    ASSERT_TRUE(collapse_valid(buffer, h));
+    apply_collapse(buffer, h);
+    EXPECT_TRUE(buffer_consistent(buffer));
+    EXPECT_EQ(buffer.face_count(), 17u);
+    EXPECT_EQ(buffer.vertex(west).open_edges, 4u);
+    EXPECT_EQ(buffer.vertex(west).face_count, 6u);
+    EXPECT_EQ(buffer.vertex(west).flags & (kManyFans | kOpenFans), kManyFans | kOpenFans);
+    EXPECT_EQ(neighbours(buffer, west),
+              (std::set<uint32_t>{vertex_at(buffer, {0, 2, 0}), vertex_at(buffer, {0, 1, 0}),
+                                  vertex_at(buffer, {1, 1, 0}), below, vertex_at(buffer, {3, 2, 0}), north_east,
+                                  vertex_at(buffer, {2, 4, 0}), vertex_at(buffer, {1, 3, 0})}));
 }
 
 // Collapse targets are float positions, exactly what set_position() will store, so that the

@@ -1,5 +1,6 @@
 // engine::decimate_file, decimate_part, convert_file and sort_file as a library user calls them:
-// exact counts, ranges on two threads, part files merged to the bytes two threads write, the
+// exact counts, ranges on two threads (each reading its own records of a binary STL), part files
+// merged to the bytes two threads write, the
 // progress a sink sees, cancellation that leaves nothing behind, and settings refused as
 // io::OptionError naming the setting.
 #include "engine/decimate.hpp"
@@ -11,7 +12,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -108,6 +111,90 @@ TEST(EngineDecimate, PartJobsMergeToTheBytesOfTwoThreads) {
     ASSERT_EQ(m.part_files.size(), 1u);
     EXPECT_EQ(m.part_files[0].k, 1u);
     EXPECT_EQ(slurp(dir / "merged.stl"), slurp(dir / "threads.stl"));
+}
+
+// A triangle's corners, rotated to start at the least (the winding kept): one key per triangle
+// whatever corner a writer starts from.
+using TriangleKey = std::array<float, 9>;
+
+// The triangles of a mesh file, as sorted keys.
+std::vector<TriangleKey> triangle_keys(const std::string& path) {
+    io::Input in = io::open_input(path);
+    io::TriangleChunk chunk;
+    std::vector<TriangleKey> keys;
+    while (in.reader->next(chunk))
+        for (size_t i = 0; i < chunk.size(); ++i) {
+            const float* t = chunk.xyz().data() + 9 * i;
+            size_t first = 0;
+            for (size_t c = 1; c < 3; ++c)
+                if (std::lexicographical_compare(t + 3 * c, t + 3 * c + 3, t + 3 * first, t + 3 * first + 3)) first = c;
+            TriangleKey key;
+            for (size_t c = 0; c < 3; ++c) std::copy_n(t + 3 * ((first + c) % 3), 3, key.data() + 3 * c);
+            keys.push_back(key);
+        }
+    std::sort(keys.begin(), keys.end());
+    return keys;
+}
+
+TEST(EngineDecimate, RangesOfABinaryStlReadTheirOwnRecords) {
+    // The bunny with three degenerate records, which the read loop drops. A range goes to the
+    // record where its triangles start when nothing before it is dropped, else it starts again
+    // from the input's start; either way the output is the bytes of part jobs, which read their
+    // way to their ranges. With a ratio of 1 every triangle passes through, so the output holds
+    // each of the bunny's once exactly when the ranges read every record once.
+    const std::string bunny = slurp(kBunny);
+    const uint64_t records = kBunnyTriangles + 3;
+    for (const std::vector<uint64_t>& at : {std::vector<uint64_t>{40000, 50000, 60000},  // in the last range
+                                            std::vector<uint64_t>{5, 1000, 60000}}) {      // two in the first
+        TempDir dir;
+        std::string stl = bunny.substr(0, 80);
+        const auto count = uint32_t(records);
+        stl.append(reinterpret_cast<const char*>(&count), 4);
+        char degenerate[50] = {};
+        const float corners[9] = {1, 2, 3, 1, 2, 3, 4, 5, 6};  // two corners at one position
+        std::memcpy(degenerate + 12, corners, sizeof corners);
+        for (uint64_t i = 0; i < kBunnyTriangles; ++i) {
+            const uint64_t next = (stl.size() - 84) / 50;  // the record appended next
+            if (std::find(at.begin(), at.end(), next) != at.end()) stl.append(degenerate, 50);
+            stl.append(bunny, 84 + 50 * i, 50);
+        }
+        ASSERT_EQ(stl.size(), 84 + 50 * records);
+        test::spit(dir / "in.stl", stl);
+
+        engine::QuietProgress quiet;
+        engine::DecimateSettings s = bunny_settings(dir / "threads.stl");
+        s.input = dir / "in.stl";
+        s.ratio = 1;
+        s.threads = 2;
+        const engine::DecimateResult r = engine::decimate_file(s, quiet);
+        EXPECT_EQ(r.facts.threads, 2u);
+        EXPECT_EQ(r.triangles_in, records);
+        EXPECT_EQ(r.facts.skipped, 3u);
+        EXPECT_EQ(r.triangles_out, kBunnyTriangles);
+        EXPECT_EQ(triangle_keys(dir / "threads.stl"), triangle_keys(kBunny)) << at[0];
+
+        s.ratio = 0.1;
+        const engine::DecimateResult t = engine::decimate_file(s, quiet);
+        EXPECT_EQ(t.triangles_in, records);
+        EXPECT_EQ(t.facts.skipped, 3u);
+        engine::DecimateSettings part = s;
+        part.threads = 1;
+        part.output = dir / "1.part";
+        part.output_format = "stl";
+        part.part = engine::PartIndex{1, 2};
+        const engine::PartResult p = engine::decimate_part(part, quiet);
+        EXPECT_EQ(p.range_end, records / 2);
+        EXPECT_EQ(p.triangles_in, records / 2);
+        engine::DecimateSettings merge = s;
+        merge.threads = 1;
+        merge.output = dir / "merged.stl";
+        merge.part = engine::PartIndex{2, 2};
+        merge.merge = {dir / "1.part"};
+        const engine::DecimateResult m = engine::decimate_file(merge, quiet);
+        EXPECT_EQ(m.triangles_in, records);
+        EXPECT_EQ(m.facts.skipped, 3u);
+        EXPECT_EQ(slurp(dir / "merged.stl"), slurp(dir / "threads.stl")) << at[0];
+    }
 }
 
 TEST(EngineDecimate, CancelledLeavesNoOutputBehind) {

@@ -1,6 +1,7 @@
 // Byte stream tests: gzip round trips and damage, multi-member gzip, atomic sinks (no file
-// without commit), patching, the window/peek/consume contract across refills, temporary
-// files, and 64-bit sizes and offsets through a RawInput that fakes a binary STL over 4 GiB.
+// without commit), patching, the window/peek/consume contract across refills, seeking in plain
+// files, temporary files, and 64-bit sizes and offsets through a RawInput that fakes a binary
+// STL over 4 GiB.
 #include "io/byte_stream.hpp"
 
 #include "io/error.hpp"
@@ -336,6 +337,28 @@ TEST(ByteSource, WindowPeekConsumeAcrossRefills) {
     } catch (const io::Error& e) {
         EXPECT_STREQ(e.what(), "mem: byte 4: bad thing");
     }
+}
+
+TEST_F(ByteStreamTest, SeekMovesInAPlainFileOnly) {
+    const std::string data = test_bytes(3 << 20, 7);
+    write_sink("plain.bin", data, -1);
+    write_sink("packed.bin.gz", data, 6);
+    auto plain = io::ByteSource::open(path("plain.bin"));
+    std::string got(100, '\0');
+    ASSERT_EQ(plain->read(got.data(), 10), 10u);
+    // Forward past the buffer, then back into bytes already read.
+    for (const uint64_t at : {uint64_t{2} << 20, uint64_t{5}, uint64_t{0}}) {
+        ASSERT_TRUE(plain->seek(at));
+        EXPECT_EQ(plain->offset(), at);
+        ASSERT_EQ(plain->read(got.data(), got.size()), got.size());
+        EXPECT_EQ(got, data.substr(at, got.size())) << at;
+    }
+    ASSERT_TRUE(plain->seek(data.size()));
+    EXPECT_TRUE(plain->at_end());
+    auto packed = io::ByteSource::open(path("packed.bin.gz"));
+    EXPECT_FALSE(packed->seek(5));
+    ASSERT_EQ(packed->read(got.data(), got.size()), got.size());
+    EXPECT_EQ(got, data.substr(0, got.size()));
 }
 
 TEST(ByteSource, TinyAndEmptyInputs) {

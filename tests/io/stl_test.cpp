@@ -1,10 +1,13 @@
 // STL reader/writer tests: exact counts on real fixtures, round trips over both encodings and
-// gzip with bit-exact floats, chunk-boundary runs, truncation at every byte, and bad input as
+// gzip with bit-exact floats, chunk-boundary runs, a binary file's records selected without
+// reading those before, truncation at every byte, and bad input as
 // small inline strings asserting file, line or byte and the message.
 #include "io/stl.hpp"
 
+#include "io/byte_stream.hpp"
 #include "io/error.hpp"
 #include "io/format.hpp"
+#include "io/triangle_input.hpp"
 
 #include "test_util.hpp"
 
@@ -334,6 +337,73 @@ TEST_F(StlTest, RoundTripsBothEncodingsPlainAndGzipBitExact) {
     write_path(path("b.stl"), read_path(path("a.stl")).xyz, "stl");
     write_path(path("c.stl"), read_path(path("b.stl")).xyz, "stl-ascii");
     EXPECT_EQ(slurp(path("a.stl")), slurp(path("c.stl")));
+}
+
+TEST_F(StlTest, BinaryReaderSelectsItsRecordsInAPlainFile) {
+    // Seven distinct triangles, the fifth degenerate: a selection reads exactly its records,
+    // gives their ordinals in the file, and is refused where the reader cannot seek.
+    std::vector<float> xyz;
+    for (int t = 0; t < 7; ++t)
+        for (int c = 0; c < 9; ++c)
+            xyz.push_back(t == 4 && c >= 3 && c < 6 ? float(10 * t + c - 3) : float(10 * t + c));
+    const std::string stl = binary_stl("seven", xyz, 7);
+    const std::string file = path("seven.stl");
+    meshstream::test::spit(file, stl);
+    const std::vector<float> middle(xyz.begin() + 9 * 2, xyz.begin() + 9 * 6);  // triangles [2, 6)
+    {
+        io::Input in = io::open_input(file);
+        ASSERT_TRUE(in.reader->select_triangles(2, 6));
+        EXPECT_TRUE(same_bits(drain(*in.reader, 3).xyz, middle));
+    }
+    {
+        // An empty selection, and one from the last record to the end.
+        io::Input in = io::open_input(file);
+        ASSERT_TRUE(in.reader->select_triangles(3, 3));
+        EXPECT_TRUE(drain(*in.reader, 4).xyz.empty());
+        io::Input last = io::open_input(file);
+        ASSERT_TRUE(last.reader->select_triangles(6, 7));
+        EXPECT_TRUE(same_bits(drain(*last.reader, 4).xyz, std::vector<float>(xyz.end() - 9, xyz.end())));
+    }
+    {
+        // The read loop counts from the selection's first triangle: the dropped one is the
+        // fifth of the file, refused by its ordinal there.
+        io::TriangleInput drop(io::open_input(file), io::BadTriangles::kDrop);
+        ASSERT_TRUE(drop.select_triangles(2, 6));
+        io::TriangleChunk chunk;
+        uint64_t passed = 0;
+        while (drop.next(chunk)) passed += chunk.size();
+        EXPECT_EQ(passed, 3u);
+        EXPECT_EQ(drop.count().read, 6u);
+        EXPECT_EQ(drop.degenerate(), 1u);
+        io::TriangleInput refuse(io::open_input(file), io::BadTriangles::kRefuse);
+        ASSERT_TRUE(refuse.select_triangles(3, 7));
+        const io::Error e = error_of([&] {
+            while (refuse.next(chunk)) {}
+        });
+        EXPECT_NE(std::string(e.what()).find("triangle 5 is degenerate"), std::string::npos) << e.what();
+    }
+    {
+        // Refused: out of order, past the count, after reading has begun, through gzip, from a
+        // source of unknown size.
+        io::Input in = io::open_input(file);
+        EXPECT_FALSE(in.reader->select_triangles(4, 2));
+        EXPECT_FALSE(in.reader->select_triangles(0, 8));
+        io::TriangleChunk chunk(1);
+        ASSERT_TRUE(in.reader->next(chunk));
+        EXPECT_FALSE(in.reader->select_triangles(2, 6));
+        EXPECT_EQ(drain(*in.reader, 3).xyz.size(), 9u * 6);  // the rest, as if never asked
+        {
+            auto sink = io::ByteSink::open(path("seven.stl.gz"), {6});
+            sink->write(stl.data(), stl.size());
+            sink->commit();
+        }
+        io::Input gz = io::open_input(path("seven.stl.gz"));
+        EXPECT_FALSE(gz.reader->select_triangles(2, 6));
+        EXPECT_TRUE(same_bits(drain(*gz.reader, 3).xyz, xyz));
+        auto source = memory_source(stl, "stdin", false);
+        auto reader = io::kStlFormat.open_reader(*source, {});
+        EXPECT_FALSE(reader->select_triangles(2, 6));
+    }
 }
 
 TEST_F(StlTest, AsciiKeepsNegativeZeroTinyAndHugeFloats) {

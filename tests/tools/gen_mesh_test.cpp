@@ -1,8 +1,9 @@
 // Tests of meshstream-gen (tools/gen_mesh.cpp) through its binary (MESHSTREAM_GEN_BINARY):
 // the triangle count within ±5 % of the request, the output approximately sorted along z (no
 // centroid more than one grid cell below an earlier one), a watertight manifold surface after
-// exact welding (the derived case table is consistent across cells), holes that open it,
-// a shuffle that keeps the same triangles in another order, same seed same bytes, and exit codes.
+// exact welding (the derived case table is consistent across cells), holes that open it and
+// holes whose boundary loops touch at vertices, a shuffle that keeps the same triangles in
+// another order, same seed same bytes, and exit codes.
 #include "compare/metro.hpp"
 #include "io/format.hpp"
 
@@ -116,6 +117,37 @@ TEST(GenMesh, HolesOpenTheSurface) {
     EXPECT_GT(e.boundary_edges, 50u);
     EXPECT_EQ(e.non_manifold_edges, 0u);
     EXPECT_NEAR(double(tris.size()), 40000.0, 2000.0);
+}
+
+TEST(GenMesh, TouchingHolesMeetAtVertices) {
+    // Inside the holes every other grid cell keeps its triangles: boundary loops that touch at
+    // vertices (four or more boundary edges), never along an edge. The holes' spheres are
+    // --holes's: their rims are there too.
+    TempDir dir;
+    GenRun r = gen(dir, "-q --touching-holes -n 40000 " + (dir.path() / "t.stl").string());
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    ASSERT_EQ(gen(dir, "-q --holes -n 40000 " + (dir.path() / "h.stl").string()).exit_code, 0);
+    auto tris = read_all(dir.path() / "t.stl");
+    const compare::EdgeCounts e = edges_of(tris);
+    EXPECT_EQ(e.non_manifold_edges, 0u);
+    EXPECT_GT(tris.size(), read_all(dir.path() / "h.stl").size());
+    // Boundary edges per corner position: an edge (a, b) is on the boundary when no face
+    // holds (b, a).
+    using Point = std::array<float, 3>;
+    std::map<std::pair<Point, Point>, int> directed;
+    auto corner = [](const std::array<float, 9>& t, int k) { return Point{t[3 * k], t[3 * k + 1], t[3 * k + 2]}; };
+    for (const auto& t : tris)
+        for (int k = 0; k < 3; ++k) ++directed[{corner(t, k), corner(t, (k + 1) % 3)}];
+    std::map<Point, int> boundary_edges;
+    for (const auto& [edge, n] : directed)
+        if (!directed.contains({edge.second, edge.first})) {
+            ++boundary_edges[edge.first];
+            ++boundary_edges[edge.second];
+        }
+    size_t touching = 0;
+    for (const auto& [point, n] : boundary_edges) touching += n >= 4;
+    EXPECT_GT(touching, 50u);
+    EXPECT_GT(e.boundary_edges, boundary_edges.size());  // more boundary edges than boundary vertices
 }
 
 TEST(GenMesh, ShuffleKeepsTheTrianglesInRandomOrder) {
