@@ -458,7 +458,11 @@ TilesResult tile_file(const TilesSettings& s, ProgressSink& progress) {
     for (int depth = deepest - 1; depth >= 0; --depth) {
         uint64_t cells_here = 0;
         for (const Node& n : tree.nodes) cells_here += n.depth == depth && !n.leaf;
-        const double share = region[size_t(depth)] > 0 ? double(s.tile_triangles * cells_here) / double(region[size_t(depth)]) : 1;
+        // About the budget a cell, and at most a quarter of what the level below has there: a
+        // surface's cells of half the size hold a quarter of its area, so each level halves the
+        // detail (and the levels above the leaves add at most a third to them).
+        const double share = std::min(
+            0.25, region[size_t(depth)] > 0 ? double(s.tile_triangles * cells_here) / double(region[size_t(depth)]) : 1);
         const uint64_t target = std::max<uint64_t>(1, uint64_t(std::llround(share * double(below_count))));
         std::string level = below, level_format = below_format;
         if (target < below_count) {
@@ -512,7 +516,7 @@ TilesResult tile_file(const TilesSettings& s, ProgressSink& progress) {
             if (!n.uri.empty() && !children.empty()) {
                 std::vector<float> own = tile_positions((fs::path(building.path()) / n.uri).string());
                 compare::CompareOptions co;
-                co.samples = std::max<uint64_t>(10000, std::max(own.size(), children.size()) / 9);
+                co.samples = std::max<uint64_t>(10000, own.size() / 9);  // about one a tile triangle
                 co.seed = s.seed;
                 co.tmpdir = s.read.tmpdir;
                 const compare::CompareResult r = compare::compare_meshes(compare::memory_source("tile", std::move(own)),

@@ -121,7 +121,7 @@ void run_tiles(const TilesOptions& opt) {
         report.details = {{"tile_triangles", opt.tile_triangles}, {"compress", opt.compress},
                           {"tiles", result.tiles}, {"bytes", result.bytes}, {"leaf_bytes", result.leaf_bytes},
                           {"geometric_error", result.geometric_error}, {"levels", levels}};
-        print_json(run_report_json(report, result.warnings));
+        std::printf("%s\n", run_report_json(report, result.warnings).dump().c_str());
     } else if (!global().quiet) {
         std::fprintf(stderr, "%s: %zu levels, %llu tiles, %s (leaves %s) from %s triangles in %.1f s\n",
                      opt.outdir.c_str(), result.levels.size(), static_cast<unsigned long long>(result.tiles),
