@@ -12,6 +12,9 @@
 #include "tools/help.hpp"
 #include "tools/input_filter.hpp"
 #include "tools/jobs.hpp"
+#if MESHSTREAM_WITH_GLTF
+#include "engine/tiles.hpp"
+#endif
 #include "tools/order_text.hpp"
 
 #include <nlohmann/json.hpp>
@@ -113,7 +116,46 @@ std::string color_values(const std::array<float, 4>& rgba) {
 
 }  // namespace
 
+#if MESHSTREAM_WITH_GLTF
+namespace {
+
+// A 3D Tiles tileset (`meshstream tiles`' tileset.json): its levels instead of a mesh's figures.
+bool names_a_tileset(const std::string& path) {
+    return path.size() > 5 && path.compare(path.size() - 5, 5, ".json") == 0 && is_regular_file(path);
+}
+
+nlohmann::ordered_json tileset_info(const InfoOptions& opt) {
+    const engine::TilesetSummary t = engine::summarize_tileset(opt.input);
+    if (opt.json) {
+        nlohmann::ordered_json levels = nlohmann::ordered_json::array();
+        for (const engine::TileLevel& l : t.levels)
+            levels.push_back({{"depth", l.depth}, {"tiles", l.tiles}, {"leaves", l.leaves}, {"triangles", l.triangles},
+                              {"bytes", l.bytes}, {"min_error", l.min_error}, {"max_error", l.max_error}});
+        return {{"file", opt.input}, {"format", "3d-tiles"}, {"version", t.version}, {"placed", t.placed},
+                {"geometric_error", t.geometric_error}, {"depth", t.levels.size()}, {"tiles", t.tiles},
+                {"triangles", t.triangles}, {"bytes", t.bytes}, {"json_files", t.json_files}, {"levels", levels}};
+    }
+    std::printf("file:        %s\n", opt.input.c_str());
+    std::printf("format:      3D Tiles %s tileset%s\n", t.version.c_str(), t.placed ? " (placed on the globe)" : "");
+    std::printf("depth:       %zu levels, %llu tiles, %s triangles, %s in %llu JSON file(s) and the tiles\n",
+                t.levels.size(), static_cast<unsigned long long>(t.tiles), human_count(double(t.triangles)).c_str(),
+                human_bytes(double(t.bytes)).c_str(), static_cast<unsigned long long>(t.json_files));
+    std::printf("error:       %.6g (the tileset's geometricError)\n", t.geometric_error);
+    for (const engine::TileLevel& l : t.levels)
+        std::printf("  depth %-3d %6llu tiles (%llu leaves) %12s triangles %10s  error %.6g..%.6g\n", l.depth,
+                    static_cast<unsigned long long>(l.tiles), static_cast<unsigned long long>(l.leaves),
+                    human_count(double(l.triangles)).c_str(), human_bytes(double(l.bytes)).c_str(), l.min_error,
+                    l.max_error);
+    return nullptr;
+}
+
+}  // namespace
+#endif
+
 nlohmann::ordered_json info_job(const InfoOptions& opt, engine::ProgressSink* progress) {
+#if MESHSTREAM_WITH_GLTF
+    if (names_a_tileset(opt.input)) return tileset_info(opt);
+#endif
     // info reports bad triangles; --strict makes the first one an error instead. It looks at
     // positions (and vertex ids, for --topology) only: the reader stores no attribute values,
     // and the header still lists every channel.

@@ -136,22 +136,23 @@ void add_tiles(CLI::App& app) {
     auto opt = std::make_shared<TilesOptions>();
     CLI::App* cmd = app.add_subcommand(
         "tiles",
-        "OGC 3D Tiles 1.1 for the web: level-of-detail GLB tiles and OUTDIR/tileset.json, built out of core\n"
+        "OGC 3D Tiles 1.1: level-of-detail GLB tiles and a tileset.json, built out of core\n"
         "  IN: any mesh ('-' = stdin, spooled); OUTDIR: a new or empty directory (--overwrite replaces one)");
     cmd->add_option("IN", opt->input, "input mesh ('-' = stdin)")->required();
     cmd->add_option("OUTDIR", opt->outdir, "the tileset's directory")->required();
-    cmd->add_option("--tile-triangles", opt->tile_triangles,
-                    "triangles a tile holds at most at full resolution, and about as many above (default 65536)")
+    cmd->add_option("--tile-triangles", opt->tile_triangles, "at most N triangles a leaf, about N above (default 65536)")
+        ->type_name("N")
         ->check(CLI::Range(uint64_t{256}, uint64_t{1} << 32));
     cmd->add_option("--compress", opt->compress, "the tiles' encoding: meshopt (default), draco or none")
+        ->type_name("FMT")
         ->check(CLI::IsMember({"meshopt", "draco", "none"}));
-    cmd->add_option("--origin", opt->origin,
-                    "LON,LAT,HEIGHT: put the model's origin there on the globe (WGS84; x east, y north, z up); "
-                    "without it the tileset is in the model's own coordinates");
+    cmd->add_option("--origin", opt->origin, "put the model's origin there (WGS84 degrees, metres; z up)")
+        ->type_name("LON,LAT,H");
     cmd->add_flag("--overwrite", opt->overwrite, "replace OUTDIR when it is not empty (once the new tileset is complete)");
-    cmd->add_option("--seed", opt->seed, "random seed of the decimations and error samples (default 1)");
+    cmd->add_option("--seed", opt->seed, "random seed of the decimations and error samples (default 1)")
+        ->type_name("N");
     add_json_flag(cmd, opt->json);
-    add_threads_option(cmd, opt->threads, "decimate each level in ranges on this many cores");
+    add_threads_option(cmd, opt->threads, "decimate the levels on N cores");
     add_read_flags(cmd, opt->read);
     cmd->footer(
         "  meshstream tiles scan.ply web/scan\n"

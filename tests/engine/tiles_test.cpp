@@ -88,12 +88,14 @@ TEST_P(Tiles, LeavesHoldEveryTriangleInsideTheirBoxesWithOrderedErrors) {
     EXPECT_EQ(w.bad_errors, 0);
     EXPECT_GT(j["root"]["geometricError"].get<double>(), 0);
 
-    // Every leaf at most the budget; the root about it.
+    // The root: at most the budget, and at most a quarter of the level below.
     const engine::TilesetSummary sum = engine::summarize_tileset(dir / "t/tileset.json");
     EXPECT_EQ(sum.tiles, r.tiles);
     EXPECT_EQ(sum.version, "1.1");
     EXPECT_EQ(sum.levels[0].triangles, r.levels[0].triangles);
-    EXPECT_NEAR(double(sum.levels[0].triangles), 5000, 50);
+    EXPECT_LE(sum.levels[0].triangles, 5050u);
+    EXPECT_LE(sum.levels[0].triangles, sum.levels[1].triangles / 4 + 50);
+    EXPECT_GT(sum.levels[0].triangles, 1000u);
 }
 
 INSTANTIATE_TEST_SUITE_P(Compressions, Tiles,

@@ -11,6 +11,7 @@ set(public
   decimate/stats.hpp          # decimate::Stats and combine_ranges
   decimate/stream_decimator.hpp
   engine/convert.hpp engine/decimate.hpp engine/files.hpp engine/progress.hpp engine/units.hpp
+  engine/tiles.hpp
   engine/warnings.hpp
   engine/part_files.hpp       # PartIndex, part files: a merge's inputs
   engine/ranges.hpp           # RangeProcesses: ranges run by other processes (MPI)

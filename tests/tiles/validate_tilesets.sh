@@ -1,7 +1,7 @@
 #!/bin/bash
 # The official 3D Tiles validator on tilesets `meshstream tiles` writes from the bunny fixture:
 # meshopt, Draco and plain content, placed on the globe or not, each with 0 errors and 0
-# warnings (validate.sh --strict). Also the command's refusal of a non-empty OUTDIR (exit 2, the
+# warnings (validate.sh --strict). Also `info` on a tileset, and the refusal of a non-empty OUTDIR (exit 2, the
 # directory kept).
 #   validate_tilesets.sh MESHSTREAM FIXTURES_DIR VALIDATOR_SOURCE VALIDATOR_DIR
 # Exit 77 (ctest's skip) with the reason when the validator's source (../shared) or node is
@@ -39,6 +39,12 @@ for case in "meshopt" "draco" "none" "meshopt --origin 7.4474,46.9480,540"; do
     status=1
   fi
 done
+# info reads a tileset: its version and levels (the bunny at 5 000 a tile: three levels).
+info=$("$meshstream" info "$work/meshopt/tileset.json")
+if ! grep -q "format:      3D Tiles 1.1 tileset" <<<"$info" || ! grep -q "depth:       3 levels" <<<"$info"; then
+  echo "FAILED: meshstream info on a tileset said: $info"
+  status=1
+fi
 # A non-empty OUTDIR: exit 2, nothing touched.
 mkdir -p "$work/full" && echo mine > "$work/full/keep.txt"
 "$meshstream" -q tiles "$fixtures/bunny_from_draco.bin.stl" "$work/full" 2> "$work/full.err"

@@ -630,7 +630,7 @@ TEST(CliBadInput, UnknownCommandIsNamedAndVersionIsPrinted) {
     CliRun r = run("decimat in.stl out.stl");
     EXPECT_EQ(r.code, 2);
     EXPECT_EQ(r.err,
-              "meshstream: unknown command 'decimat' (one of: info, convert, decimate, sort, compare); see meshstream "
+              "meshstream: unknown command 'decimat' (one of: info, convert, decimate, sort, compare, tiles); see meshstream "
               "--help\n");
     TempDir dir;
     CliRun v = run("--version > " + dir / "version.txt");

@@ -190,11 +190,11 @@ TEST(CliHelp, EveryCommandLineErrorNamesTheProgramAndTheCommand) {
     CliRun none = run("");
     EXPECT_EQ(none.code, 2);
     EXPECT_EQ(none.err,
-              "meshstream: no command given (one of: info, convert, decimate, sort, compare); see meshstream --help\n");
+              "meshstream: no command given (one of: info, convert, decimate, sort, compare, tiles); see meshstream --help\n");
     CliRun typo = run("decimat in.stl out.stl");
     EXPECT_EQ(typo.code, 2);
     EXPECT_EQ(typo.err,
-              "meshstream: unknown command 'decimat' (one of: info, convert, decimate, sort, compare); see meshstream "
+              "meshstream: unknown command 'decimat' (one of: info, convert, decimate, sort, compare, tiles); see meshstream "
               "--help\n");
 }
 
