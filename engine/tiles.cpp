@@ -393,6 +393,7 @@ TilesResult tile_file(const TilesSettings& s, ProgressSink& progress) {
 
     std::string input = s.input;
     std::string input_format = s.input_format;
+    std::optional<ConvertResult> spooled;
     if (!is_regular_file(input)) {
         // Read more than once: a pipe is spooled first.
         StepProgress step(progress, "spooling the input");
@@ -402,7 +403,7 @@ TilesResult tile_file(const TilesSettings& s, ProgressSink& progress) {
         cs.output = (fs::path(work.path()) / "input.mstream").string();
         cs.output_format = "stream";
         cs.read = s.read;
-        convert_file(cs, step);
+        spooled = convert_file(cs, step);
         input = cs.output;
         input_format = "stream";
     }
@@ -450,6 +451,13 @@ TilesResult tile_file(const TilesSettings& s, ProgressSink& progress) {
                 return n >= 0 && tree.nodes[size_t(n)].leaf ? n : -1;
             },
             &region, step, &result.warnings, &result);
+    }
+
+    // A spooled input is named as it came, with what its reader found.
+    if (spooled) {
+        result.input_name = spooled->input_name;
+        result.input_format = spooled->input_format;
+        result.warnings.merge(spooled->warnings);
     }
 
     // The levels above, each decimated from the one below as one mesh.

@@ -45,6 +45,13 @@ if ! grep -q "format:      3D Tiles 1.1 tileset" <<<"$info" || ! grep -q "depth:
   echo "FAILED: meshstream info on a tileset said: $info"
   status=1
 fi
+# A pipe is spooled: the same leaves, the input named as it came.
+if ! "$meshstream" -q tiles - "$work/pipe" --tile-triangles 5000 --json < "$fixtures/bunny_from_draco.bin.stl" > "$work/pipe.json" ||
+  ! grep -q '"inputs":\[{"path":"-","format":"stl"' "$work/pipe.json" ||
+  ! grep -q '"triangles_in":69451' "$work/pipe.json"; then
+  echo "FAILED: tiles from a pipe: $(cat "$work/pipe.json")"
+  status=1
+fi
 # A non-empty OUTDIR: exit 2, nothing touched.
 mkdir -p "$work/full" && echo mine > "$work/full/keep.txt"
 "$meshstream" -q tiles "$fixtures/bunny_from_draco.bin.stl" "$work/full" 2> "$work/full.err"
