@@ -500,7 +500,7 @@ TilesResult tile_file(const TilesSettings& s, ProgressSink& progress) {
             },
             &region, step, nullptr, nullptr);
         // The level below is no longer needed (the input stays).
-        if (below != input) fs::remove(below, ec);
+        if (below != input && below != level) fs::remove(below, ec);
         below = level, below_format = level_format;
 
         // The errors of this depth's tiles: to their children's content, plus the children's own.
