@@ -207,8 +207,9 @@ std::array<double, 16> enu_to_ecef(const GeoOrigin& o) {
 // tile's cell written as that tile's GLB.
 class TileWriter {
 public:
-    TileWriter(const TilesSettings& s, Tree& tree, const Cube& cube, const std::string& root)
-        : s_(s), tree_(tree), cube_(cube), root_(root) {}
+    // Builds in `root`; notes name the tiles under `shown_root`, where they will be.
+    TileWriter(const TilesSettings& s, Tree& tree, const Cube& cube, const std::string& root, std::string shown_root)
+        : s_(s), tree_(tree), cube_(cube), root_(root), shown_root_(std::move(shown_root)) {}
 
     // Writes the tiles of `mesh` whose cell `select` picks (a node id, or -1 to skip the
     // triangle); counts in `region[d]` the triangles whose node at depth d is not a leaf.
@@ -279,6 +280,17 @@ public:
             if (wo.channels.material) tile->writer->update_materials(in.header().materials);
             tile->finish();
             Node& n = tree_.nodes[size_t(current)];
+            // What the writer could not keep (Draco's degenerate triangles, images of other
+            // types) is said, the first tiles' notes whole.
+            if (const std::vector<std::string> notes = tile->writer->raw_notes(); !notes.empty()) {
+                ++tiles_with_notes_;
+                if (tiles_with_notes_ <= kNotedTiles)
+                    for (std::string note : notes) {
+                        for (size_t at; (at = note.find(root_)) != std::string::npos;)
+                            note.replace(at, root_.size(), shown_root_);
+                        notes_.note("output_note", note);
+                    }
+            }
             n.bytes = fs::file_size(fs::path(root_) / n.uri);
             tile.reset();
             current = -1;
@@ -330,11 +342,23 @@ public:
         close();
     }
 
+    // The writers' notes, into `warnings`.
+    void report_notes(Warnings& warnings) const {
+        warnings.merge(notes_);
+        if (tiles_with_notes_ > kNotedTiles)
+            warnings.note("output_note", std::to_string(tiles_with_notes_ - kNotedTiles) +
+                                             " more tiles have notes like these from the glTF writer");
+    }
+
 private:
+    static constexpr uint64_t kNotedTiles = 5;
+    Warnings notes_;
+    uint64_t tiles_with_notes_ = 0;
     const TilesSettings& s_;
     Tree& tree_;
     const Cube& cube_;
     std::string root_;
+    std::string shown_root_;
 };
 
 // A tile's triangles as read back from its GLB (positions as stored: y-up).
@@ -440,7 +464,7 @@ TilesResult tile_file(const TilesSettings& s, ProgressSink& progress) {
     const int deepest = tree.max_depth;
 
     // The leaves: the input at full resolution.
-    TileWriter writer(s, tree, cube, building.path());
+    TileWriter writer(s, tree, cube, building.path(), outdir.string());
     std::vector<uint64_t> region(size_t(std::max(deepest, 1)), 0);
     {
         StepProgress step(progress, "leaves");
@@ -486,6 +510,7 @@ TilesResult tile_file(const TilesSettings& s, ProgressSink& progress) {
             ds.read = s.read;
             ds.write.tmpdir = s.read.tmpdir;
             const DecimateResult d = decimate_file(ds, step);
+            result.warnings.merge(d.warnings);
             level = ds.output;
             level_format = "stream";
             below_count = d.triangles_out;
@@ -538,6 +563,8 @@ TilesResult tile_file(const TilesSettings& s, ProgressSink& progress) {
             throw_if_cancelled(progress);
         }
     }
+
+    writer.report_notes(result.warnings);
 
     // The boxes: each tile's content and its children's.
     for (int i = int(tree.nodes.size()) - 1; i >= 0; --i) {
