@@ -39,9 +39,10 @@ if [ -n "$missing" ]; then
 fi
 
 # npm tools: the Khronos glTF validator, which the tests run on every glTF they write; three.js,
-# whose GLTFLoader (with MeshoptDecoder and DRACOLoader) renders them in Chromium; gltfpack,
+# whose GLTFLoader (with MeshoptDecoder and DRACOLoader) renders them in Chromium, and
+# 3d-tiles-renderer, which loads the tilesets of `meshstream tiles` there as viewers do; gltfpack,
 # the size reference of bench/web.sh.
-for pkg in gltf-validator@2.0.0-dev.3.10 three@0.170.0 gltfpack@0.18.0; do
+for pkg in gltf-validator@2.0.0-dev.3.10 three@0.170.0 3d-tiles-renderer@0.5.3 gltfpack@0.18.0; do
   name=${pkg%@*}
   if [ "$(node -p "try { require('$tools_dir/node_modules/$name/package.json').version } catch (e) { '' }" 2>/dev/null)" != "${pkg##*@}" ]; then
     echo "meshstream setup: installing $pkg into $tools_dir" >&2

@@ -1,6 +1,6 @@
 // Runs one page in headless Chromium (Debian's package, WebGL through SwiftShader) against a
 // local HTTP server, for the scripts that check what the files meshstream writes look like in a
-// browser (render_gltf.mjs: three.js's GLTFLoader).
+// browser (render_gltf.mjs: three.js's GLTFLoader; render_tiles.mjs: 3d-tiles-renderer).
 //
 //   const outcome = await runPage({ page, serve, post, name, timeoutMs });
 //
@@ -11,6 +11,7 @@
 // `done(value)` when it has all it needs. runPage resolves to that value, or to 'timeout' when the
 // page did not finish within timeoutMs (Chromium's last words are then printed). Chromium runs
 // in its own process group with a throw-away profile, both removed before runPage returns.
+// `onGet(url, bytes)` (optional) sees every file served and its size.
 import fs from 'node:fs';
 import http from 'node:http';
 import os from 'node:os';
@@ -55,7 +56,7 @@ export function below(root, rest) {
 const types = { '.js': 'text/javascript', '.mjs': 'text/javascript', '.wasm': 'application/wasm', '.html': 'text/html',
     '.json': 'application/json', '.glb': 'model/gltf-binary', '.png': 'image/png', '.jpg': 'image/jpeg' };
 
-export async function runPage({ chromium, page, serve, post, name, timeoutMs }) {
+export async function runPage({ chromium, page, serve, post, onGet, name, timeoutMs }) {
     let finish;
     const finished = new Promise((resolve) => (finish = resolve));
     const server = http.createServer((req, res) => {
@@ -81,6 +82,7 @@ export async function runPage({ chromium, page, serve, post, name, timeoutMs }) 
             res.end();
             return;
         }
+        if (onGet) onGet(url, fs.statSync(file).size);
         res.setHeader('Content-Type', types[path.extname(file)] || 'application/octet-stream');
         fs.createReadStream(file).pipe(res);
     });
