@@ -101,9 +101,33 @@ inline constexpr const char* kPrecisionNote = "coordinates";
 inline constexpr const char* kLastLineNote = "last line";
 inline constexpr const char* kLastLineText = "has no line end: the file may be cut short inside it";
 
+// What a reader of an indexed format gives a whole-mesh read (io::read_indexed) instead of its
+// triangle soup, when every corner carries nothing but its vertex's values (PLY): the file's
+// own vertices, in file order, and its faces as indices into them, so that nothing is welded
+// again. See Reader::indexed().
+class IndexedSource {
+public:
+    virtual ~IndexedSource() = default;
+    // The vertices the faces index (all of the file's, referenced or not); fewer than 2^32.
+    virtual uint64_t vertex_count() const = 0;
+    // Vertex i (< vertex_count()): xyz[3] and, when `record` is non-null, its values as
+    // CornerLayout(channels) packs them, `channels` being what the reader stores (ReadOptions::
+    // channels of the header's). Cheapest in order.
+    virtual void vertex(uint64_t i, float* xyz, std::byte* record) = 0;
+    // Appends the triangles of the next faces (about `max` of them, a polygon triangulated as
+    // next() would), 3 vertex indices each, counter-clockwise; returns false, appending
+    // nothing, once the faces are done and the rest of the file checked. Throws io::Error for
+    // what next() would.
+    virtual bool next_triangles(std::vector<uint32_t>& indices, size_t max) = 0;
+};
+
 class Reader {
 public:
     virtual ~Reader() = default;
+    // The file's vertices and faces for a whole-mesh read, before any next(), from readers
+    // that can give them (IndexedSource); the others, and a reader that was read from, return
+    // null. A reader that returns one is then read through it only (never next()).
+    virtual IndexedSource* indexed() { return nullptr; }
     // Fills `chunk` (cleared first) with up to chunk.capacity() triangles; returns false once
     // the input is exhausted (chunk then empty). Fills only the channels the chunk was made
     // with (header().channels are those the reader can fill). Throws io::Error on bad input

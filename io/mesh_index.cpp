@@ -174,6 +174,16 @@ uint64_t indexed_mesh_bytes(uint64_t vertices, uint64_t triangles, const Channel
     return vertices * per_vertex + triangles * (12 + (channels.material ? 4 : 0));
 }
 
+Error non_finite_triangle_error(const std::string& file, const std::string& format, uint64_t triangle) {
+    return Error(file, "triangle " + std::to_string(triangle) + " has a NaN or infinite coordinate, which " + format +
+                           " cannot store (" + mention(Setting::kStrict) + ")");
+}
+
+Error index_count_error(const std::string& file, const std::string& format, uint64_t triangles) {
+    return Error(file, "more than 2^32 - 1 indices (" + std::to_string(triangles) + " triangles): " + format +
+                           " uses 32-bit indices; split the mesh");
+}
+
 MeshIndexer::MeshIndexer(std::string file_name, std::string format, const Channels& channels, bool strict)
     : file_name_(std::move(file_name)), format_(std::move(format)), strict_(strict), layout_(channels) {
     mesh_.channels = channels;
@@ -253,17 +263,11 @@ void MeshIndexer::add(const TriangleChunk& chunk) {
         bool finite = true;
         for (int k = 0; k < 9; ++k) finite = finite && std::isfinite(p[k]);
         if (!finite) {
-            if (strict_)
-                throw Error(file_name_, "triangle " + std::to_string(input_triangles_) +
-                                            " has a NaN or infinite "
-                                            "coordinate, which " +
-                                            format_ + " cannot store (" + mention(Setting::kStrict) + ")");
+            if (strict_) throw non_finite_triangle_error(file_name_, format_, input_triangles_);
             ++non_finite_;
             continue;
         }
-        if (mesh_.indices.size() + 3 > kMaxIndexCount)
-            throw Error(file_name_, "more than 2^32 - 1 indices (" + std::to_string(input_triangles_ + 1) +
-                                        " triangles): " + format_ + " uses 32-bit indices; split the mesh");
+        if (mesh_.indices.size() + 3 > kMaxIndexCount) throw index_count_error(file_name_, format_, input_triangles_ + 1);
         uint32_t v[3];
         for (int k = 0; k < 3; ++k) {
             if (layout_.bytes()) {

@@ -106,6 +106,12 @@ private:
     uint64_t counted_ = 0;               // all the triangles, while counting
 };
 
+// The errors MeshIndexer throws, for others that build an IndexedMesh (io::read_indexed):
+// triangle `triangle` (its ordinal in the input) has a NaN or infinite coordinate, refused under
+// --strict; the mesh's `triangles` triangles need more than 2^32 - 1 indices.
+Error non_finite_triangle_error(const std::string& file, const std::string& format, uint64_t triangle);
+Error index_count_error(const std::string& file, const std::string& format, uint64_t triangles);
+
 class MeshIndexer {
 public:
     // `file_name` names the file in error messages, `format` what holds the mesh in them

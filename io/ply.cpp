@@ -146,7 +146,7 @@ std::string describe_properties(const Element& e) {
 
 // ---------------- reader ----------------
 
-class PlyReader : public Reader {
+class PlyReader : public Reader, private IndexedSource {
 public:
     PlyReader(ByteSource& source, const ReadOptions& options) : src_(source), options_(options) {
         parse_header();
@@ -180,7 +180,45 @@ public:
         }
     }
 
+    // Every corner of a PLY carries its vertex's values only: the table and the faces' indices
+    // are the mesh (the table's records, when it has them, are CornerLayout(stored_)'s).
+    IndexedSource* indexed() override {
+        const bool untouched = item_ == 0 && polygon_.empty() && strip_triangles_.empty() && !body_finished_;
+        return table_ && untouched && table_->size() <= 0xFFFFFFFFull ? this : nullptr;
+    }
+
 private:
+    // ---- IndexedSource ----
+    uint64_t vertex_count() const override { return table_->size(); }
+    void vertex(uint64_t i, float* xyz, std::byte* record) override { table_->get(i, xyz, layout_ ? record : nullptr); }
+    bool next_triangles(std::vector<uint32_t>& indices, size_t max) override {
+        const size_t start = indices.size();
+        for (;;) {
+            if (strip_next_ < strip_triangles_.size()) {  // read_face queued a strip's triangles
+                indices.insert(indices.end(), strip_triangles_.begin() + strip_next_, strip_triangles_.end());
+                strip_next_ = strip_triangles_.size();
+            }
+            if (indices.size() >= start + 3 * max) return true;
+            if (face_ < 0 || body_finished_ || item_ == elements_[static_cast<size_t>(face_)].count) {
+                finish_body();
+                return indices.size() > start;
+            }
+            read_face();
+            const size_t n = polygon_.size();
+            if (n == 3) {
+                indices.insert(indices.end(), polygon_.begin(), polygon_.end());
+            } else if (n > 3) {  // triangulated as emit_polygon does, on the corners' positions
+                PolygonScratch& scratch = polygon_scratch_;
+                scratch.xyz.resize(3 * n);
+                for (size_t k = 0; k < n; ++k) table_->get(polygon_[k], &scratch.xyz[3 * k], nullptr);
+                scratch.triangles.clear();
+                triangulate_polygon(scratch.xyz, scratch.triangulate, scratch.triangles);
+                for (const uint32_t corner : scratch.triangles) indices.push_back(static_cast<uint32_t>(polygon_[corner]));
+            }
+            polygon_.clear();
+        }
+    }
+
     // ---- header ----
     std::string header_line() {
         std::string_view line;

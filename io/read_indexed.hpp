@@ -1,12 +1,17 @@
 // A whole mesh file as one indexed mesh in memory (vertices, indices and channels), for library
 // users who want arrays rather than the chunk stream, as miniply and tinyobjloader give. The
-// file is read through the same registry, detection and read loop as the commands, then welded
-// as the whole-mesh writers weld (io::MeshIndexer): corners with bit-equal positions (or, from
-// readers that index, the same vertex id) and equal attributes are one vertex, so UV and normal
-// seams stay apart. Every triangle is kept in file order, degenerate ones too, except those with
-// a NaN or infinite coordinate, which are dropped and counted (an io::Error under
-// ReadOptions::strict); NaN or infinite attribute values are stored as 0 and counted.
-// Memory: the whole mesh (see io::IndexedMesh), plus the reader's own buffers while reading.
+// file is opened through the same registry and detection as the commands. A file whose corners
+// are its vertices, attributes and all (PLY: Reader::indexed), keeps its own: its vertices in
+// file order, those no triangle uses left out, and its faces' indices. Any other is read as the
+// commands read it and welded as the whole-mesh writers weld (io::MeshIndexer): corners with
+// bit-equal positions (or, from readers that index, the same vertex id) and equal attributes
+// are one vertex, numbered in the order the triangles first use them, so UV and normal seams
+// (an OBJ's) stay apart. Every triangle is kept in file order, degenerate ones too, except those
+// with a NaN or infinite coordinate, which are dropped and counted (an io::Error under
+// ReadOptions::strict); NaN or infinite attribute values are stored as 0 and counted (per
+// vertex from a file that keeps its own, per corner otherwise).
+// Memory: the whole mesh (see io::IndexedMesh), plus the reader's own buffers while reading
+// (and 1 byte a file vertex for a file that keeps its own).
 #pragma once
 
 #include "io/format.hpp"

@@ -29,6 +29,18 @@ def test_open3d_round_trip(name):
         assert np.array_equal(np.asarray(o.triangle_uvs, np.float32), mesh.uvs[0][mesh.faces.reshape(-1)])
 
 
+@pytest.mark.parametrize("name", ["cactus_vcolor.binary_le.ply", "elephant_normals.binary_be.ply"])
+def test_ply_read_gives_the_files_own_arrays(name):
+    # A PLY keeps its vertices in file order and its faces' indices: what meshio (and Open3D)
+    # read from the file, array for array.
+    mesh = meshstream.read(fixture("ply", name))
+    m = meshio.read(fixture("ply", name))
+    assert np.array_equal(mesh.vertices, np.asarray(m.points, np.float32))
+    assert np.array_equal(mesh.faces, np.asarray(m.cells_dict["triangle"], np.uint32))
+    o = open3d.io.read_triangle_mesh(fixture("ply", name))
+    assert np.array_equal(mesh.faces, np.asarray(o.triangles, np.uint32))
+
+
 def test_open3d_mesh_written_and_read_back(tmp_path):
     o = open3d.geometry.TriangleMesh.create_box(1.0, 2.0, 3.0)
     o.compute_vertex_normals()
