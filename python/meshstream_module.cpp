@@ -839,6 +839,10 @@ PYBIND11_MODULE(_meshstream, m) {
     def_file_job<tools::DecimateOptions>(
         m, "decimate", [](CLI::App& app, tools::DecimateOptions& o) { return tools::decimate_command(app, o); },
         [](auto& o, auto* sink) { return tools::decimate_job(o, nullptr, sink); });
+#if MESHSTREAM_WITH_GLTF
+    def_file_job<tools::TilesOptions>(m, "tiles", tools::tiles_command,
+                                      [](auto& o, auto* sink) { return tools::tiles_job(o, sink); });
+#endif
     m.def(
         "info",
         [](const py::object& path, const py::object& progress, const py::kwargs& kwargs) {

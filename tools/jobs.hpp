@@ -9,6 +9,9 @@
 
 #include "decimate/stream_decimator.hpp"
 #include "engine/progress.hpp"
+#if MESHSTREAM_WITH_GLTF
+#include "engine/tiles.hpp"
+#endif
 #include "tools/common.hpp"
 
 #include <nlohmann/json.hpp>
@@ -98,6 +101,26 @@ CLI::App* compare_command(CLI::App& app, CompareCliOptions& opt);
 // compare's --json object (null without `json`: the text is printed instead). A sink's
 // cancelled() is looked at between the comparison's progress steps.
 nlohmann::ordered_json compare_job(const CompareCliOptions& opt, engine::ProgressSink* progress = nullptr);
+
+#if MESHSTREAM_WITH_GLTF
+struct TilesOptions {
+    std::string input, output;  // the mesh, the tileset's directory
+    uint64_t tile_triangles = engine::kDefaultTileTriangles;
+    std::string compress = "meshopt";
+    std::string origin;  // "LON,LAT,HEIGHT" or empty
+    bool overwrite = false;
+    bool json = false;
+    unsigned threads = every_core();
+    uint64_t seed = 1;
+    ReadFlags read;
+};
+CLI::App* tiles_command(CLI::App& app, TilesOptions& opt);
+// tiles' --json object (null without `json`: a line on stderr instead). Without a `progress`
+// sink (the command) Ctrl-C, SIGTERM and SIGHUP cancel the build, which removes what it made,
+// and then end the process as the signal would have; a sink's cancelled() does the same
+// without the signal (engine::Cancelled is thrown).
+nlohmann::ordered_json tiles_job(const TilesOptions& opt, engine::ProgressSink* progress = nullptr);
+#endif
 
 // Sets `cmd`'s callback: runs `job` on the parsed options and prints its report with --json
 // (`indent` as nlohmann's dump(): -1 one line, as convert, sort and decimate print it).

@@ -6,6 +6,7 @@
 #include "tools/commands.hpp"
 #include "tools/common.hpp"
 #include "tools/help.hpp"
+#include "tools/jobs.hpp"
 #include "tools/run_report.hpp"
 
 #include <atomic>
@@ -17,18 +18,6 @@
 
 namespace meshstream::tools {
 namespace {
-
-struct TilesOptions {
-    std::string input, outdir;
-    uint64_t tile_triangles = engine::kDefaultTileTriangles;
-    std::string compress = "meshopt";
-    std::string origin;
-    bool overwrite = false;
-    bool json = false;
-    unsigned threads = every_core();
-    uint64_t seed = 1;
-    ReadFlags read;
-};
 
 // Ctrl-C and termination ask the engine to stop: it removes the tileset being built and its
 // temporary files, then the signal ends the process as it would have.
@@ -75,26 +64,16 @@ engine::GeoOrigin parse_origin(const std::string& text) {
     return {v[0], v[1], v[2]};
 }
 
-void run_tiles(const TilesOptions& opt) {
-    const auto start = std::chrono::steady_clock::now();
-    engine::TilesSettings s;
-    s.input = opt.input;
-    s.input_format = opt.read.from;
-    s.outdir = opt.outdir;
-    s.tile_triangles = opt.tile_triangles;
-    s.compression = parse_compression(opt.compress);
-    if (!opt.origin.empty()) s.origin = parse_origin(opt.origin);
-    s.overwrite = opt.overwrite;
-    s.threads = opt.threads;
-    s.seed = opt.seed;
-    s.read = opt.read.options();
-
+// The build, cancelled by the signals (no `sink`) or by the sink.
+engine::TilesResult build(const engine::TilesSettings& s, engine::ProgressSink* sink) {
+    if (sink) return engine::tile_file(s, *sink);
+    g_cancel.store(false);
+    g_signal.store(0);
     for (int sig : {SIGINT, SIGTERM, SIGHUP}) std::signal(sig, ask_to_stop);
-    engine::TilesResult result;
     try {
         Progress bar("tiles", std::nullopt);
         CancellableProgress progress(bar);
-        result = engine::tile_file(s, progress);
+        return engine::tile_file(s, progress);
     } catch (const engine::Cancelled&) {
         // Everything is removed: end as the signal would have.
         if (const int sig = g_signal.load(); sig != 0) {
@@ -103,62 +82,83 @@ void run_tiles(const TilesOptions& opt) {
         }
         throw;
     }
-    print_warnings(result.warnings);
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    if (opt.json) {
-        RunReport report;
-        report.command = "tiles";
-        report.inputs = {{opt.input, result.input_format, false}};
-        report.outputs = {{opt.outdir + "/tileset.json", "3d-tiles", false}};
-        report.triangles_in = result.triangles_in;
-        for (const engine::TileLevel& l : result.levels) report.triangles_out += l.triangles;
-        report.seconds = seconds;
-        report.peak_rss_bytes = peak_rss_bytes();
-        nlohmann::ordered_json levels = nlohmann::ordered_json::array();
-        for (const engine::TileLevel& l : result.levels)
-            levels.push_back({{"depth", l.depth}, {"tiles", l.tiles}, {"leaves", l.leaves}, {"triangles", l.triangles},
-                              {"bytes", l.bytes}, {"min_error", l.min_error}, {"max_error", l.max_error}});
-        report.details = {{"tile_triangles", opt.tile_triangles}, {"compress", opt.compress},
-                          {"tiles", result.tiles}, {"bytes", result.bytes}, {"leaf_bytes", result.leaf_bytes},
-                          {"geometric_error", result.geometric_error}, {"levels", levels}};
-        std::printf("%s\n", run_report_json(report, result.warnings).dump().c_str());
-    } else if (!global().quiet) {
-        std::fprintf(stderr, "%s: %zu levels, %llu tiles, %s (leaves %s) from %s triangles in %.1f s\n",
-                     opt.outdir.c_str(), result.levels.size(), static_cast<unsigned long long>(result.tiles),
-                     human_bytes(double(result.bytes)).c_str(), human_bytes(double(result.leaf_bytes)).c_str(),
-                     human_count(double(result.triangles_in)).c_str(), seconds);
-    }
 }
 
 }  // namespace
 
-void add_tiles(CLI::App& app) {
-    auto opt = std::make_shared<TilesOptions>();
+nlohmann::ordered_json tiles_job(const TilesOptions& opt, engine::ProgressSink* progress) {
+    const auto start = std::chrono::steady_clock::now();
+    engine::TilesSettings s;
+    s.input = opt.input;
+    s.input_format = opt.read.from;
+    s.outdir = opt.output;
+    s.tile_triangles = opt.tile_triangles;
+    s.compression = parse_compression(opt.compress);
+    if (!opt.origin.empty()) s.origin = parse_origin(opt.origin);
+    s.overwrite = opt.overwrite;
+    s.threads = opt.threads;
+    s.seed = opt.seed;
+    s.read = opt.read.options();
+    const engine::TilesResult result = build(s, progress);
+    print_warnings(result.warnings);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (!opt.json) {
+        if (!global().quiet)
+            std::fprintf(stderr, "%s: %zu levels, %llu tiles, %s (leaves %s) from %s triangles in %.1f s\n",
+                         opt.output.c_str(), result.levels.size(), static_cast<unsigned long long>(result.tiles),
+                         human_bytes(double(result.bytes)).c_str(), human_bytes(double(result.leaf_bytes)).c_str(),
+                         human_count(double(result.triangles_in)).c_str(), seconds);
+        return nullptr;
+    }
+    RunReport report;
+    report.command = "tiles";
+    report.inputs = {{opt.input, result.input_format, false}};
+    report.outputs = {{opt.output + "/tileset.json", "3d-tiles", false}};
+    report.triangles_in = result.triangles_in;
+    for (const engine::TileLevel& l : result.levels) report.triangles_out += l.triangles;
+    report.seconds = seconds;
+    report.peak_rss_bytes = peak_rss_bytes();
+    nlohmann::ordered_json levels = nlohmann::ordered_json::array();
+    for (const engine::TileLevel& l : result.levels)
+        levels.push_back({{"depth", l.depth}, {"tiles", l.tiles}, {"leaves", l.leaves}, {"triangles", l.triangles},
+                          {"bytes", l.bytes}, {"min_error", l.min_error}, {"max_error", l.max_error}});
+    report.details = {{"tile_triangles", opt.tile_triangles}, {"compress", opt.compress},
+                      {"tiles", result.tiles}, {"bytes", result.bytes}, {"leaf_bytes", result.leaf_bytes},
+                      {"geometric_error", result.geometric_error}, {"levels", levels}};
+    return run_report_json(report, result.warnings);
+}
+
+CLI::App* tiles_command(CLI::App& app, TilesOptions& opt) {
     CLI::App* cmd = app.add_subcommand(
         "tiles",
         "OGC 3D Tiles 1.1: level-of-detail GLB tiles and a tileset.json, built out of core\n"
         "  IN: any mesh ('-' = stdin, spooled); OUTDIR: a new or empty directory (--overwrite replaces one)");
-    cmd->add_option("IN", opt->input, "input mesh ('-' = stdin)")->required();
-    cmd->add_option("OUTDIR", opt->outdir, "the tileset's directory")->required();
-    cmd->add_option("--tile-triangles", opt->tile_triangles, "at most N triangles a leaf, about N above (default 65536)")
+    cmd->add_option("IN", opt.input, "input mesh ('-' = stdin)")->required();
+    cmd->add_option("OUTDIR", opt.output, "the tileset's directory")->required();
+    cmd->add_option("--tile-triangles", opt.tile_triangles, "at most N triangles a leaf, about N above (default 65536)")
         ->type_name("N")
         ->check(CLI::Range(uint64_t{256}, uint64_t{1} << 32));
-    cmd->add_option("--compress", opt->compress, "the tiles' encoding: meshopt (default), draco or none")
+    cmd->add_option("--compress", opt.compress, "the tiles' encoding: meshopt (default), draco or none")
         ->type_name("FMT")
         ->check(CLI::IsMember({"meshopt", "draco", "none"}));
-    cmd->add_option("--origin", opt->origin, "put the model's origin there (WGS84 degrees, metres; z up)")
+    cmd->add_option("--origin", opt.origin, "put the model's origin there (WGS84 degrees, metres; z up)")
         ->type_name("LON,LAT,H");
-    cmd->add_flag("--overwrite", opt->overwrite, "replace OUTDIR when it is not empty (once the new tileset is complete)");
-    cmd->add_option("--seed", opt->seed, "random seed of the decimations and error samples (default 1)")
+    cmd->add_flag("--overwrite", opt.overwrite, "replace OUTDIR when it is not empty (once the new tileset is complete)");
+    cmd->add_option("--seed", opt.seed, "random seed of the decimations and error samples (default 1)")
         ->type_name("N");
-    add_json_flag(cmd, opt->json);
-    add_threads_option(cmd, opt->threads, "decimate the levels on N cores");
-    add_read_flags(cmd, opt->read);
+    add_json_flag(cmd, opt.json);
+    add_threads_option(cmd, opt.threads, "decimate the levels on N cores");
+    add_read_flags(cmd, opt.read);
     cmd->footer(
         "  meshstream tiles scan.ply web/scan\n"
         "  meshstream tiles scan.ply web/scan --origin 7.4474,46.9480,540 --compress draco\n"
         "  meshstream info web/scan/tileset.json");
-    cmd->callback([opt] { run_tiles(*opt); });
+    return cmd;
+}
+
+void add_tiles(CLI::App& app) {
+    auto opt = std::make_shared<TilesOptions>();
+    run_when_parsed(tiles_command(app, *opt), opt, [](TilesOptions& o) { return tiles_job(o); });
 }
 
 }  // namespace meshstream::tools

@@ -2,7 +2,7 @@
 
 Whole meshes as numpy arrays (read, write), the triangle stream a chunk at a time (chunks,
 Writer), and every command as a call returning its --json report as a dict (convert, sort,
-decimate, info, compare). Keyword arguments are the command's flags: ``from_`` for --from,
+decimate, info, compare, and tiles for OGC 3D Tiles when built with glTF). Keyword arguments are the command's flags: ``from_`` for --from,
 ``draco_qp`` for --draco-qp, ``memory="512M"``; bad values raise ValueError in the command's
 words, unknown keywords TypeError. Files that cannot be read or written raise
 meshstream.Error with .file, .line and .offset. The work runs without the GIL; Ctrl-C (or a
@@ -12,6 +12,9 @@ has examples.
 
 from ._meshstream import Chunk, ChunkReader, Error, compare, convert, decimate, info, sort
 from . import _meshstream
+
+if hasattr(_meshstream, "tiles"):  # built with glTF (MESHSTREAM_WITH_GLTF)
+    from ._meshstream import tiles
 
 import numpy as _np
 
@@ -29,6 +32,7 @@ __all__ = [
     "info",
     "read",
     "sort",
+    *(["tiles"] if hasattr(_meshstream, "tiles") else []),
     "to_meshio",
     "to_open3d",
     "write",

@@ -220,6 +220,34 @@ def test_convert_sort_info_compare_reports_equal_the_command(tmp_path, coloured)
         run_json("compare", coloured, str(tmp_path / "s.ply"), "--samples", "20000", "--attributes")
 
 
+@pytest.mark.skipif(not hasattr(meshstream, "tiles"), reason="built without glTF (MESHSTREAM_WITH_GLTF=OFF)")
+def test_tiles_matches_the_command_file_for_file(tmp_path, coloured):
+    report = meshstream.tiles(coloured, tmp_path / "py", tile_triangles=8000, threads=2)
+    command = run_json("tiles", coloured, str(tmp_path / "cmd"), "--tile-triangles", "8000", "--threads", "2")
+    command["outputs"][0]["path"] = str(tmp_path / "py" / "tileset.json")
+    assert without_timings(report) == without_timings(command)
+    assert report["triangles_in"] == run_json("info", coloured)["triangles"] and report["tiles"]["tiles"] > 1
+    def files(root):
+        return sorted(os.path.relpath(os.path.join(d, f), root) for d, _, names in os.walk(root) for f in names)
+
+    assert files(tmp_path / "py") == files(tmp_path / "cmd") and len(files(tmp_path / "cmd")) == 1 + report["tiles"]["tiles"]
+    assert all(filecmp.cmp(tmp_path / "py" / f, tmp_path / "cmd" / f, shallow=False) for f in files(tmp_path / "cmd"))
+    summary = run_json("info", str(tmp_path / "cmd" / "tileset.json"))
+    summary["file"] = str(tmp_path / "py" / "tileset.json")
+    assert meshstream.info(tmp_path / "py" / "tileset.json") == summary
+    # A tileset is not replaced unasked (the setting named), and a cancelled build leaves nothing.
+    with pytest.raises(ValueError, match=r"--overwrite"):
+        meshstream.tiles(coloured, tmp_path / "py")
+
+    def interrupt(phase, done, total):
+        if done > 0:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        meshstream.tiles(coloured, tmp_path / "cancelled", tile_triangles=8000, progress=interrupt)
+    assert sorted(os.listdir(tmp_path)) == ["cmd", "py"]
+
+
 def test_report_warnings_in_the_commands_words(tmp_path):
     report = meshstream.convert(fixture("ply", "cactus_vcolor.binary_le.ply"), tmp_path / "o.stl", draco_qp=12)
     codes = {w["code"]: w["text"] for w in report["warnings"]}
