@@ -772,14 +772,15 @@ CompareResult compare_meshes(const MeshSource& a, const MeshSource& b, const Com
     triangles.values = values;
     {
         EdgeCounter edges(options.memory_budget_bytes, options.tmpdir);
-        stream_mesh(std::move(held_reader), layout, held_summary, &edges, options, "reading " + held.name,
+        stream_mesh(std::move(held_reader), layout, held_summary, options.edges ? &edges : nullptr, options,
+                    "reading " + held.name,
                     [&](uint64_t, const float* t, const float* corners) {
                         triangles.xyz.insert(triangles.xyz.end(), t, t + 9);
                         if (values)
                             triangles.corner_values.insert(triangles.corner_values.end(), corners,
                                                            corners + 3 * values);
                     });
-        held_summary.edges = edges.finish();
+        if (options.edges) held_summary.edges = edges.finish();
     }
     if (triangles.xyz.empty()) throw io::Error(held.name, "holds no (finite) triangles; nothing to compare");
     uint64_t held_samples = options.samples.value_or(default_sample_count(held_summary.triangles));
@@ -793,7 +794,8 @@ CompareResult compare_meshes(const MeshSource& a, const MeshSource& b, const Com
     {
         EdgeCounter edges(options.memory_budget_bytes, options.tmpdir);
         uint64_t seen = 0;
-        stream_mesh(streamed.open(), layout, streamed_summary, &edges, options, "pass 1: " + streamed.name,
+        stream_mesh(streamed.open(), layout, streamed_summary, options.edges ? &edges : nullptr, options,
+                    "pass 1: " + streamed.name,
                     [&](uint64_t index, const float* t, const float* corners) {
                         Rng rng = triangle_rng(options.seed, kSaltReservoir, index);
                         const uint64_t k = rng.next() % 3;
@@ -812,7 +814,7 @@ CompareResult compare_meshes(const MeshSource& a, const MeshSource& b, const Com
                         }
                         ++seen;
                     });
-        streamed_summary.edges = edges.finish();
+        if (options.edges) streamed_summary.edges = edges.finish();
     }
     if (reservoir.empty()) throw io::Error(streamed.name, "holds no (finite) triangles; nothing to compare");
     uint64_t streamed_samples = options.samples.value_or(default_sample_count(streamed_summary.triangles));

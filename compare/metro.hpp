@@ -67,6 +67,9 @@ struct CompareOptions {
     // file). The sources are read with those channels, so their readers must keep them (a
     // file_source's ReadOptions::channels).
     bool attributes = false;
+    // Count both meshes' edges (MeshSummary::edges: boundary and non-manifold edges, which the
+    // result's notes use); false leaves them 0, for callers that want the distances only.
+    bool edges = true;
     // Progress callback (may be empty): phase label, triangles done, total when known.
     std::function<void(std::string_view phase, uint64_t done, std::optional<uint64_t> total)> progress;
 };

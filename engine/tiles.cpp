@@ -13,6 +13,10 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <atomic>
+#include <exception>
+#include <mutex>
+#include <thread>
 #include <array>
 #include <cmath>
 #include <cstring>
@@ -22,7 +26,6 @@
 #include <fstream>
 #include <map>
 #include <unistd.h>
-#include <unordered_map>
 
 namespace meshstream::engine {
 
@@ -78,6 +81,56 @@ struct Box {
         for (int a = 0; a < 3; ++a) d += (max[a] - min[a]) * (max[a] - min[a]);
         return std::sqrt(d);
     }
+};
+
+// Triangles per cell key (a centroid's depth-10 cell): an open-addressing table (linear
+// probing, load at most 1/2) of the cells met, 16 bytes a slot: a surface meets about one cell
+// a triangle at 1 M triangles, and at most 6 · 4^10 cells (the cube's, over its area) beyond.
+class CellCounts {
+public:
+    void add(uint32_t key) {
+        size_t i = slot(key);
+        if (keys_[i] == kEmpty) {
+            keys_[i] = key;
+            if (2 * ++size_ > keys_.size()) {
+                grow();
+                i = slot(key);
+            }
+        }
+        ++counts_[i];
+    }
+    bool empty() const { return size_ == 0; }
+    // (key, count) of every cell met, by key.
+    std::vector<std::pair<uint32_t, uint64_t>> sorted() const {
+        std::vector<std::pair<uint32_t, uint64_t>> out;
+        out.reserve(size_);
+        for (size_t i = 0; i < keys_.size(); ++i)
+            if (keys_[i] != kEmpty) out.emplace_back(keys_[i], counts_[i]);
+        std::sort(out.begin(), out.end());
+        return out;
+    }
+
+private:
+    static constexpr uint32_t kEmpty = ~uint32_t{0};  // keys have 30 bits
+    size_t slot(uint32_t key) const {
+        const size_t mask = keys_.size() - 1;
+        size_t i = (uint64_t{key} * 0x9E3779B97F4A7C15ull >> 32) & mask;
+        while (keys_[i] != kEmpty && keys_[i] != key) i = (i + 1) & mask;
+        return i;
+    }
+    void grow() {
+        std::vector<uint32_t> keys(2 * keys_.size(), kEmpty);
+        std::vector<uint64_t> counts(keys.size(), 0);
+        std::swap(keys, keys_), std::swap(counts, counts_);
+        for (size_t i = 0; i < keys.size(); ++i)
+            if (keys[i] != kEmpty) {
+                const size_t j = slot(keys[i]);
+                keys_[j] = keys[i], counts_[j] = counts[i];
+            }
+    }
+    std::vector<uint32_t> keys_ = std::vector<uint32_t>(1024, kEmpty);
+    std::vector<uint64_t> counts_ = std::vector<uint64_t>(1024, 0);
+    size_t size_ = 0;
 };
 
 struct Node {
@@ -370,6 +423,78 @@ std::vector<float> tile_positions(const std::string& path) {
     return xyz;
 }
 
+// The geometric error of a tile: the Hausdorff distance from its content to its children's
+// (0 without content: nothing is drawn instead of the children), plus their largest error.
+double tile_error(const Node& n, const Tree& tree, const std::string& root, const TilesSettings& s) {
+    std::vector<float> children;
+    double child_error = 0;
+    for (int c : n.child) {
+        if (c < 0) continue;
+        const Node& ch = tree.nodes[size_t(c)];
+        child_error = std::max(child_error, ch.error);
+        if (!ch.uri.empty()) {
+            std::vector<float> xyz = tile_positions((fs::path(root) / ch.uri).string());
+            children.insert(children.end(), xyz.begin(), xyz.end());
+        }
+    }
+    double distance = 0;
+    if (!n.uri.empty() && !children.empty()) {
+        std::vector<float> own = tile_positions((fs::path(root) / n.uri).string());
+        compare::CompareOptions co;
+        co.samples = std::max<uint64_t>(10000, own.size() / 9);  // about one a tile triangle
+        co.seed = s.seed;
+        co.tmpdir = s.read.tmpdir;
+        co.edges = false;  // the distances only
+        const compare::CompareResult r = compare::compare_meshes(compare::memory_source("tile", std::move(own)),
+                                                                 compare::memory_source("children", std::move(children)), co);
+        distance = r.hausdorff();
+    }
+    return distance + child_error;
+}
+
+// Sets the errors of `parents` (tiles of one depth, whose children's errors are set) on
+// s.threads threads, each tile's on one, so the figures do not depend on the threads. Memory:
+// a tile and its children's positions per thread.
+void measure_errors(const std::vector<Node*>& parents, const Tree& tree, const std::string& root,
+                    const TilesSettings& s, ProgressSink& progress) {
+    std::atomic<size_t> next{0}, done{0};
+    std::atomic<bool> stop{false};
+    std::exception_ptr failure;
+    std::mutex failure_mutex;
+    auto work = [&] {
+        for (size_t i; !stop.load() && (i = next.fetch_add(1)) < parents.size();) {
+            try {
+                parents[i]->error = tile_error(*parents[i], tree, root, s);
+            } catch (...) {
+                const std::lock_guard<std::mutex> lock(failure_mutex);
+                if (!failure) failure = std::current_exception();
+                stop.store(true);
+            }
+            done.fetch_add(1);
+        }
+    };
+    std::vector<std::thread> workers;
+    const size_t extra = std::min<size_t>(parents.size(), std::max(1u, s.threads)) - (parents.empty() ? 0 : 1);
+    for (size_t t = 0; t < extra; ++t) workers.emplace_back(work);
+    // This thread works too, and says how far they are and looks for a cancel between tiles.
+    for (size_t i; !stop.load() && (i = next.fetch_add(1)) < parents.size();) {
+        try {
+            parents[i]->error = tile_error(*parents[i], tree, root, s);
+            done.fetch_add(1);
+            progress.update(done.load());
+            if (progress.cancelled()) stop.store(true);
+        } catch (...) {
+            const std::lock_guard<std::mutex> lock(failure_mutex);
+            if (!failure) failure = std::current_exception();
+            stop.store(true);
+        }
+    }
+    for (std::thread& w : workers) w.join();
+    if (failure) std::rethrow_exception(failure);
+    throw_if_cancelled(progress);
+    progress.update(done.load());
+}
+
 Json box_json(const Box& b, double pad) {
     Json j = Json::array();
     double c[3], h[3];
@@ -446,19 +571,18 @@ TilesResult tile_file(const TilesSettings& s, ProgressSink& progress) {
         if (!(extent >= 0) || !std::isfinite(extent))
             throw io::Error(s.input, "no triangle with finite coordinates: nothing to tile");
         cube.extent = extent > 0 ? extent * (1 + 1e-6) : 1;
-        std::unordered_map<uint32_t, uint64_t> counts;
+        CellCounts counts;
         io::TriangleInput in(io::open_input(input, input_format, s.read), io::BadTriangles::kDrop);
         io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, {});
         step.phase("cells", in.header().triangle_count);
         while (in.next(chunk)) {
-            for (size_t i = 0; i < chunk.size(); ++i) ++counts[cube.triangle_key(&chunk.xyz()[9 * i])];
+            for (size_t i = 0; i < chunk.size(); ++i) counts.add(cube.triangle_key(&chunk.xyz()[9 * i]));
             step.update(in.count().read, in.source().stored_offset(), in.source().stored_size());
             throw_if_cancelled(progress);
         }
         if (counts.empty()) throw io::Error(s.input, "no triangle to tile");
-        std::vector<std::pair<uint32_t, uint64_t>> cells(counts.begin(), counts.end());
+        const std::vector<std::pair<uint32_t, uint64_t>> cells = counts.sorted();
         counts = {};
-        std::sort(cells.begin(), cells.end());
         tree.build(cells, 0, cells.size(), 0, 0, s.tile_triangles);
     }
     const int deepest = tree.max_depth;
@@ -530,38 +654,10 @@ TilesResult tile_file(const TilesSettings& s, ProgressSink& progress) {
 
         // The errors of this depth's tiles: to their children's content, plus the children's own.
         step.phase("measuring errors", cells_here);
-        uint64_t measured = 0;
-        for (Node& n : tree.nodes) {
-            if (n.depth != depth || n.leaf) continue;
-            std::vector<float> children;
-            double child_error = 0;
-            Box child_box;
-            for (int c : n.child) {
-                if (c < 0) continue;
-                const Node& ch = tree.nodes[size_t(c)];
-                child_error = std::max(child_error, ch.error);
-                if (!ch.uri.empty()) {
-                    std::vector<float> xyz = tile_positions((fs::path(building.path()) / ch.uri).string());
-                    children.insert(children.end(), xyz.begin(), xyz.end());
-                }
-            }
-            double distance = 0;
-            if (!n.uri.empty() && !children.empty()) {
-                std::vector<float> own = tile_positions((fs::path(building.path()) / n.uri).string());
-                compare::CompareOptions co;
-                co.samples = std::max<uint64_t>(10000, own.size() / 9);  // about one a tile triangle
-                co.seed = s.seed;
-                co.tmpdir = s.read.tmpdir;
-                const compare::CompareResult r = compare::compare_meshes(compare::memory_source("tile", std::move(own)),
-                                                                         compare::memory_source("children", std::move(children)), co);
-                distance = r.hausdorff();
-            } else if (n.uri.empty()) {
-                distance = 0;  // no content: nothing drawn instead of the children
-            }
-            n.error = distance + child_error;
-            step.update(++measured);
-            throw_if_cancelled(progress);
-        }
+        std::vector<Node*> parents;
+        for (Node& n : tree.nodes)
+            if (n.depth == depth && !n.leaf) parents.push_back(&n);
+        measure_errors(parents, tree, building.path(), s, step);
     }
 
     writer.report_notes(result.warnings);

@@ -139,6 +139,21 @@ TEST(Metro, TranslatedSphereHausdorffIsTheOffset) {
     EXPECT_NEAR(r.diagonal, 2 * std::sqrt(3.0), 1e-6);
 }
 
+TEST(Metro, WithoutEdgesTheDistancesAreTheSameAndNoEdgeIsCounted) {
+    CompareOptions options;
+    options.samples = 20'000;
+    const CompareResult with = compare_meshes(memory_source("a", sphere(3)), memory_source("b", sphere(3, 0.05f)), options);
+    options.edges = false;
+    const CompareResult without = compare_meshes(memory_source("a", sphere(3)), memory_source("b", sphere(3, 0.05f)), options);
+    EXPECT_GT(with.a.edges.edges, 0u);
+    EXPECT_EQ(without.a.edges.edges, 0u);
+    EXPECT_EQ(without.b.edges.edges, 0u);
+    EXPECT_EQ(without.a_to_b.max, with.a_to_b.max);
+    EXPECT_EQ(without.b_to_a.max, with.b_to_a.max);
+    EXPECT_EQ(without.a_to_b.rms, with.a_to_b.rms);
+    EXPECT_EQ(without.b_to_a.mean, with.b_to_a.mean);
+}
+
 TEST(Metro, TiltedSquareAgainstFlatSquareHasClosedFormRms) {
     // A = z = s·x over the unit square, B = z = 0. From A, each point (x, y, s x) projects
     // inside B at distance s·x with x uniform on [0, 1] (area-uniform on the tilted square):
