@@ -84,22 +84,31 @@ struct Box {
 };
 
 // Triangles per cell key (a centroid's depth-10 cell): an open-addressing table (linear
-// probing, load at most 1/2) of the cells met, 16 bytes a slot: a surface meets about one cell
-// a triangle at 1 M triangles, and at most 6 · 4^10 cells (the cube's, over its area) beyond.
+// probing, load at most 1/2) of the cells met, 12 bytes a slot. A mesh meets about one cell a
+// triangle up to a few million triangles; past `budget_bytes` (the table and, while it grows,
+// the one before it) the counts go to cells of the depth above, 8 times as large, as often as
+// needed, and keys count at that depth (their lower bits 0): depth() says which.
 class CellCounts {
 public:
+    explicit CellCounts(uint64_t budget_bytes)
+        : max_slots_(std::max<uint64_t>(kFirstSlots, budget_bytes / (3 * kSlotBytes))) {}
+
     void add(uint32_t key) {
-        size_t i = slot(key);
+        size_t i = slot(key & mask_);
         if (keys_[i] == kEmpty) {
-            keys_[i] = key;
+            keys_[i] = key & mask_;
             if (2 * ++size_ > keys_.size()) {
-                grow();
-                i = slot(key);
+                if (2 * keys_.size() <= max_slots_)
+                    rehash(2 * keys_.size());
+                else
+                    while (2 * size_ > keys_.size()) coarsen();
+                i = slot(key & mask_);
             }
         }
         ++counts_[i];
     }
     bool empty() const { return size_ == 0; }
+    int depth() const { return depth_; }
     // (key, count) of every cell met, by key.
     std::vector<std::pair<uint32_t, uint64_t>> sorted() const {
         std::vector<std::pair<uint32_t, uint64_t>> out;
@@ -112,24 +121,37 @@ public:
 
 private:
     static constexpr uint32_t kEmpty = ~uint32_t{0};  // keys have 30 bits
+    static constexpr uint64_t kSlotBytes = sizeof(uint32_t) + sizeof(uint64_t);
+    static constexpr size_t kFirstSlots = 1024;
     size_t slot(uint32_t key) const {
         const size_t mask = keys_.size() - 1;
         size_t i = (uint64_t{key} * 0x9E3779B97F4A7C15ull >> 32) & mask;
         while (keys_[i] != kEmpty && keys_[i] != key) i = (i + 1) & mask;
         return i;
     }
-    void grow() {
-        std::vector<uint32_t> keys(2 * keys_.size(), kEmpty);
-        std::vector<uint64_t> counts(keys.size(), 0);
+    // The table made anew with `slots` slots, the keys under the current mask.
+    void rehash(size_t slots) {
+        std::vector<uint32_t> keys(slots, kEmpty);
+        std::vector<uint64_t> counts(slots, 0);
         std::swap(keys, keys_), std::swap(counts, counts_);
+        size_ = 0;
         for (size_t i = 0; i < keys.size(); ++i)
             if (keys[i] != kEmpty) {
-                const size_t j = slot(keys[i]);
-                keys_[j] = keys[i], counts_[j] = counts[i];
+                const size_t j = slot(keys[i] & mask_);
+                size_ += keys_[j] == kEmpty;
+                keys_[j] = keys[i] & mask_, counts_[j] += counts[i];
             }
     }
-    std::vector<uint32_t> keys_ = std::vector<uint32_t>(1024, kEmpty);
-    std::vector<uint64_t> counts_ = std::vector<uint64_t>(1024, 0);
+    void coarsen() {
+        --depth_;
+        mask_ <<= 3;
+        rehash(keys_.size());
+    }
+    uint64_t max_slots_;
+    uint32_t mask_ = ~uint32_t{0};
+    int depth_ = kMaxDepth;
+    std::vector<uint32_t> keys_ = std::vector<uint32_t>(kFirstSlots, kEmpty);
+    std::vector<uint64_t> counts_ = std::vector<uint64_t>(kFirstSlots, 0);
     size_t size_ = 0;
 };
 
@@ -151,8 +173,9 @@ struct Tree {
     int max_depth = 0;
 
     // Builds the cells of [lo, hi) of the sorted (key, count) list under `prefix` at `depth`.
+    // Cells split down to `deepest` (the depth the counts are of) at most.
     int build(const std::vector<std::pair<uint32_t, uint64_t>>& cells, size_t lo, size_t hi, uint32_t prefix,
-              int depth, uint64_t budget) {
+              int depth, uint64_t budget, int deepest) {
         const int id = int(nodes.size());
         nodes.emplace_back();
         uint64_t count = 0;
@@ -161,14 +184,15 @@ struct Tree {
         nodes[id].depth = depth;
         nodes[id].count = count;
         max_depth = std::max(max_depth, depth);
-        if (count <= budget || depth == kMaxDepth) return id;
+        if (count <= budget || depth >= deepest) return id;
         nodes[id].leaf = false;
         size_t i = lo;
         for (int o = 0; o < 8; ++o) {
             size_t j = i;
             while (j < hi && octant(cells[j].first, depth + 1) == o) ++j;
             if (j > i) {
-                const int c = build(cells, i, j, prefix | uint32_t(o) << (3 * (kMaxDepth - depth - 1)), depth + 1, budget);
+                const int c = build(cells, i, j, prefix | uint32_t(o) << (3 * (kMaxDepth - depth - 1)), depth + 1, budget,
+                                    deepest);
                 nodes[id].child[o] = c;
             }
             i = j;
@@ -366,7 +390,8 @@ public:
                     Node& n = tree_.nodes[size_t(current)];
                     n.uri = "tiles/" + std::to_string(n.depth) + "/" + std::to_string(n.prefix >> (3 * (kMaxDepth - n.depth))) + ".glb";
                     fs::create_directories(fs::path(root_) / "tiles" / std::to_string(n.depth));
-                    wo.expected_triangle_count = n.count ? n.count : std::optional<uint64_t>();
+                    // A leaf holds its input triangles; a tile above, a decimation of them (not known yet).
+                    wo.expected_triangle_count = n.leaf && n.count ? n.count : std::optional<uint64_t>();
                     tile.emplace(io::open_output((fs::path(root_) / n.uri).string(), "glb", wo));
                 }
                 Node& n = tree_.nodes[size_t(current)];
@@ -571,7 +596,7 @@ TilesResult tile_file(const TilesSettings& s, ProgressSink& progress) {
         if (!(extent >= 0) || !std::isfinite(extent))
             throw io::Error(s.input, "no triangle with finite coordinates: nothing to tile");
         cube.extent = extent > 0 ? extent * (1 + 1e-6) : 1;
-        CellCounts counts;
+        CellCounts counts(s.read.memory_budget_bytes / 4);
         io::TriangleInput in(io::open_input(input, input_format, s.read), io::BadTriangles::kDrop);
         io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, {});
         step.phase("cells", in.header().triangle_count);
@@ -582,8 +607,7 @@ TilesResult tile_file(const TilesSettings& s, ProgressSink& progress) {
         }
         if (counts.empty()) throw io::Error(s.input, "no triangle to tile");
         const std::vector<std::pair<uint32_t, uint64_t>> cells = counts.sorted();
-        counts = {};
-        tree.build(cells, 0, cells.size(), 0, 0, s.tile_triangles);
+        tree.build(cells, 0, cells.size(), 0, 0, s.tile_triangles, counts.depth());
     }
     const int deepest = tree.max_depth;
 

@@ -98,6 +98,25 @@ TEST_P(Tiles, LeavesHoldEveryTriangleInsideTheirBoxesWithOrderedErrors) {
     EXPECT_GT(sum.levels[0].triangles, 1000u);
 }
 
+TEST(Tiles, InASmallMemoryBudgetEveryTriangleIsInTheLeavesAndTilesAboveAreNotRefused) {
+    // 4 MiB: the whole bunny would not fit a glTF writer's budget (6.7 MiB), each tile does; the
+    // cell counts (a quarter of the budget) go to coarser cells past about 8 000 cells.
+    TempDir dir;
+    engine::QuietProgress quiet;
+    engine::TilesSettings s = bunny_settings(dir / "t", engine::TileCompression::kMeshopt);
+    s.read.memory_budget_bytes = uint64_t{4} << 20;
+    const engine::TilesResult r = engine::tile_file(s, quiet);
+    ASSERT_GE(r.levels.size(), 2u);
+    std::ifstream f(dir / "t/tileset.json");
+    const Json j = Json::parse(f);
+    Walk w{dir.path() / "t"};
+    w.tile(j["root"], j["geometricError"].get<double>());
+    EXPECT_EQ(w.leaf_triangles, 69451u);
+    EXPECT_EQ(w.outside, 0u);
+    EXPECT_EQ(w.bad_errors, 0);
+    EXPECT_LE(r.levels[0].triangles, 5050u);
+}
+
 INSTANTIATE_TEST_SUITE_P(Compressions, Tiles,
                          ::testing::Values(engine::TileCompression::kMeshopt, engine::TileCompression::kNone,
                                            engine::TileCompression::kDraco));
