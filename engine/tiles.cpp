@@ -16,6 +16,7 @@
 #include <atomic>
 #include <exception>
 #include <mutex>
+#include <set>
 #include <thread>
 #include <array>
 #include <cmath>
@@ -633,6 +634,7 @@ TilesResult tile_file(const TilesSettings& s, ProgressSink& progress) {
     }
 
     // The levels above, each decimated from the one below as one mesh.
+    const std::set<std::string> input_codes = result.warnings.codes();
     std::string below = input, below_format = input_format;
     uint64_t below_count = result.triangles_in;
     for (int depth = deepest - 1; depth >= 0; --depth) {
@@ -654,11 +656,18 @@ TilesResult tile_file(const TilesSettings& s, ProgressSink& progress) {
             ds.output_format = "stream";
             ds.target = target;
             ds.threads = s.threads;
+            // The decimators' buffers within a third of the memory budget together (about 300
+            // bytes a triangle each): a level's order is the cell order, which a smaller
+            // buffer follows as well.
+            ds.buffer = std::clamp<size_t>(size_t(s.read.memory_budget_bytes / 3 / (300 * std::max(1u, s.threads))),
+                                           kMinRangeBuffer, decimate::kDefaultBufferTriangles);
             ds.seed = s.seed;
             ds.read = s.read;
             ds.write.tmpdir = s.read.tmpdir;
             const DecimateResult d = decimate_file(ds, step);
-            result.warnings.merge(d.warnings);
+            // What the leaves' pass said of the input (dropped triangles, the reader's findings)
+            // is not said again by the level read from it.
+            result.warnings.merge(d.warnings, below == input ? &input_codes : nullptr);
             level = ds.output;
             level_format = "stream";
             below_count = d.triangles_out;

@@ -10,6 +10,7 @@
 
 #include <cstdint>
 #include <map>
+#include <set>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -26,15 +27,23 @@ public:
     }
     // A one-off finding: told as it is.
     void note(std::string_view code, const std::string& text) { entries_.emplace(text, Entry{std::string(code), 0}); }
-    // Every warning of `other`, added to these.
-    void merge(const Warnings& other) {
+    // Every warning of `other`, added to these; but those of the codes in `except`, when given.
+    void merge(const Warnings& other, const std::set<std::string>* except = nullptr) {
         for (const auto& [text, entry] : other.entries_)
-            if (entry.count == 0)
+            if (except && except->count(entry.code))
+                continue;
+            else if (entry.count == 0)
                 note(entry.code, text);
             else
                 add(entry.code, text, entry.count);
     }
     bool empty() const { return entries_.empty(); }
+    // The codes of these warnings.
+    std::set<std::string> codes() const {
+        std::set<std::string> out;
+        for (const auto& [text, entry] : entries_) out.insert(entry.code);
+        return out;
+    }
     struct Line {
         std::string code, text;
         uint64_t count = 0;  // 0 for a one-off finding
