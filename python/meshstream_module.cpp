@@ -8,6 +8,7 @@
 // command's, and a bad value raises ValueError in them. The work runs without the GIL; the
 // progress callable and the Ctrl-C check run with it, from the job's ProgressSink, which
 // cancels the job (engine::Cancelled: its output removed) when either raises.
+#include "engine/warnings.hpp"
 #include "io/error.hpp"
 #include "io/format.hpp"
 #include "io/read_indexed.hpp"
@@ -365,6 +366,24 @@ py::dict read_mesh(const std::string& path, const py::kwargs& kwargs) {
     d["format"] = std::string(file.format->name);
     d["non_finite_triangles"] = file.non_finite_triangles;
     d["non_finite_attributes"] = file.non_finite_attributes;
+    // What the reader changed or left out, and the per-face scalars an IndexedMesh does not hold,
+    // in the words and codes of the commands' reports.
+    engine::Warnings warnings;
+    engine::note_input_changes(file.header, path, warnings);
+    std::string face_scalars;
+    for (const io::ScalarChannel& s : call.read.options().channels.of(file.header.channels).face_scalars)
+        face_scalars += (face_scalars.empty() ? "'" : ", '") + s.name + "'";
+    if (!face_scalars.empty())
+        warnings.note("channels_dropped", "per-face scalars " + face_scalars +
+                                              " left out: read() holds per-vertex channels and the material; "
+                                              "chunks() gives them");
+    py::list said;
+    for (const engine::Warnings::Line& l : warnings.all()) {
+        py::dict w;
+        w["code"] = l.code, w["text"] = l.text, w["count"] = l.count;
+        said.append(w);
+    }
+    d["warnings"] = said;
     return d;
 }
 

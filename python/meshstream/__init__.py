@@ -61,6 +61,7 @@ class Mesh:
         self.face_materials = None if face_materials is None else _np.asarray(face_materials, dtype=_np.uint32)
         self.materials = list(materials)
         self.format = None
+        self.warnings = []
 
     def __repr__(self):
         extra = [name for name in ("normals", "colors", "face_materials") if getattr(self, name) is not None]
@@ -72,12 +73,14 @@ class Mesh:
 def read(path, **flags):
     """Reads a whole mesh file (any format meshstream reads) as a Mesh. Flags: from_, memory,
     tmpdir, strict, drop. Triangles with a NaN or infinite coordinate are dropped
-    (mesh.non_finite_triangles counts them; strict=True makes them an Error)."""
+    (mesh.non_finite_triangles counts them; strict=True makes them an Error). mesh.warnings lists
+    what the reader changed or left out (dicts: code, text, count; count 0 for a one-off), as the
+    commands' --json reports do, and the per-face scalars that only chunks() gives."""
     d = _meshstream._read(str(path), **flags)
     mesh = Mesh.__new__(Mesh)
     for key in ("vertices", "faces", "normals", "colors", "color_type", "color_alpha", "uvs", "scalars",
                 "scalar_types", "face_materials", "materials", "format", "non_finite_triangles",
-                "non_finite_attributes"):
+                "non_finite_attributes", "warnings"):
         setattr(mesh, key, d[key])
     if mesh.color_type is None:
         mesh.color_type = "uint8"

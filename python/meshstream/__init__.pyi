@@ -26,6 +26,7 @@ class Mesh:
     face_materials: Optional[npt.NDArray[np.uint32]]  # m
     materials: list[Material]
     format: Optional[str]
+    warnings: list[dict[str, Any]]  # from read(): code, text, count
     def __init__(self, vertices: npt.ArrayLike, faces: npt.ArrayLike, *, normals: Optional[npt.ArrayLike] = ...,
                  colors: Optional[npt.ArrayLike] = ..., color_type: str = ..., color_alpha: bool = ...,
                  uvs: Sequence[npt.ArrayLike] = ..., scalars: Optional[dict[str, npt.ArrayLike]] = ...,

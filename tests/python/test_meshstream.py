@@ -33,6 +33,21 @@ def test_read_cube_with_normals_and_uvs_keeps_the_seams_apart():
     assert np.all(np.abs(mesh.normals).sum(axis=1) == 1)
 
 
+def test_read_says_what_it_left_out(tmp_path):
+    # A face of two vertices (skipped by the reader) and a per-face scalar (not in a Mesh).
+    path = tmp_path / "label.ply"
+    path.write_text("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                    "property float z\nelement face 2\nproperty list uchar int vertex_indices\n"
+                    "property int label\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2 7\n2 0 1 8\n")
+    mesh = meshstream.read(path)
+    assert len(mesh.faces) == 1
+    said = {w["code"]: w for w in mesh.warnings}
+    assert said["reader_warning"]["count"] == 1 and "fewer than 3" in said["reader_warning"]["text"]
+    assert "'label'" in said["channels_dropped"]["text"] and "chunks()" in said["channels_dropped"]["text"]
+    assert meshstream.read(fixture("ply", "cube_uv.ply")).warnings == []
+    assert meshstream.read(path, drop="extra").warnings == [said["reader_warning"]]
+
+
 def test_read_counts_match_info():
     for name in (("ply", "cactus_vcolor.binary_le.ply"), ("obj", "WusonOBJ.obj"), ("cube.bin.stl",)):
         mesh = meshstream.read(fixture(*name))
