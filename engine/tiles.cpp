@@ -487,33 +487,30 @@ void measure_errors(const std::vector<Node*>& parents, const Tree& tree, const s
     std::atomic<bool> stop{false};
     std::exception_ptr failure;
     std::mutex failure_mutex;
-    auto work = [&] {
-        for (size_t i; !stop.load() && (i = next.fetch_add(1)) < parents.size();) {
-            try {
-                parents[i]->error = tile_error(*parents[i], tree, root, s);
-            } catch (...) {
-                const std::lock_guard<std::mutex> lock(failure_mutex);
-                if (!failure) failure = std::current_exception();
-                stop.store(true);
-            }
-            done.fetch_add(1);
-        }
-    };
-    std::vector<std::thread> workers;
-    const size_t extra = std::min<size_t>(parents.size(), std::max(1u, s.threads)) - (parents.empty() ? 0 : 1);
-    for (size_t t = 0; t < extra; ++t) workers.emplace_back(work);
-    // This thread works too, and says how far they are and looks for a cancel between tiles.
-    for (size_t i; !stop.load() && (i = next.fetch_add(1)) < parents.size();) {
+    // Measures the next tile; false when none is left or the work stopped.
+    auto measure_next = [&] {
+        const size_t i = stop.load() ? parents.size() : next.fetch_add(1);
+        if (i >= parents.size()) return false;
         try {
             parents[i]->error = tile_error(*parents[i], tree, root, s);
             done.fetch_add(1);
-            progress.update(done.load());
-            if (progress.cancelled()) stop.store(true);
         } catch (...) {
             const std::lock_guard<std::mutex> lock(failure_mutex);
             if (!failure) failure = std::current_exception();
             stop.store(true);
         }
+        return true;
+    };
+    std::vector<std::thread> workers;
+    const size_t extra = std::min<size_t>(parents.size(), std::max(1u, s.threads)) - (parents.empty() ? 0 : 1);
+    for (size_t t = 0; t < extra; ++t) workers.emplace_back([&] {
+        while (measure_next()) {
+        }
+    });
+    // This thread works too, and says how far they are and looks for a cancel between tiles.
+    while (measure_next()) {
+        progress.update(done.load());
+        if (progress.cancelled()) stop.store(true);
     }
     for (std::thread& w : workers) w.join();
     if (failure) std::rethrow_exception(failure);

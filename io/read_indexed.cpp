@@ -60,25 +60,19 @@ void read_own_indices(const std::string& name, IndexedSource& source, const Chan
             state[c[0]] |= 2, state[c[1]] |= 2, state[c[2]] |= 2;
         }
     }
-    // The used vertices, moved down in file order; the indices renumbered when any moved.
-    std::vector<uint32_t> renumber;
+    // The used vertices, moved down in file order, and the indices renumbered, when some are not.
     uint64_t kept = 0;
-    for (uint64_t v = 0; v < n; ++v) {
-        if (!(state[v] & 2)) {
-            if (renumber.empty()) {
-                renumber.resize(n);
-                for (uint64_t u = 0; u < v; ++u) renumber[u] = static_cast<uint32_t>(u);
-            }
-            continue;
+    for (const uint8_t v : state) kept += (v & 2) != 0;
+    if (kept < n) {
+        std::vector<uint32_t> renumber(n);
+        uint64_t k = 0;
+        for (uint64_t v = 0; v < n; ++v) {
+            if (!(state[v] & 2)) continue;
+            renumber[v] = static_cast<uint32_t>(k);
+            std::memmove(&mesh.positions[3 * k], &mesh.positions[3 * v], 3 * sizeof(float));
+            if (rb) std::memmove(&mesh.attributes[rb * k], &mesh.attributes[rb * v], rb);
+            ++k;
         }
-        if (!renumber.empty()) {
-            renumber[v] = static_cast<uint32_t>(kept);
-            std::memmove(&mesh.positions[3 * kept], &mesh.positions[3 * v], 3 * sizeof(float));
-            if (rb) std::memmove(&mesh.attributes[rb * kept], &mesh.attributes[rb * v], rb);
-        }
-        ++kept;
-    }
-    if (!renumber.empty()) {
         for (uint32_t& i : mesh.indices) i = renumber[i];
         mesh.positions.resize(3 * kept);
         mesh.attributes.resize(rb * kept);
