@@ -14,6 +14,8 @@
 
 #include <algorithm>
 #include <atomic>
+#include <condition_variable>
+#include <deque>
 #include <exception>
 #include <mutex>
 #include <set>
@@ -39,6 +41,9 @@ using Json = nlohmann::json;
 
 constexpr int kMaxDepth = 10;  // cell keys: 3 bits a depth, 30 bits
 constexpr uint64_t kMinTileTriangles = 256;
+// Depths a tileset file holds: at most 1 + 8 + 64 tiles and 512 references to files below
+// (about 200 kB of JSON).
+constexpr int kDepthsPerFile = 3;
 
 // The bounding cube and the cell key of a point: the Morton code of its depth-10 cell.
 struct Cube {
@@ -281,24 +286,105 @@ std::array<double, 16> enu_to_ecef(const GeoOrigin& o) {
             x, y, z, 1};
 }
 
-// One level's tiles written from a mesh file: its triangles sorted by cell key, each run of a
-// tile's cell written as that tile's GLB.
+// A tile's triangles, turned y-up, on their way to its GLB.
+struct TileJob {
+    int node = -1;
+    std::vector<io::TriangleChunk> chunks;
+};
+
+// Runs `write` on the jobs given, on `threads` threads (each job on one; with one thread, on
+// the caller's at once). At most 2 × threads jobs wait, so memory holds about 3 × threads tiles.
+class TilePool {
+public:
+    TilePool(unsigned threads, std::function<void(TileJob&)> write) : write_(std::move(write)) {
+        if (threads <= 1) return;
+        for (unsigned t = 0; t < threads; ++t) workers_.emplace_back([this] { work(); });
+        capacity_ = 2 * size_t(threads);
+    }
+    ~TilePool() { stop(); }
+    TilePool(const TilePool&) = delete;
+    TilePool& operator=(const TilePool&) = delete;
+
+    // Writes `job`, or queues it once there is room; rethrows a failed job's error.
+    void submit(TileJob job) {
+        if (workers_.empty()) {
+            write_(job);
+            return;
+        }
+        std::unique_lock<std::mutex> lock(mutex_);
+        room_.wait(lock, [&] { return queue_.size() < capacity_ || failure_; });
+        if (failure_) std::rethrow_exception(failure_);
+        queue_.push_back(std::move(job));
+        ready_.notify_one();
+    }
+    // Waits for every job; rethrows a failed job's error.
+    void finish() {
+        stop();
+        if (failure_) std::rethrow_exception(failure_);
+    }
+
+private:
+    void work() {
+        for (;;) {
+            TileJob job;
+            {
+                std::unique_lock<std::mutex> lock(mutex_);
+                ready_.wait(lock, [&] { return !queue_.empty() || done_; });
+                if (queue_.empty() || failure_) return;
+                job = std::move(queue_.front());
+                queue_.pop_front();
+                room_.notify_one();
+            }
+            try {
+                write_(job);
+            } catch (...) {
+                const std::lock_guard<std::mutex> lock(mutex_);
+                if (!failure_) failure_ = std::current_exception();
+                room_.notify_all();
+                return;
+            }
+        }
+    }
+    // Lets the workers empty the queue (none left after a failure) and joins them.
+    void stop() {
+        {
+            const std::lock_guard<std::mutex> lock(mutex_);
+            done_ = true;
+        }
+        ready_.notify_all();
+        for (std::thread& w : workers_) w.join();
+        workers_.clear();
+    }
+
+    std::function<void(TileJob&)> write_;
+    std::vector<std::thread> workers_;
+    size_t capacity_ = 0;
+    std::deque<TileJob> queue_;
+    std::mutex mutex_;
+    std::condition_variable ready_, room_;
+    bool done_ = false;
+    std::exception_ptr failure_;
+};
+
+// One level's tiles from a mesh file: its triangles sorted by cell key (sort()), then each run
+// of a tile's cell written as that tile's GLB (write()), on s.threads threads.
 class TileWriter {
 public:
     // Builds in `root`; notes name the tiles under `shown_root`, where they will be.
     TileWriter(const TilesSettings& s, Tree& tree, const Cube& cube, const std::string& root, std::string shown_root)
         : s_(s), tree_(tree), cube_(cube), root_(root), shown_root_(std::move(shown_root)) {}
 
-    // Writes the tiles of `mesh` whose cell `select` picks (a node id, or -1 to skip the
-    // triangle); counts in `region[d]` the triangles whose node at depth d is not a leaf.
-    void write_level(const std::string& mesh, std::string_view format, const std::function<int(uint32_t)>& select,
-                     std::vector<uint64_t>* region, ProgressSink& progress, Warnings* warnings, TilesResult* result) {
-        io::TriangleInput in(io::open_input(mesh, format, s_.read), io::BadTriangles::kDrop);
-        const io::MeshHeader& header = in.header();
+    // Reads `mesh` into the sorter by cell key, counting the keys in `counts` when given.
+    // Notes what the reader dropped or changed in `warnings` and the input's name and count in
+    // `result`, when given.
+    void sort(const std::string& mesh, std::string_view format, CellCounts* counts, ProgressSink& progress,
+              Warnings* warnings, TilesResult* result) {
+        in_.emplace(io::open_input(mesh, format, s_.read), io::BadTriangles::kDrop);
+        const io::MeshHeader& header = in_->header();
         const io::Format& glb = io::output_format("x.glb", "glb");
-        io::WriteOptions wo;
-        wo.tmpdir = s_.read.tmpdir;
-        wo.memory_budget_bytes = s_.read.memory_budget_bytes;
+        wo_ = io::WriteOptions{};
+        wo_.tmpdir = s_.read.tmpdir;
+        wo_.memory_budget_bytes = s_.read.memory_budget_bytes;
         io::GltfSettings gs;
         gs.compression = gltf_compression(s_.compression);
         if (gs.compression == io::GltfSettings::Compression::kMeshopt) {
@@ -310,70 +396,74 @@ public:
             grid.extent = float(cube_.extent);
             gs.grid = grid;
         }
-        wo.format_options.set(gs);
+        wo_.format_options.set(gs);
         const io::Channels wanted = s_.read.channels.of(header.channels);
-        wo.channels = io::writable_channels(glb, wanted, wo);
-        wo.channels.vertex_id = false;
-        if (wo.channels.material) wo.materials = header.materials;
+        wo_.channels = io::writable_channels(glb, wanted, wo_);
+        wo_.channels.vertex_id = false;
         if (warnings != nullptr) {
-            if (const std::string dropped = io::describe_missing(wanted, wo.channels); !dropped.empty())
-                warnings->note("channels_dropped", dropped_channels_text(dropped, glb, wo.channels));
+            if (const std::string dropped = io::describe_missing(wanted, wo_.channels); !dropped.empty())
+                warnings->note("channels_dropped", dropped_channels_text(dropped, glb, wo_.channels));
         }
 
         sort::SorterOptions so;
         so.memory_budget_bytes = s_.read.memory_budget_bytes / 2;
         so.tmpdir = s_.read.tmpdir;
-        so.channels = wo.channels;
+        so.channels = wo_.channels;
         so.key = [this](const float* xyz) { return cube_.triangle_key(xyz); };
-        sort::ExternalSorter sorter(so);
-        io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, wo.channels);
+        sorter_.emplace(so);
+        io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, wo_.channels);
         progress.phase("sorting by cell", header.triangle_count);
-        while (in.next(chunk)) {
-            sorter.add(chunk);
-            progress.update(in.count().read, in.source().stored_offset(), in.source().stored_size());
+        while (in_->next(chunk)) {
+            sorter_->add(chunk);
+            if (counts != nullptr)
+                for (size_t i = 0; i < chunk.size(); ++i) counts->add(cube_.triangle_key(&chunk.xyz()[9 * i]));
+            progress.update(in_->count().read, in_->source().stored_offset(), in_->source().stored_size());
             throw_if_cancelled(progress);
         }
-        sorter.finish_input();
+        sorter_->finish_input();
+        // The material table is whole once the input is read.
+        if (wo_.channels.material) wo_.materials = in_->header().materials;
         if (warnings != nullptr) {
-            note_dropped_triangles(dropped_triangles(in), "left out", *warnings);
-            note_input_changes(in.header(), in.name(), *warnings);
+            note_dropped_triangles(dropped_triangles(*in_), "left out", *warnings);
+            note_input_changes(in_->header(), in_->name(), *warnings);
         }
         if (result != nullptr) {
-            result->input_name = in.name();
-            result->input_format = std::string(in.format().name);
-            result->triangles_in = in.count().read;
+            result->input_name = in_->name();
+            result->input_format = std::string(in_->format().name);
+            result->triangles_in = in_->count().read;
         }
+    }
 
-        progress.phase("writing tiles", sorter.triangle_count());
-        io::TriangleChunk out(io::TriangleChunk::kDefaultCapacity, wo.channels);
-        int current = -1;
-        std::optional<io::Output> tile;
+    // Writes the tiles of the sorted triangles whose cell `select` picks (a node id, or -1 to
+    // skip the triangle); counts in `region[d]` the triangles whose node at depth d is not a
+    // leaf. With `copy`, writes every sorted triangle there too, as a triangle stream.
+    void write(const std::function<int(uint32_t)>& select, std::vector<uint64_t>* region, ProgressSink& progress,
+               const std::string& copy = {}) {
+        std::optional<io::Output> copied;
+        if (!copy.empty()) {
+            io::WriteOptions co;
+            co.tmpdir = s_.read.tmpdir;
+            co.memory_budget_bytes = s_.read.memory_budget_bytes;
+            co.channels = wo_.channels;
+            co.materials = wo_.materials;
+            co.triangle_count = sorter_->triangle_count();  // in its header: read without a count
+            copied.emplace(io::open_output(copy, "stream", co));
+        }
+        std::vector<std::vector<std::string>> notes(tree_.nodes.size());
+        std::vector<int> written;  // the tiles in the order written
+        TilePool pool(s_.threads, [&](TileJob& job) { write_tile(job, notes[size_t(job.node)]); });
+
+        progress.phase("writing tiles", sorter_->triangle_count());
+        io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, wo_.channels);
+        TileJob job;
         uint64_t done = 0;
-        auto flush = [&] {
-            if (!out.empty()) tile->write(out), out.clear();
-        };
         auto close = [&] {
-            if (current < 0) return;
-            flush();
-            if (wo.channels.material) tile->writer->update_materials(in.header().materials);
-            tile->finish();
-            Node& n = tree_.nodes[size_t(current)];
-            // What the writer could not keep (Draco's degenerate triangles, images of other
-            // types) is said, the first tiles' notes whole.
-            if (const std::vector<std::string> notes = tile->writer->raw_notes(); !notes.empty()) {
-                ++tiles_with_notes_;
-                if (tiles_with_notes_ <= kNotedTiles)
-                    for (std::string note : notes) {
-                        for (size_t at; (at = note.find(root_)) != std::string::npos;)
-                            note.replace(at, root_.size(), shown_root_);
-                        notes_.note("output_note", note);
-                    }
-            }
-            n.bytes = fs::file_size(fs::path(root_) / n.uri);
-            tile.reset();
-            current = -1;
+            if (job.node < 0) return;
+            pool.submit(std::move(job));
+            job = TileJob{};
         };
-        while (sorter.next(chunk)) {
+        while (sorter_->next(chunk)) {
+            if (copied) copied->write(chunk);
             for (size_t i = 0; i < chunk.size(); ++i) {
                 const float* xyz = &chunk.xyz()[9 * i];
                 const uint32_t key = cube_.triangle_key(xyz);
@@ -385,19 +475,21 @@ public:
                     }
                 const int target = select(key);
                 if (target < 0) continue;
-                if (target != current) {
+                if (target != job.node) {
                     close();
-                    current = target;
-                    Node& n = tree_.nodes[size_t(current)];
-                    n.uri = "tiles/" + std::to_string(n.depth) + "/" + std::to_string(n.prefix >> (3 * (kMaxDepth - n.depth))) + ".glb";
+                    job.node = target;
+                    written.push_back(target);
+                    Node& n = tree_.nodes[size_t(target)];
+                    n.uri = "tiles/" + std::to_string(n.depth) + "/" +
+                            std::to_string(n.prefix >> (3 * (kMaxDepth - n.depth))) + ".glb";
                     fs::create_directories(fs::path(root_) / "tiles" / std::to_string(n.depth));
-                    // A leaf holds its input triangles; a tile above, a decimation of them (not known yet).
-                    wo.expected_triangle_count = n.leaf && n.count ? n.count : std::optional<uint64_t>();
-                    tile.emplace(io::open_output((fs::path(root_) / n.uri).string(), "glb", wo));
                 }
-                Node& n = tree_.nodes[size_t(current)];
+                Node& n = tree_.nodes[size_t(target)];
                 for (int c = 0; c < 3; ++c) n.box.add(xyz + 3 * c);
                 ++n.triangles;
+                if (job.chunks.empty() || job.chunks.back().full())
+                    job.chunks.emplace_back(io::TriangleChunk::kDefaultCapacity, wo_.channels);
+                io::TriangleChunk& out = job.chunks.back();
                 // y-up for glTF: (x, y, z) → (x, z, -y).
                 out.push_copy(chunk, i);
                 float* p = &out.xyz()[9 * (out.size() - 1)];
@@ -412,13 +504,26 @@ public:
                         nrm[3 * c + 1] = nrm[3 * c + 2];
                         nrm[3 * c + 2] = -y;
                     }
-                if (out.full()) flush();
             }
             done += chunk.size();
             progress.update(done);
             throw_if_cancelled(progress);
         }
         close();
+        pool.finish();
+        if (copied) copied->finish();
+        // What the writer could not keep (Draco's degenerate triangles, images of other types)
+        // is said, the first tiles' notes whole, in the order the tiles were written.
+        for (int id : written) {
+            if (notes[size_t(id)].empty()) continue;
+            if (++tiles_with_notes_ > kNotedTiles) continue;
+            for (std::string note : notes[size_t(id)]) {
+                for (size_t at; (at = note.find(root_)) != std::string::npos;) note.replace(at, root_.size(), shown_root_);
+                notes_.note("output_note", note);
+            }
+        }
+        sorter_.reset();
+        in_.reset();
     }
 
     // The writers' notes, into `warnings`.
@@ -430,6 +535,21 @@ public:
     }
 
 private:
+    // A tile's GLB: its triangles and, for the notes, what its writer said.
+    void write_tile(TileJob& job, std::vector<std::string>& notes) const {
+        Node& n = tree_.nodes[size_t(job.node)];
+        io::WriteOptions wo = wo_;
+        // A leaf holds its input triangles; a tile above, a decimation of them (not known before).
+        wo.expected_triangle_count = n.leaf && n.count ? n.count : std::optional<uint64_t>();
+        io::Output tile = io::open_output((fs::path(root_) / n.uri).string(), "glb", wo);
+        for (const io::TriangleChunk& c : job.chunks) tile.write(c);
+        job.chunks.clear();
+        if (wo.channels.material) tile.writer->update_materials(wo.materials);
+        tile.finish();
+        notes = tile.writer->raw_notes();
+        n.bytes = fs::file_size(fs::path(root_) / n.uri);
+    }
+
     static constexpr uint64_t kNotedTiles = 5;
     Warnings notes_;
     uint64_t tiles_with_notes_ = 0;
@@ -438,6 +558,9 @@ private:
     const Cube& cube_;
     std::string root_;
     std::string shown_root_;
+    std::optional<io::TriangleInput> in_;
+    std::optional<sort::ExternalSorter> sorter_;
+    io::WriteOptions wo_;
 };
 
 // A tile's triangles as read back from its GLB (positions as stored: y-up).
@@ -580,11 +703,10 @@ TilesResult tile_file(const TilesSettings& s, ProgressSink& progress) {
         input_format = "stream";
     }
 
-    // The bounding cube, and the cells' counts.
+    // The bounding cube.
     Cube cube;
-    Tree tree;
     {
-        StepProgress step(progress, "counting");
+        StepProgress step(progress, "bounds");
         const io::Bounds b = input_bounds(input, input_format, s.read, step);
         double extent = 0;
         for (int a = 0; a < 3; ++a) {
@@ -594,34 +716,31 @@ TilesResult tile_file(const TilesSettings& s, ProgressSink& progress) {
         if (!(extent >= 0) || !std::isfinite(extent))
             throw io::Error(s.input, "no triangle with finite coordinates: nothing to tile");
         cube.extent = extent > 0 ? extent * (1 + 1e-6) : 1;
+    }
+
+    // The leaves: the input sorted by cell while its cells are counted, the octree built from
+    // the counts, then each leaf's triangles written at full resolution, and all of them, in
+    // cell order, as the first level's input.
+    Tree tree;
+    TileWriter writer(s, tree, cube, building.path(), outdir.string());
+    const std::string sorted_input = (fs::path(work.path()) / "input.sorted.mstream").string();
+    std::vector<uint64_t> region;
+    {
+        StepProgress step(progress, "leaves");
         CellCounts counts(s.read.memory_budget_bytes / 4);
-        io::TriangleInput in(io::open_input(input, input_format, s.read), io::BadTriangles::kDrop);
-        io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, {});
-        step.phase("cells", in.header().triangle_count);
-        while (in.next(chunk)) {
-            for (size_t i = 0; i < chunk.size(); ++i) counts.add(cube.triangle_key(&chunk.xyz()[9 * i]));
-            step.update(in.count().read, in.source().stored_offset(), in.source().stored_size());
-            throw_if_cancelled(progress);
-        }
+        writer.sort(input, input_format, &counts, step, &result.warnings, &result);
         if (counts.empty()) throw io::Error(s.input, "no triangle to tile");
         const std::vector<std::pair<uint32_t, uint64_t>> cells = counts.sorted();
         tree.build(cells, 0, cells.size(), 0, 0, s.tile_triangles, counts.depth());
-    }
-    const int deepest = tree.max_depth;
-
-    // The leaves: the input at full resolution.
-    TileWriter writer(s, tree, cube, building.path(), outdir.string());
-    std::vector<uint64_t> region(size_t(std::max(deepest, 1)), 0);
-    {
-        StepProgress step(progress, "leaves");
-        writer.write_level(
-            input, input_format,
+        region.assign(size_t(std::max(tree.max_depth, 1)), 0);
+        writer.write(
             [&](uint32_t key) {
                 const int n = tree.at(key, kMaxDepth);
                 return n >= 0 && tree.nodes[size_t(n)].leaf ? n : -1;
             },
-            &region, step, &result.warnings, &result);
+            &region, step, tree.max_depth > 0 ? sorted_input : std::string());
     }
+    const int deepest = tree.max_depth;
 
     // A spooled input is named as it came, with what its reader found.
     if (spooled) {
@@ -630,10 +749,11 @@ TilesResult tile_file(const TilesSettings& s, ProgressSink& progress) {
         result.warnings.merge(spooled->warnings);
     }
 
-    // The levels above, each decimated from the one below as one mesh.
+    // The levels above, each decimated from the one below as one mesh (the first from the
+    // sorted copy of the input).
     const std::set<std::string> input_codes = result.warnings.codes();
-    std::string below = input, below_format = input_format;
-    uint64_t below_count = result.triangles_in;
+    std::string below = sorted_input, below_format = "stream";
+    uint64_t below_count = tree.nodes[0].count;
     for (int depth = deepest - 1; depth >= 0; --depth) {
         uint64_t cells_here = 0;
         for (const Node& n : tree.nodes) cells_here += n.depth == depth && !n.leaf;
@@ -662,24 +782,24 @@ TilesResult tile_file(const TilesSettings& s, ProgressSink& progress) {
             ds.read = s.read;
             ds.write.tmpdir = s.read.tmpdir;
             const DecimateResult d = decimate_file(ds, step);
-            // What the leaves' pass said of the input (dropped triangles, the reader's findings)
-            // is not said again by the level read from it.
-            result.warnings.merge(d.warnings, below == input ? &input_codes : nullptr);
+            // What the leaves' pass said of the input (dropped triangles) is not said again by
+            // the level read from its copy.
+            result.warnings.merge(d.warnings, below == sorted_input ? &input_codes : nullptr);
             level = ds.output;
             level_format = "stream";
             below_count = d.triangles_out;
         }
         std::fill(region.begin(), region.end(), 0);
         StepProgress step(progress, "level " + std::to_string(depth) + " tiles");
-        writer.write_level(
-            level, level_format,
+        writer.sort(level, level_format, nullptr, step, nullptr, nullptr);
+        writer.write(
             [&](uint32_t key) {
                 const int n = tree.at(key, depth);
                 return n >= 0 && !tree.nodes[size_t(n)].leaf && tree.nodes[size_t(n)].depth == depth ? n : -1;
             },
-            &region, step, nullptr, nullptr);
-        // The level below is no longer needed (the input stays).
-        if (below != input && below != level) fs::remove(below, ec);
+            &region, step);
+        // The level below is no longer needed.
+        if (below != level) fs::remove(below, ec);
         below = level, below_format = level_format;
 
         // The errors of this depth's tiles: to their children's content, plus the children's own.
@@ -707,19 +827,56 @@ TilesResult tile_file(const TilesSettings& s, ProgressSink& progress) {
         return s.compression == TileCompression::kDraco ? extent / 16383.0 : cube.extent * 1e-7;
     };
 
-    std::function<Json(int)> tile_json = [&](int id) {
+    // A tileset file: the tile `root` under the asset, with `error` as the tileset's.
+    uint64_t json_bytes = 0;
+    auto write_tileset = [&](const fs::path& relative, const Json& root, double error) {
+        const Json tileset = {{"asset", {{"version", "1.1"}, {"generator", std::string("meshstream tiles")}}},
+                              {"geometricError", error},
+                              {"root", root}};
+        const fs::path path = fs::path(building.path()) / relative;
+        fs::create_directories(path.parent_path());
+        std::ofstream f(path);
+        f << tileset.dump(1) << '\n';
+        f.close();
+        if (!f) throw io::Error(path.string(), "cannot write: " + std::string(std::strerror(errno)));
+        json_bytes += fs::file_size(path);
+        ++result.json_files;
+    };
+    // The tile `id` and its subtree as JSON in the file of directory `dir` (relative to the
+    // tileset's root; URIs are relative to it). A subtree whose root's depth is a multiple of
+    // kDepthsPerFile goes to a tileset file of its own (tiles/<depth>/<cell>.json, an external
+    // tileset), which its parent's file references from a tile of the same volume and the
+    // parent's error (so a viewer that refines the parent refines into it): no file holds
+    // more than the tiles of kDepthsPerFile depths and the references below them.
+    std::function<Json(int, const fs::path&)> tile_json = [&](int id, const fs::path& dir) {
         const Node& n = tree.nodes[size_t(id)];
         Json t;
         t["boundingVolume"] = box_json(n.box, pad(n.box));
         t["geometricError"] = n.error;
-        if (!n.uri.empty()) t["content"] = {{"uri", n.uri}};
+        if (!n.uri.empty()) t["content"] = {{"uri", fs::path(n.uri).lexically_relative(dir).generic_string()}};
         Json children = Json::array();
-        for (int c : n.child)
-            if (c >= 0 && !tree.nodes[size_t(c)].box.empty()) children.push_back(tile_json(c));
+        for (int c : n.child) {
+            if (c < 0 || tree.nodes[size_t(c)].box.empty()) continue;
+            const Node& child = tree.nodes[size_t(c)];
+            if (child.leaf || child.depth % kDepthsPerFile != 0) {
+                children.push_back(tile_json(c, dir));
+                continue;
+            }
+            const fs::path file = fs::path("tiles") / std::to_string(child.depth) /
+                                  (std::to_string(child.prefix >> (3 * (kMaxDepth - child.depth))) + ".json");
+            Json sub = tile_json(c, file.parent_path());
+            sub["refine"] = "REPLACE";
+            write_tileset(file, sub, child.error);
+            Json reference;
+            reference["boundingVolume"] = box_json(child.box, pad(child.box));
+            reference["geometricError"] = n.error;
+            reference["content"] = {{"uri", file.lexically_relative(dir).generic_string()}};
+            children.push_back(reference);
+        }
         if (!children.empty()) t["children"] = children;
         return t;
     };
-    Json root = tile_json(0);
+    Json root = tile_json(0, fs::path("."));
     root["refine"] = "REPLACE";
     if (s.origin) {
         const std::array<double, 16> m = enu_to_ecef(*s.origin);
@@ -727,16 +884,7 @@ TilesResult tile_file(const TilesSettings& s, ProgressSink& progress) {
     }
     const Node& top = tree.nodes[0];
     result.geometric_error = std::max(top.box.diagonal(), top.error);
-    Json tileset = {{"asset", {{"version", "1.1"}, {"generator", std::string("meshstream tiles")}}},
-                    {"geometricError", result.geometric_error},
-                    {"root", root}};
-    {
-        const std::string path = (fs::path(building.path()) / "tileset.json").string();
-        std::ofstream f(path);
-        f << tileset.dump(1) << '\n';
-        f.close();
-        if (!f) throw io::Error(path, "cannot write: " + std::string(std::strerror(errno)));
-    }
+    write_tileset("tileset.json", root, result.geometric_error);
 
     // The figures per depth.
     result.levels.assign(size_t(deepest + 1), TileLevel{});
@@ -756,7 +904,7 @@ TilesResult tile_file(const TilesSettings& s, ProgressSink& progress) {
     }
     for (TileLevel& l : result.levels)
         if (l.tiles == 0) l.min_error = 0;
-    result.bytes += fs::file_size(fs::path(building.path()) / "tileset.json");
+    result.bytes += json_bytes;
 
     // Into place: an existing outdir (allowed by `overwrite`) goes only once the new one is whole.
     throw_if_cancelled(progress);

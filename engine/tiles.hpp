@@ -2,27 +2,31 @@
 // fetches as the camera needs them, built out of core from the engine's parts.
 //
 // The tree is an octree over the input's bounding cube: a cell splits while more than
-// `tile_triangles` triangles have their centroid in it (counted in one pass, at most 10
-// levels). Leaves hold the input's triangles at full resolution; the cells above them hold level
-// meshes: level L is a streaming decimation of level L + 1 as one mesh (engine::decimate_file,
-// on every core) to about `tile_triangles` per cell of depth L, so the tiles of one depth are
-// pieces of one mesh and share their borders vertex for vertex. Triangles go to their tiles by
-// an external sort on the cell key (sort::ExternalSorter), so no step holds more than a tile.
-// A tile's geometricError is measured: the Hausdorff distance (compare::compare_meshes) between
-// its content and its children's, plus the largest of theirs, 0 at the leaves; so it bounds the
-// distance to full resolution and never grows from parent to child.
+// `tile_triangles` triangles have their centroid in it (counted while the input is read into an
+// external sort by cell key, at most 10 levels). Leaves hold the input's triangles at full
+// resolution, cut from the sorted stream; the cells above them hold level meshes: level L is a
+// streaming decimation of level L + 1 as one mesh (engine::decimate_file, on every core; the
+// first from the sorted copy of the input) to about `tile_triangles` per cell of depth L, so the
+// tiles of one depth are pieces of one mesh and share their borders vertex for vertex. Triangles
+// go to their tiles by an external sort on the cell key (sort::ExternalSorter), so no step holds
+// more than a few tiles per thread. A tile's geometricError is measured: the Hausdorff distance
+// (compare::compare_meshes) between its content and its children's, plus the largest of theirs,
+// 0 at the leaves; so it bounds the distance to full resolution and never grows from parent to
+// child.
 //
-// Content: one GLB a tile (tiles/<depth>/<cell>.glb), positions turned y-up as glTF wants them
-// ((x, y, z) as (x, z, -y); 3D Tiles turns them back), with every channel the glTF writer keeps
-// and materials with their images embedded in each tile that uses them. With meshopt
-// compression all tiles share one quantization grid (16 bits over the bounding cube).
+// Content: one GLB a tile (tiles/<depth>/<cell>.glb), written on `threads` threads, positions
+// turned y-up as glTF wants them ((x, y, z) as (x, z, -y); 3D Tiles turns them back), with every
+// channel the glTF writer keeps and materials with their images embedded in each tile that uses
+// them. With meshopt compression all tiles share one quantization grid (16 bits over the
+// bounding cube). Every three depths a subtree goes to a tileset file of its own
+// (tiles/<depth>/<cell>.json, an external tileset), so no JSON file grows with the input.
 //
 // Memory: the decimations' (engine/decimate.hpp) within the reader's memory budget, the sorts'
-// half of it, one tile in the glTF writer and in the error measure (a cell and its children),
-// and the octree's cell counts (12 bytes a non-empty cell of depth 10). Disk: the level meshes
-// (about a third of the input's triangles in meshstream's triangle stream) and the sorts' runs
-// in the temporary directory, and the tileset itself, built beside OUTDIR and renamed into place
-// when complete; nothing is left of either on an error or a cancel.
+// half of it, up to three tiles per thread in the glTF writers, one tile and its children in
+// the error measure, and the octree's cell counts (a quarter of the budget). Disk: a sorted copy
+// of the input and the level meshes in meshstream's triangle stream and the sorts' runs in the
+// temporary directory, and the tileset itself, built beside OUTDIR and renamed into place when
+// complete; nothing is left of either on an error or a cancel.
 #pragma once
 
 #include "engine/progress.hpp"
@@ -75,7 +79,8 @@ struct TilesResult {
     std::string input_format;
     uint64_t triangles_in = 0;
     std::vector<TileLevel> levels;
-    uint64_t tiles = 0, bytes = 0;  // all content, and the tileset's JSON with it
+    uint64_t tiles = 0, bytes = 0;  // all content, and the tileset's JSON files with it
+    uint64_t json_files = 0;        // tileset.json and the external tilesets it references
     uint64_t leaf_bytes = 0;
     double geometric_error = 0;  // the tileset's
     Warnings warnings;

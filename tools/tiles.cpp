@@ -124,7 +124,7 @@ nlohmann::ordered_json tiles_job(const TilesOptions& opt, engine::ProgressSink* 
                           {"bytes", l.bytes}, {"min_error", l.min_error}, {"max_error", l.max_error}});
     report.details = {{"tile_triangles", opt.tile_triangles}, {"compress", opt.compress},
                       {"tiles", result.tiles}, {"bytes", result.bytes}, {"leaf_bytes", result.leaf_bytes},
-                      {"geometric_error", result.geometric_error}, {"levels", levels}};
+                      {"json_files", result.json_files}, {"geometric_error", result.geometric_error}, {"levels", levels}};
     return run_report_json(report, result.warnings);
 }
 

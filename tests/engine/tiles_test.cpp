@@ -13,6 +13,8 @@
 #include <atomic>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <map>
 #include <string>
 
 namespace meshstream {
@@ -33,23 +35,40 @@ engine::TilesSettings bunny_settings(const std::string& outdir, engine::TileComp
     return s;
 }
 
-// Walks the tiles: content inside the box (positions turned back to z-up), errors ordered.
+// Walks the tiles, into external tilesets: content inside the box (positions turned back to
+// z-up), errors ordered, the tiles each JSON file holds.
 struct Walk {
     fs::path dir;
     uint64_t leaf_triangles = 0, tiles = 0, outside = 0;
     int bad_errors = 0;
     double pad = 0;  // beyond the box: none, the boxes are padded by the writer
+    std::map<std::string, uint64_t> tiles_in_file;  // JSON files (relative to `dir`) and their tiles
 
-    void tile(const Json& t, double parent_error) {
+    void file(const fs::path& relative, double parent_error) {
+        std::ifstream f(dir / relative);
+        ASSERT_TRUE(f) << relative;
+        const Json j = Json::parse(f);
+        EXPECT_EQ(j["asset"]["version"], "1.1") << relative;
+        EXPECT_EQ(j["root"]["refine"], "REPLACE") << relative;
+        if (j["geometricError"].get<double>() > parent_error) ++bad_errors;
+        tile(j["root"], j["geometricError"].get<double>(), relative);
+    }
+    void tile(const Json& t, double parent_error, const fs::path& in_file) {
+        ++tiles_in_file[in_file.generic_string()];
         const double e = t["geometricError"].get<double>();
         if (e > parent_error) ++bad_errors;
         const bool leaf = !t.contains("children");
-        if (leaf && e != 0) ++bad_errors;
         const std::vector<double> box = t["boundingVolume"]["box"].get<std::vector<double>>();
         if (t.contains("content")) {
+            const fs::path uri = (in_file.parent_path() / t["content"]["uri"].get<std::string>()).lexically_normal();
+            if (uri.extension() == ".json") {
+                EXPECT_TRUE(leaf) << "a reference to " << uri << " has children";
+                file(uri, e);
+                return;
+            }
+            if (leaf && e != 0) ++bad_errors;
             ++tiles;
-            io::TriangleInput in(io::open_input((dir / t["content"]["uri"].get<std::string>()).string()),
-                                 io::BadTriangles::kKeep);
+            io::TriangleInput in(io::open_input((dir / uri).string()), io::BadTriangles::kKeep);
             io::TriangleChunk chunk;
             while (in.next(chunk)) {
                 for (size_t i = 0; i < 3 * chunk.size(); ++i) {
@@ -62,7 +81,7 @@ struct Walk {
             }
         }
         if (!leaf)
-            for (const Json& c : t["children"]) tile(c, e);
+            for (const Json& c : t["children"]) tile(c, e, in_file);
     }
 };
 
@@ -80,8 +99,9 @@ TEST_P(Tiles, LeavesHoldEveryTriangleInsideTheirBoxesWithOrderedErrors) {
     const Json j = Json::parse(f);
     EXPECT_EQ(j["asset"]["version"], "1.1");
     EXPECT_EQ(j["root"]["refine"], "REPLACE");
-    Walk w{dir.path() / "t"};
-    w.tile(j["root"], j["geometricError"].get<double>());
+    Walk w;
+    w.dir = dir.path() / "t";
+    w.file("tileset.json", j["geometricError"].get<double>());
     EXPECT_EQ(w.leaf_triangles, 69451u);
     EXPECT_EQ(w.tiles, r.tiles);
     EXPECT_EQ(w.outside, 0u);
@@ -109,8 +129,9 @@ TEST(Tiles, InASmallMemoryBudgetEveryTriangleIsInTheLeavesAndTilesAboveAreNotRef
     ASSERT_GE(r.levels.size(), 2u);
     std::ifstream f(dir / "t/tileset.json");
     const Json j = Json::parse(f);
-    Walk w{dir.path() / "t"};
-    w.tile(j["root"], j["geometricError"].get<double>());
+    Walk w;
+    w.dir = dir.path() / "t";
+    w.file("tileset.json", j["geometricError"].get<double>());
     EXPECT_EQ(w.leaf_triangles, 69451u);
     EXPECT_EQ(w.outside, 0u);
     EXPECT_EQ(w.bad_errors, 0);
@@ -120,6 +141,79 @@ TEST(Tiles, InASmallMemoryBudgetEveryTriangleIsInTheLeavesAndTilesAboveAreNotRef
 INSTANTIATE_TEST_SUITE_P(Compressions, Tiles,
                          ::testing::Values(engine::TileCompression::kMeshopt, engine::TileCompression::kNone,
                                            engine::TileCompression::kDraco));
+
+TEST(Tiles, DeepTreesGoToExternalTilesetsOfThreeDepthsEach) {
+    // 300 triangles a tile: five depths, so the subtrees from depth 3 are tileset files of their own.
+    TempDir dir;
+    engine::QuietProgress quiet;
+    engine::TilesSettings s = bunny_settings(dir / "t", engine::TileCompression::kMeshopt);
+    s.tile_triangles = 300;
+    const engine::TilesResult r = engine::tile_file(s, quiet);
+    ASSERT_GE(r.levels.size(), 5u);
+    Walk w;
+    w.dir = dir.path() / "t";
+    w.file("tileset.json", HUGE_VAL);
+    EXPECT_EQ(w.leaf_triangles, 69451u);
+    EXPECT_EQ(w.tiles, r.tiles);
+    EXPECT_EQ(w.outside, 0u);
+    EXPECT_EQ(w.bad_errors, 0);
+    EXPECT_EQ(w.tiles_in_file.size(), r.json_files);
+    EXPECT_GT(r.json_files, 8u);
+    for (const auto& [file, tiles] : w.tiles_in_file) {
+        EXPECT_LE(tiles, 1u + 8 + 64 + 512) << file;
+        if (file != "tileset.json") {
+            EXPECT_TRUE(file.starts_with("tiles/3/")) << file;
+        }
+    }
+    // tileset.json holds depths 0 to 2 and the references to depth 3.
+    EXPECT_LE(w.tiles_in_file["tileset.json"], r.levels[0].tiles + r.levels[1].tiles + r.levels[2].tiles +
+                                                    r.levels[3].tiles);
+    const engine::TilesetSummary sum = engine::summarize_tileset(dir / "t/tileset.json");
+    EXPECT_EQ(sum.tiles, r.tiles);
+    EXPECT_EQ(sum.json_files, r.json_files);
+    EXPECT_EQ(sum.bytes, r.bytes);
+    ASSERT_EQ(sum.levels.size(), r.levels.size());
+    for (size_t d = 0; d < r.levels.size(); ++d) {
+        EXPECT_EQ(sum.levels[d].tiles, r.levels[d].tiles) << d;
+        EXPECT_EQ(sum.levels[d].triangles, r.levels[d].triangles) << d;
+    }
+}
+
+// Every file of a directory tree, by relative path, with its bytes.
+std::map<std::string, std::string> files_under(const fs::path& root) {
+    std::map<std::string, std::string> files;
+    for (const fs::directory_entry& e : fs::recursive_directory_iterator(root))
+        if (e.is_regular_file()) {
+            std::ifstream f(e.path(), std::ios::binary);
+            files[fs::relative(e.path(), root).string()] = std::string(std::istreambuf_iterator<char>(f), {});
+        }
+    return files;
+}
+
+TEST(Tiles, TilesWrittenOnThreadsAreTheSameRunToRunAndTheLeavesAsOnOne) {
+    TempDir dir;
+    engine::QuietProgress quiet;
+    engine::TilesSettings s = bunny_settings(dir / "one", engine::TileCompression::kMeshopt);
+    engine::tile_file(s, quiet);
+    s.threads = 2;
+    s.outdir = dir / "two";
+    const engine::TilesResult two = engine::tile_file(s, quiet);
+    s.outdir = dir / "again";
+    engine::tile_file(s, quiet);
+    const auto one_files = files_under(dir / "one"), two_files = files_under(dir / "two");
+    EXPECT_EQ(two_files, files_under(dir / "again"));
+    // The leaves hold the input, whatever decimated the levels above.
+    const std::string deepest = "tiles/" + std::to_string(two.levels.size() - 1) + "/";
+    size_t leaves = 0;
+    for (const auto& [path, bytes] : two_files)
+        if (path.starts_with(deepest)) {
+            ++leaves;
+            ASSERT_TRUE(one_files.count(path)) << path;
+            EXPECT_EQ(bytes, one_files.at(path)) << path;
+        }
+    EXPECT_EQ(leaves, two.levels.back().leaves);
+    EXPECT_GT(leaves, 8u);
+}
 
 TEST(Tiles, ANonEmptyDirectoryIsRefusedAndKept) {
     TempDir dir;

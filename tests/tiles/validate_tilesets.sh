@@ -22,11 +22,14 @@ fi
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 status=0
-for case in "meshopt" "draco" "none" "meshopt --origin 7.4474,46.9480,540"; do
+# The last case: 300 triangles a tile, five depths, so external tilesets from depth 3.
+for case in "meshopt" "draco" "none" "meshopt --origin 7.4474,46.9480,540" "meshopt --tile-triangles 300"; do
   name=${case// /_}
   name=${name//[,.-]/_}
-  # shellcheck disable=SC2086  # the case's words are options
-  if ! "$meshstream" -q tiles "$fixtures/bunny_from_draco.bin.stl" "$work/$name" --tile-triangles 5000 --compress $case; then
+  options="--compress $case"
+  [[ $case == *--tile-triangles* ]] || options+=" --tile-triangles 5000"
+  # shellcheck disable=SC2086  # the words are options
+  if ! "$meshstream" -q tiles "$fixtures/bunny_from_draco.bin.stl" "$work/$name" $options; then
     echo "FAILED: meshstream tiles --compress $case"
     status=1
     continue
@@ -39,6 +42,10 @@ for case in "meshopt" "draco" "none" "meshopt --origin 7.4474,46.9480,540"; do
     status=1
   fi
 done
+if [ -z "$(find "$work/meshopt___tile_triangles_300/tiles" -name '*.json')" ]; then
+  echo "FAILED: 300 triangles a tile wrote no external tileset"
+  status=1
+fi
 # info reads a tileset: its version and levels (the bunny at 5 000 a tile: three levels).
 info=$("$meshstream" info "$work/meshopt/tileset.json")
 if ! grep -q "format:      3D Tiles 1.1 tileset" <<<"$info" || ! grep -q "depth:       3 levels" <<<"$info"; then
