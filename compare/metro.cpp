@@ -720,6 +720,36 @@ std::string describe_attributes(const io::Channels& c) {
 
 }  // namespace
 
+double one_sided_hausdorff(const std::vector<float>& from, std::vector<float> to, uint64_t samples, uint64_t seed) {
+    TriangleIndex index;
+    index.xyz.reserve(to.size());
+    for (size_t t = 0; t + 9 <= to.size(); t += 9)
+        if (finite_triangle(&to[t])) index.xyz.insert(index.xyz.end(), &to[t], &to[t] + 9);
+    to = {};
+    if (index.xyz.empty()) return 0;
+    index.build();
+    double area = 0;
+    for (size_t t = 0; t + 9 <= from.size(); t += 9)
+        if (finite_triangle(&from[t])) area += triangle_area(&from[t]);
+    if (!(area > 0)) return 0;
+    const double density = double(samples) / area;
+    // Only the largest distance counts: a sample is first looked for within the largest so far
+    // (a search that small is quick), and measured in full only when nothing is that near.
+    double max2 = 0;
+    for (size_t t = 0; t + 9 <= from.size(); t += 9) {
+        const float* tri = &from[t];
+        if (!finite_triangle(tri)) continue;
+        Rng rng = triangle_rng(seed, kSaltMemorySamples, t / 9);
+        for (uint64_t k = samples_for(triangle_area(tri), density, rng); k > 0; --k) {
+            double p[3], bary[3];
+            point_in_triangle(tri, rng, p, bary);
+            if (max2 > 0 && index.nearest_dist2(p, max2) < max2) continue;
+            max2 = std::max(max2, index.nearest_dist2(p));
+        }
+    }
+    return std::sqrt(max2);
+}
+
 CompareResult compare_meshes(const MeshSource& a, const MeshSource& b, const CompareOptions& options) {
     // Which one to hold: the smaller by header count (or a PLY's face count) when both are
     // known, else B. A stream cannot be read twice (nor opened once just for its count), so it

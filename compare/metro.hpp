@@ -140,4 +140,12 @@ public:
 // NoSharedAttributes as said above.
 CompareResult compare_meshes(const MeshSource& a, const MeshSource& b, const CompareOptions& options = {});
 
+// The one-sided Hausdorff distance from surface `from` to surface `to`, both held by the caller
+// (9 floats a triangle; triangles with a non-finite coordinate are skipped): the largest
+// distance from about `samples` samples on `from`, spread by area as compare_meshes spreads them
+// (deterministic for a seed), to the nearest point of `to`; 0 when either side is empty. For
+// callers that hold both sides (the tiles' errors). Memory: `to` with its BVH.
+double one_sided_hausdorff(const std::vector<float>& from, std::vector<float> to, uint64_t samples,
+                           uint64_t seed = 1);
+
 }  // namespace meshstream::compare

@@ -27,7 +27,10 @@
 #include <numbers>
 #include <filesystem>
 #include <fstream>
+#include <list>
 #include <map>
+#include <memory>
+#include <unordered_map>
 #include <unistd.h>
 
 namespace meshstream::engine {
@@ -301,7 +304,14 @@ public:
         for (unsigned t = 0; t < threads; ++t) workers_.emplace_back([this] { work(); });
         capacity_ = 2 * size_t(threads);
     }
-    ~TilePool() { stop(); }
+    // Without finish() (an error or a cancel): the jobs still waiting are dropped.
+    ~TilePool() {
+        {
+            const std::lock_guard<std::mutex> lock(mutex_);
+            queue_.clear();
+        }
+        stop();
+    }
     TilePool(const TilePool&) = delete;
     TilePool& operator=(const TilePool&) = delete;
 
@@ -379,8 +389,12 @@ public:
     // `result`, when given.
     void sort(const std::string& mesh, std::string_view format, CellCounts* counts, ProgressSink& progress,
               Warnings* warnings, TilesResult* result) {
-        in_.emplace(io::open_input(mesh, format, s_.read), io::BadTriangles::kDrop);
-        const io::MeshHeader& header = in_->header();
+        // The reader's share of the memory budget (what a PLY or OBJ reader holds: its vertex
+        // table, spilled past it), beside the sort's half and the cell counts' quarter.
+        io::ReadOptions read = s_.read;
+        read.memory_budget_bytes = s_.read.memory_budget_bytes / 4;
+        io::TriangleInput in(io::open_input(mesh, format, read), io::BadTriangles::kDrop);
+        const io::MeshHeader& header = in.header();
         const io::Format& glb = io::output_format("x.glb", "glb");
         wo_ = io::WriteOptions{};
         wo_.tmpdir = s_.read.tmpdir;
@@ -413,24 +427,24 @@ public:
         sorter_.emplace(so);
         io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, wo_.channels);
         progress.phase("sorting by cell", header.triangle_count);
-        while (in_->next(chunk)) {
+        while (in.next(chunk)) {
             sorter_->add(chunk);
             if (counts != nullptr)
                 for (size_t i = 0; i < chunk.size(); ++i) counts->add(cube_.triangle_key(&chunk.xyz()[9 * i]));
-            progress.update(in_->count().read, in_->source().stored_offset(), in_->source().stored_size());
+            progress.update(in.count().read, in.source().stored_offset(), in.source().stored_size());
             throw_if_cancelled(progress);
         }
         sorter_->finish_input();
         // The material table is whole once the input is read.
-        if (wo_.channels.material) wo_.materials = in_->header().materials;
+        if (wo_.channels.material) wo_.materials = in.header().materials;
         if (warnings != nullptr) {
-            note_dropped_triangles(dropped_triangles(*in_), "left out", *warnings);
-            note_input_changes(in_->header(), in_->name(), *warnings);
+            note_dropped_triangles(dropped_triangles(in), "left out", *warnings);
+            note_input_changes(in.header(), in.name(), *warnings);
         }
         if (result != nullptr) {
-            result->input_name = in_->name();
-            result->input_format = std::string(in_->format().name);
-            result->triangles_in = in_->count().read;
+            result->input_name = in.name();
+            result->input_format = std::string(in.format().name);
+            result->triangles_in = in.count().read;
         }
     }
 
@@ -523,7 +537,6 @@ public:
             }
         }
         sorter_.reset();
-        in_.reset();
     }
 
     // The writers' notes, into `warnings`.
@@ -558,7 +571,6 @@ private:
     const Cube& cube_;
     std::string root_;
     std::string shown_root_;
-    std::optional<io::TriangleInput> in_;
     std::optional<sort::ExternalSorter> sorter_;
     io::WriteOptions wo_;
 };
@@ -572,9 +584,71 @@ std::vector<float> tile_positions(const std::string& path) {
     return xyz;
 }
 
-// The geometric error of a tile: the Hausdorff distance from its content to its children's
-// (0 without content: nothing is drawn instead of the children), plus their largest error.
-double tile_error(const Node& n, const Tree& tree, const std::string& root, const TilesSettings& s) {
+// Tiles' positions as read back, kept for the error measure's threads, the least recently used
+// dropped past `budget_bytes` (a tile in use stays until its users let it go): the tiles of a
+// depth and their neighbours are read once each as long as the neighbourhoods of the tiles
+// measured at the same time fit.
+class TileCache {
+public:
+    using Positions = std::shared_ptr<const std::vector<float>>;
+    TileCache(const Tree& tree, std::string root, uint64_t budget_bytes)
+        : tree_(tree), root_(std::move(root)), budget_(budget_bytes) {}
+
+    Positions get(int node) {
+        {
+            const std::lock_guard<std::mutex> lock(mutex_);
+            if (auto it = entries_.find(node); it != entries_.end()) {
+                used_.splice(used_.begin(), used_, it->second.second);
+                return it->second.first;
+            }
+        }
+        Positions xyz = std::make_shared<const std::vector<float>>(
+            tile_positions((fs::path(root_) / tree_.nodes[size_t(node)].uri).string()));
+        const std::lock_guard<std::mutex> lock(mutex_);
+        if (entries_.count(node) == 0) {
+            used_.push_front(node);
+            entries_.emplace(node, std::make_pair(xyz, used_.begin()));
+            bytes_ += xyz->size() * sizeof(float);
+            while (bytes_ > budget_ && used_.size() > 1) {
+                const int last = used_.back();
+                bytes_ -= entries_.at(last).first->size() * sizeof(float);
+                entries_.erase(last);
+                used_.pop_back();
+            }
+        }
+        return xyz;
+    }
+
+private:
+    const Tree& tree_;
+    std::string root_;
+    uint64_t budget_, bytes_ = 0;
+    std::mutex mutex_;
+    std::list<int> used_;  // most recently used first
+    std::unordered_map<int, std::pair<Positions, std::list<int>::iterator>> entries_;
+};
+
+// Appends to `out` the triangles of `xyz` whose bounding box meets `crop` (both y-up).
+void append_within(const std::vector<float>& xyz, const Box& crop, std::vector<float>& out) {
+    for (size_t t = 0; t < xyz.size(); t += 9) {
+        Box b;
+        for (int c = 0; c < 3; ++c) b.add(&xyz[t + 3 * size_t(c)]);
+        bool meets = true;
+        for (int a = 0; a < 3; ++a) meets = meets && b.min[a] <= crop.max[a] && b.max[a] >= crop.min[a];
+        if (meets) out.insert(out.end(), &xyz[t], &xyz[t] + 9);
+    }
+}
+
+// The geometric error of a tile: the Hausdorff distance between what a viewer draws with it
+// and what it draws with its children instead, plus their largest error (0 without content:
+// nothing is drawn instead of the children). Triangles go to tiles by centroid, so near a
+// cell's border the surface over a piece of one side may be a neighbour's (drawn beside it, not
+// in it): each side's samples are measured against the other side's surface around them — the
+// children, or the tile, with the triangles of the other tiles of their depth (and of the leaves
+// above it) within `margin` (a sixteenth of the tile's cell) of the samples' box. A distance
+// beyond the margin is measured as it is to the triangles within it: never less than the true
+// one.
+double tile_error(const Node& n, const Tree& tree, const Cube& cube, TileCache& cache, const TilesSettings& s) {
     std::vector<float> children;
     double child_error = 0;
     for (int c : n.child) {
@@ -582,30 +656,51 @@ double tile_error(const Node& n, const Tree& tree, const std::string& root, cons
         const Node& ch = tree.nodes[size_t(c)];
         child_error = std::max(child_error, ch.error);
         if (!ch.uri.empty()) {
-            std::vector<float> xyz = tile_positions((fs::path(root) / ch.uri).string());
-            children.insert(children.end(), xyz.begin(), xyz.end());
+            const TileCache::Positions xyz = cache.get(c);
+            children.insert(children.end(), xyz->begin(), xyz->end());
         }
     }
-    double distance = 0;
-    if (!n.uri.empty() && !children.empty()) {
-        std::vector<float> own = tile_positions((fs::path(root) / n.uri).string());
-        compare::CompareOptions co;
-        co.samples = std::max<uint64_t>(10000, own.size() / 9);  // about one a tile triangle
-        co.seed = s.seed;
-        co.tmpdir = s.read.tmpdir;
-        co.edges = false;  // the distances only
-        const compare::CompareResult r = compare::compare_meshes(compare::memory_source("tile", std::move(own)),
-                                                                 compare::memory_source("children", std::move(children)), co);
-        distance = r.hausdorff();
-    }
-    return distance + child_error;
+    if (n.uri.empty() || children.empty()) return child_error;
+    const int id = int(&n - tree.nodes.data());
+    const TileCache::Positions own = cache.get(id);
+    const double margin = cube.extent / double(1 << n.depth) / 16;
+    // `side` and what the viewer draws with the tiles of `depth` around the samples' box.
+    auto surface_near = [&](std::vector<float> side, const std::vector<float>& samples, int depth) {
+        Box around;  // the samples', y-up
+        for (size_t i = 0; i < samples.size(); i += 3) around.add(&samples[i]);
+        for (int a = 0; a < 3; ++a) around.min[a] -= margin, around.max[a] += margin;
+        // The same box in the model's coordinates (y-up (x, z, -y) back to z-up).
+        Box model;
+        model.min[0] = around.min[0], model.max[0] = around.max[0];
+        model.min[1] = -around.max[2], model.max[1] = -around.min[2];
+        model.min[2] = around.min[1], model.max[2] = around.max[1];
+        for (size_t o = 0; o < tree.nodes.size(); ++o) {
+            const Node& other = tree.nodes[o];
+            const bool drawn = other.depth == depth || (other.leaf && other.depth < depth);
+            if (!drawn || other.uri.empty() || other.box.empty() || int(o) == id) continue;
+            if (std::find(n.child.begin(), n.child.end(), int(o)) != n.child.end()) continue;  // in `side`
+            bool meets = true;
+            for (int a = 0; a < 3; ++a)
+                meets = meets && other.box.min[a] <= model.max[a] && other.box.max[a] >= model.min[a];
+            if (meets) append_within(*cache.get(int(o)), around, side);
+        }
+        return side;
+    };
+    const uint64_t samples = std::max<uint64_t>(10000, own->size() / 9);  // about one a tile triangle
+    const double from_tile =
+        compare::one_sided_hausdorff(*own, surface_near(children, *own, n.depth + 1), samples, s.seed);
+    const double from_children =
+        compare::one_sided_hausdorff(children, surface_near(*own, children, n.depth), samples, s.seed);
+    return std::max(from_tile, from_children) + child_error;
 }
 
 // Sets the errors of `parents` (tiles of one depth, whose children's errors are set) on
 // s.threads threads, each tile's on one, so the figures do not depend on the threads. Memory:
-// a tile and its children's positions per thread.
-void measure_errors(const std::vector<Node*>& parents, const Tree& tree, const std::string& root,
+// a quarter of the budget for the tiles read back (TileCache), and per thread a tile, its
+// children and the triangles of their neighbours near them.
+void measure_errors(const std::vector<Node*>& parents, const Tree& tree, const Cube& cube, const std::string& root,
                     const TilesSettings& s, ProgressSink& progress) {
+    TileCache cache(tree, root, s.read.memory_budget_bytes / 4);
     std::atomic<size_t> next{0}, done{0};
     std::atomic<bool> stop{false};
     std::exception_ptr failure;
@@ -615,7 +710,7 @@ void measure_errors(const std::vector<Node*>& parents, const Tree& tree, const s
         const size_t i = stop.load() ? parents.size() : next.fetch_add(1);
         if (i >= parents.size()) return false;
         try {
-            parents[i]->error = tile_error(*parents[i], tree, root, s);
+            parents[i]->error = tile_error(*parents[i], tree, cube, cache, s);
             done.fetch_add(1);
         } catch (...) {
             const std::lock_guard<std::mutex> lock(failure_mutex);
@@ -807,7 +902,7 @@ TilesResult tile_file(const TilesSettings& s, ProgressSink& progress) {
         std::vector<Node*> parents;
         for (Node& n : tree.nodes)
             if (n.depth == depth && !n.leaf) parents.push_back(&n);
-        measure_errors(parents, tree, building.path(), s, step);
+        measure_errors(parents, tree, cube, building.path(), s, step);
     }
 
     writer.report_notes(result.warnings);

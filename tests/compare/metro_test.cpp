@@ -91,6 +91,23 @@ EdgeCounts count_edges(const std::vector<float>& xyz, uint64_t budget = uint64_t
 
 }  // namespace
 
+TEST(Metro, OneSidedHausdorffIsTheFarthestSampleOfOneSideOnly) {
+    // A unit sphere against itself moved by 0.25 along x: 0.25. Against its half x >= 0: the
+    // pole (-1, 0, 0) is sqrt 2 from the half's rim (the circle x = 0), while the half lies on
+    // the whole (0, within float rounding).
+    const std::vector<float> s = sphere(5);
+    EXPECT_NEAR(one_sided_hausdorff(s, sphere(5, 0.25f), 200000, 1), 0.25, 0.01);
+    std::vector<float> half;
+    for (size_t t = 0; t < s.size(); t += 9)
+        if (s[t] >= 0 && s[t + 3] >= 0 && s[t + 6] >= 0) half.insert(half.end(), &s[t], &s[t] + 9);
+    EXPECT_NEAR(one_sided_hausdorff(s, half, 200000, 1), std::sqrt(2.0), 0.02);
+    EXPECT_LT(one_sided_hausdorff(half, s, 200000, 1), 1e-6);
+    // The same samples for the same seed; nothing to measure against: 0.
+    EXPECT_EQ(one_sided_hausdorff(s, half, 5000, 7), one_sided_hausdorff(s, half, 5000, 7));
+    EXPECT_EQ(one_sided_hausdorff(s, {}, 5000, 1), 0.0);
+    EXPECT_EQ(one_sided_hausdorff({}, s, 5000, 1), 0.0);
+}
+
 TEST(Metro, MeshAgainstItselfIsZero) {
     // Samples on the held mesh are stored as floats, so a sample may sit off its own triangle by
     // float rounding of its coordinates: at most ~2^-24 · |coordinate| ≈ 6e-8 on a unit sphere.

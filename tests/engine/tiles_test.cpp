@@ -2,6 +2,7 @@
 // content lies in its bounding volume, geometric errors are 0 at the leaves and never grow from
 // parent to child, a non-empty directory is refused and kept, a cancel leaves nothing behind.
 #include "engine/tiles.hpp"
+#include "compare/metro.hpp"
 #include "io/error.hpp"
 #include "io/format.hpp"
 #include "io/triangle_input.hpp"
@@ -141,6 +142,31 @@ TEST(Tiles, InASmallMemoryBudgetEveryTriangleIsInTheLeavesAndTilesAboveAreNotRef
 INSTANTIATE_TEST_SUITE_P(Compressions, Tiles,
                          ::testing::Values(engine::TileCompression::kMeshopt, engine::TileCompression::kNone,
                                            engine::TileCompression::kDraco));
+
+TEST(Tiles, TheRootsErrorBoundsItsDistanceToTheInputAndIsNotMuchMore) {
+    // The root's error sums the errors between depths along the worst path (two here): at least
+    // the root content's Hausdorff distance to the input, and not many times it. Measuring each
+    // tile against its children alone, as if the neighbours drew nothing, made it 4.5 times.
+    TempDir dir;
+    engine::QuietProgress quiet;
+    engine::TilesSettings s = bunny_settings(dir / "t", engine::TileCompression::kNone);
+    const engine::TilesResult r = engine::tile_file(s, quiet);
+    ASSERT_EQ(r.levels.size(), 3u);
+    std::vector<float> root;
+    io::TriangleInput in(io::open_input(dir / "t/tiles/0/0.glb"), io::BadTriangles::kKeep);
+    io::TriangleChunk chunk;
+    while (in.next(chunk))
+        for (size_t i = 0; i < 3 * chunk.size(); ++i) {  // back to z-up
+            const float* p = &chunk.xyz()[3 * i];
+            root.insert(root.end(), {p[0], -p[2], p[1]});
+        }
+    compare::CompareOptions co;
+    co.edges = false;
+    const double direct = compare::compare_meshes(compare::file_source(kBunny), compare::memory_source("root", root), co)
+                              .hausdorff();
+    EXPECT_GE(r.levels[0].max_error, direct * 0.9);
+    EXPECT_LE(r.levels[0].max_error, direct * 3);
+}
 
 TEST(Tiles, DeepTreesGoToExternalTilesetsOfThreeDepthsEach) {
     // 300 triangles a tile: five depths, so the subtrees from depth 3 are tileset files of their own.

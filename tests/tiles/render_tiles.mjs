@@ -14,13 +14,15 @@
 //           of the model's radius, the far plane a quarter of the radius away, error target 16 px
 //   match   the whole model filling the view, error target 1 px, unlit (basic materials with
 //           the tiles' colours), beside the reference drawn the same way
-//   levels  the same whole view, error target 16 px, each tile lit and coloured by its level
+//   whole   the same whole view, error target 16 px (the renderer's default)
+//   levels  the same whole view, error target 1 px, each tile lit and coloured by its level
 //           (red, orange, yellow, green, cyan, blue, ... from the root down)
 // Every file the page fetches below the tileset (its JSON too) is counted by the server, scene by
 // scene. Report:
 //   {tiles: {count, levels, leaves, bytes, leaf_bytes},                 // the whole tileset
-//    far|close|match|levels: {settled, frames, ms, fetched_bytes, fetched_by_level (content
-//                       bytes), drawn_by_level (tiles), fetched_leaves, leaves_in_view,
+//    far|close|match|whole|levels: {settled, frames, ms, fetched_bytes, fetched_by_level (content
+//                       bytes), drawn_by_level (tiles), drawn_max_error (the largest
+//                       geometricError of the tiles drawn), fetched_leaves, leaves_in_view,
 //                       fetched_leaves_out_of_view, fetched_leaf_bytes_out_of_view,
 //                       out_of_view_parent_out_of_view, failed},
 //    match: {..., covered_reference, covered_tiles, missing, extra, colour_difference, colour_differs},
@@ -32,7 +34,9 @@
 // covered pixels the tiles leave uncovered (cover beyond it); colour_difference the mean absolute
 // difference (0–255, over r, g, b) on pixels both cover, colour_differs the share of those pixels
 // with a channel more than 32 apart. OUT_DIR receives far.png, close.png, match_tiles.png,
-// match_reference.png and levels.png.
+// match_reference.png, whole.png and levels.png.
+// RENDER_TILES_SCENES (e.g. "far,close,whole,levels") runs only those scenes (match loads the
+// leaves in view and the reference whole).
 // Exit status: 0 when the report was written, 2 when Chromium, three.js or 3d-tiles-renderer
 // cannot be found or the page does not report within 120 s.
 import fs from 'node:fs';
@@ -49,6 +53,7 @@ if (!outDir || !tilesetJson || !referenceGlb) {
 const chromium = requireTools('render_tiles', modules, [
     ['three', 'build/three.module.js'], ['3d-tiles-renderer', 'build/index.js']]);
 const tilesetDir = path.dirname(path.resolve(tilesetJson));
+const scenes = (process.env.RENDER_TILES_SCENES || 'far,close,match,whole,levels').split(',');
 fs.mkdirSync(outDir, { recursive: true });
 
 // 4 × 4 column-major matrices, as 3D Tiles writes `transform`.
@@ -89,7 +94,7 @@ function walk(file, tile, parentMatrix, level, parentPath) {
             const p = path.relative(tilesetDir, target);
             inventory.push({
                 path: p, level, leaf: !(tile.children && tile.children.length), parent: parentPath,
-                bytes: fs.statSync(target).size,
+                bytes: fs.statSync(target).size, error: tile.geometricError,
                 corners: tile.boundingVolume.box ? boxCorners(tile.boundingVolume.box, m) : null,
             });
             childLevel = level + 1;
@@ -227,37 +232,42 @@ try {
     await show('close', camera(radius / 20, hit ? hit.point : center, radius / 4), 16);
 
     // match: the tiles at a 1-pixel error target against the reference, both unlit.
-    const tilePixels = (await show('match', whole, 1, (scene) => basic(scene))).pixels;
-    basic(reference);
-    const refScene = new THREE.Scene();
-    refScene.add(reference);
-    renderer.render(refScene, whole);
-    const refPixels = pixels();
-    await save('match_reference');
-    let coveredRef = 0, coveredTiles = 0, missing = 0, extra = 0, both = 0, difference = 0, differs = 0;
-    for (let i = 0; i < refPixels.length; i += 4) {
-        const a = refPixels[i] + refPixels[i + 1] + refPixels[i + 2] > 0;
-        const b = tilePixels[i] + tilePixels[i + 1] + tilePixels[i + 2] > 0;
-        coveredRef += a; coveredTiles += b;
-        if (a && !b) ++missing;
-        if (b && !a) ++extra;
-        if (a && b) {
-            ++both;
-            let most = 0;
-            for (let k = 0; k < 3; ++k) {
-                const d = Math.abs(refPixels[i + k] - tilePixels[i + k]);
-                difference += d;
-                most = Math.max(most, d);
+    if (${JSON.stringify(scenes)}.includes('match')) {
+        const tilePixels = (await show('match', whole, 1, (scene) => basic(scene))).pixels;
+        basic(reference);
+        const refScene = new THREE.Scene();
+        refScene.add(reference);
+        renderer.render(refScene, whole);
+        const refPixels = pixels();
+        await save('match_reference');
+        let coveredRef = 0, coveredTiles = 0, missing = 0, extra = 0, both = 0, difference = 0, differs = 0;
+        for (let i = 0; i < refPixels.length; i += 4) {
+            const a = refPixels[i] + refPixels[i + 1] + refPixels[i + 2] > 0;
+            const b = tilePixels[i] + tilePixels[i + 1] + tilePixels[i + 2] > 0;
+            coveredRef += a; coveredTiles += b;
+            if (a && !b) ++missing;
+            if (b && !a) ++extra;
+            if (a && b) {
+                ++both;
+                let most = 0;
+                for (let k = 0; k < 3; ++k) {
+                    const d = Math.abs(refPixels[i + k] - tilePixels[i + k]);
+                    difference += d;
+                    most = Math.max(most, d);
+                }
+                if (most > 32) ++differs;
             }
-            if (most > 32) ++differs;
         }
+        await post('/match', { covered_reference: coveredRef / (size * size), covered_tiles: coveredTiles / (size * size),
+            missing: coveredRef ? missing / coveredRef : 0, extra: coveredRef ? extra / coveredRef : 0,
+            colour_difference: both ? difference / (3 * both) : 0, colour_differs: both ? differs / both : 0 });
     }
-    await post('/match', { covered_reference: coveredRef / (size * size), covered_tiles: coveredTiles / (size * size),
-        missing: coveredRef ? missing / coveredRef : 0, extra: coveredRef ? extra / coveredRef : 0,
-        colour_difference: both ? difference / (3 * both) : 0, colour_differs: both ? differs / both : 0 });
 
-    // levels: the whole view at the renderer's default error target, each tile lit and coloured by its level.
-    await show('levels', whole, 16, (scene, tile) => {
+    // whole: the whole view at the renderer's default error target.
+    if (${JSON.stringify(scenes)}.includes('whole')) await show('whole', whole, 16);
+
+    // levels: the whole view at a 1-pixel error target, each tile lit and coloured by its level.
+    await show('levels', whole, 1, (scene, tile) => {
         const colour = palette[Math.min(tile.internal.depth, palette.length - 1)];
         scene.traverse((o) => {
             if (!o.isMesh) return;
@@ -308,9 +318,11 @@ const outcome = await runPage({
                 if (t) fetchedBytesByLevel[t.level] = (fetchedBytesByLevel[t.level] || 0) + f.bytes;
             }
             const drawnByLevel = {};
+            let drawnMaxError = 0;
             for (const p of value.drawn) {
                 const t = byPath.get(p);
                 if (t) drawnByLevel[t.level] = (drawnByLevel[t.level] || 0) + 1;
+                if (t) drawnMaxError = Math.max(drawnMaxError, t.error);
             }
             const fetchedLeaves = [...new Set(files.filter((f) => byPath.get(f.path)?.leaf).map((f) => f.path))];
             const inView = new Set(value.inView);
@@ -321,6 +333,7 @@ const outcome = await runPage({
                 fetched_bytes: files.reduce((s, f) => s + f.bytes, 0),
                 fetched_by_level: fetchedBytesByLevel,
                 drawn_by_level: drawnByLevel,
+                drawn_max_error: drawnMaxError,
                 fetched_leaves: fetchedLeaves.length,
                 leaves_in_view: [...inView].filter((p) => byPath.get(p).leaf).length,
                 fetched_leaves_out_of_view: outOfView.length,

@@ -11,7 +11,8 @@
 #   match   at a 1-pixel error target, missing and extra coverage each under 0.1 % of the
 #           reference's pixels (a leaf of the 288 covers about that much), mean colour difference
 #           under 1 (of 255), under 0.1 % of the pixels more than 32 apart in a channel;
-#   levels  at least two levels drawn at the default 16-pixel target.
+#   whole   the whole model at the default 16-pixel target: no leaf fetched;
+#   levels  at least two levels drawn at a 1-pixel target.
 # The report is printed. KEEP_DIR, when given, receives the pictures and the report.
 # Exit 77 (ctest's skip) with the reason when node, Chromium, three.js or 3d-tiles-renderer is
 # absent (tools/bootstrap.sh installs them).
@@ -55,7 +56,7 @@ const check = (ok, what) => { if (!ok) failures.push(what); };
 const t = r.tiles;
 check(!r.error, `the page threw: ${r.error}`);
 check(t.levels === 4 && t.leaves > 100, `the tileset has ${t.levels} levels and ${t.leaves} leaves (expected 4 and over 100)`);
-for (const name of ['far', 'close', 'match', 'levels']) {
+for (const name of ['far', 'close', 'match', 'whole', 'levels']) {
   const s = r[name];
   if (!s) { failures.push(`no report of the ${name} scene`); continue; }
   check(s.settled, `${name}: still loading after 20 s`);
@@ -82,11 +83,12 @@ if (r.match) {
   check(m.colour_difference < 1, `match: mean colour difference ${m.colour_difference}`);
   check(m.colour_differs < 0.001, `match: ${(100 * m.colour_differs).toFixed(3)} % of the pixels' colours more than 32 apart`);
 }
+if (r.whole) check(r.whole.fetched_leaves === 0, `whole: ${r.whole.fetched_leaves} leaves fetched`);
 if (r.levels) check(Object.keys(r.levels.drawn_by_level).length >= 2, `levels: drawn ${JSON.stringify(r.levels.drawn_by_level)}`);
 if (failures.length) {
   for (const f of failures) console.log('FAILED: ' + f);
   process.exit(1);
 }
-console.log(`ok: far ${share(r.far.fetched_bytes)} of ${t.bytes} bytes, close ${share(r.close.fetched_bytes)} (${r.close.fetched_leaves} of ${t.leaves} leaves), ` +
+console.log(`ok: far ${share(r.far.fetched_bytes)} of ${t.bytes} bytes, whole ${share(r.whole.fetched_bytes)}, close ${share(r.close.fetched_bytes)} (${r.close.fetched_leaves} of ${t.leaves} leaves), ` +
   `match missing ${(100 * r.match.missing).toFixed(4)} % extra ${(100 * r.match.extra).toFixed(4)} % colour ${r.match.colour_difference.toFixed(3)}`);
 EOF
