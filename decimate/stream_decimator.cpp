@@ -513,7 +513,7 @@ void StreamDecimator::Impl::decimate_final(size_t keep) {
             ++stats_.collapses;
         } else if (buffer_.full_resolution_first()) {
             // The seam pass's seams have no valid collapse left: the rest of the target from
-            // every edge, cheapest first, as before.
+            // every edge, cheapest first.
             buffer_.set_full_resolution_first(false);
             rate_all(buffer_, queue_);
             rated_all = true;
