@@ -458,6 +458,9 @@ void apply_collapse(HalfEdgeBuffer& buffer, uint32_t h) {
     // on one of them, was in one open fan, or in several with or without kOpenFans, which holds.
     uint16_t& q_flags = buffer.vertex(e.q).flags;
     if ((buffer.vertex(e.p).flags & kManyFans) && (q_flags & kManyFans) == 0) q_flags |= kManyFans | kOpenFans;
+    // A merged vertex is at full resolution only when both ends were (the seam pass): a seam
+    // vertex merged into its decimated neighbour is gone, and the neighbour stays as it was.
+    if ((buffer.vertex(e.p).flags & kFullResolution) == 0) q_flags &= ~kFullResolution;
     buffer.move_corners(e.p, e.q);
     buffer.quadric(e.q) += buffer.quadric(e.p);
     if ((buffer.vertex(e.q).flags & kFrozen) == 0) buffer.set_partner(e.q, buffer.vertex(e.p).pos);

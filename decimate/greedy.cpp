@@ -38,6 +38,10 @@ void rate_edge(HalfEdgeBuffer& buffer, CollapseQueue& queue, uint32_t h) {
     const uint32_t p = buffer.corner_vertex(h), q = buffer.corner_vertex(next_in_face(h));
     const Vertex& vp = buffer.vertex(p);
     const Vertex& vq = buffer.vertex(q);
+    if (buffer.full_resolution_first() && ((vp.flags | vq.flags) & kFullResolution) == 0) {
+        CollapseQueue::forget(buffer, h);
+        return;
+    }
     // Most edges first: an interior edge between free ends (free_end() of both, in one test).
     if (is_half_edge(t) && ((vp.flags | vq.flags) & kNoSource) == 0 && (vp.open_edges | vq.open_edges) == 0 &&
         vp.face_count <= kMaxMovedFaces && vq.face_count <= kMaxMovedFaces) {

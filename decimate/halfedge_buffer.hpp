@@ -77,6 +77,10 @@ inline constexpr uint16_t kHasValues = 1024;  // its attribute record is set up 
 // With kManyFans: every fan is open, so the fans meet at this vertex only (boundary loops that
 // touch here), and the vertex may slide along a boundary edge (collapse.hpp).
 inline constexpr uint16_t kOpenFans = 2048;
+// The seam pass (Part::kSeams): made by a triangle that stands for itself (a range's seam piece,
+// at full resolution) and in no triangle that stands for more (a range's decimated interior).
+// A vertex along a seam; see set_full_resolution_first().
+inline constexpr uint16_t kFullResolution = 4096;
 
 struct Vertex {
     float pos[3];           // input position, moved by collapses and once when written (§4.4)
@@ -142,6 +146,15 @@ public:
     uint32_t faces_added() const { return born_counter_; }
     // Faces with a corner on P_in (the rest are interior: oldest_interior_face()).
     size_t pinned_face_count() const { return pinned_face_count_; }
+    // Vertices on P_in (those still open towards input, in the welding hash table).
+    size_t open_vertex_count() const { return hash_count_; }
+    // While set, only edges with an end flagged kFullResolution are rated for collapse
+    // (greedy.cpp, rate_edge); the others are left out of the queue. The seam pass decimates
+    // its full-resolution seams first: the ranges' interiors it reads are at the ratio already,
+    // and their quadrics hold only the planes of the decimated triangles, which make a collapse
+    // there look cheaper than it is.
+    bool full_resolution_first() const { return full_resolution_first_; }
+    void set_full_resolution_first(bool on) { full_resolution_first_ = on; }
     // Free vertex slots; add_triangle needs 3.
     size_t free_vertex_count() const { return vertex_capacity_ - vertex_used_; }
     // Face slots [0, face_slots()) have been used; face_alive() tells which hold a face.
@@ -421,6 +434,7 @@ private:
 
     uint64_t vertices_merged_ = 0, nonmanifold_edges_ = 0, boundary_edges_ = 0;
     AttributeStore* attributes_ = nullptr;
+    bool full_resolution_first_ = false;
 };
 
 }  // namespace meshstream::decimate

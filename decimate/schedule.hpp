@@ -41,6 +41,19 @@ inline double part_budget(double ratio, double represented, uint64_t triangles_o
     return ratio * represented - double(triangles_out) + (1 - ratio) * double(pinned);
 }
 
+// The budget a range ends with (StreamDecimator::finish_range): part_budget, but the faces on
+// P_in count only for what the seam pass will not remove. Every vertex still on P_in at the
+// range's end is on a seam (or a hole's rim); the seam pass joins the seam and collapses each of
+// its vertices away, removing one face on each side, which leaves the strip at the ratio. So the
+// faces on P_in stand for one face a vertex on P_in, not for (1 − p) of themselves: the range
+// decimates the difference itself, by its own quadrics, instead of leaving it to the seam pass,
+// whose quadrics of the ranges' decimated interiors hold only the planes of the decimated
+// triangles. Never above part_budget.
+inline double range_end_budget(double ratio, double represented, uint64_t triangles_out, size_t pinned,
+                               size_t open_vertices) {
+    return ratio * represented - double(triangles_out) + std::min((1 - ratio) * double(pinned), double(open_vertices));
+}
+
 struct RoomPlan {
     size_t decimate_to;  // collapse until the buffer holds at most this many triangles
     size_t write_to;     // then write until it holds at most this many

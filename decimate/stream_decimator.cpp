@@ -158,6 +158,9 @@ StreamDecimator::Impl::Impl(const Options& options, io::InputCount own, const io
       rng_(options.seed),
       output_(options.output_chunk_triangles, attributes_ ? &attributes_->layout() : nullptr) {
     buffer_.set_attributes(attributes_.get());
+    // The seam pass collapses along its full-resolution seams first (finish_at falls back to
+    // every edge once they are done).
+    if (options.part == Part::kSeams) buffer_.set_full_resolution_first(true);
     face_scalars_.resize(attributes.face_scalar_count());
     stats_.buffer_capacity = options.buffer_triangles;
     if (options.sorted_axis) {
@@ -263,6 +266,16 @@ void StreamDecimator::Impl::read_triangle(const io::TriangleChunk& in, size_t i,
         return;
     }
     if (attributes_) attributes_->add_face(buffer_, added.face, corners, material, fs);
+    // The seam pass: a vertex made by a seam piece's triangle (standing for itself) is at full
+    // resolution until a triangle of a decimated interior (standing for more) reaches it.
+    if (options_.part == Part::kSeams)
+        for (const uint32_t v : added.vertex) {
+            Vertex& x = buffer_.vertex(v);
+            if (weight_ > 1)
+                x.flags &= ~kFullResolution;
+            else if (x.face_count == 1)
+                x.flags |= kFullResolution;
+        }
     // A vertex whose fan this triangle closed left P_in: its edges are rated now, while the fan
     // is in the cache, not when the buffer is next full. (The seam pass rates only when a
     // collapse is due: make_room.)
@@ -439,6 +452,14 @@ void StreamDecimator::Impl::finish_at(uint64_t target, const Emit& out) {
     if (finished_) throw std::logic_error("StreamDecimator::finish called twice");
     if (options_.part == Part::kRange) throw std::logic_error("StreamDecimator: a range ends with finish_range()");
     finished_ = true;
+    // The seam pass: a vertex still open at the end is on a hole's rim, not on a seam (a seam's
+    // vertices closed when the next range's seam piece came); its collapses take their turn in
+    // the greedy order with the rest, as one thread's rims do.
+    if (options_.part == Part::kSeams)
+        for (uint32_t v = 0; v < buffer_.vertex_slots(); ++v) {
+            Vertex& x = buffer_.vertex(v);
+            if ((x.flags & (kAlive | kInHash)) == (kAlive | kInHash)) x.flags &= ~kFullResolution;
+        }
     // No more input: whatever is still open is true boundary.
     buffer_.finalize_all();
     stats_.target_triangles = target;
@@ -476,14 +497,26 @@ void StreamDecimator::Impl::finish_range(const Emit& interior, const Emit& first
 
 void StreamDecimator::Impl::decimate_final(size_t keep) {
     // A range's budget falls as collapses remove faces on P_in (they stood for themselves): it is
-    // followed as it falls.
+    // followed as it falls. It ends with each vertex on P_in standing for one of their faces
+    // (range_end_budget).
     const bool range = options_.part == Part::kRange;
-    auto in_core = [&] { return range ? size_t(std::max(0.0, std::round(budget()))) : keep; };
+    auto in_core = [&] {
+        if (!range) return keep;
+        const double b = range_end_budget(ratio_, represented_, output_.triangle_count(), buffer_.pinned_face_count(),
+                                          buffer_.open_vertex_count());
+        return size_t(std::max(0.0, std::round(b)));
+    };
     rate_pending(buffer_, queue_);
     bool rated_all = false;
     while (buffer_.face_count() >= in_core() + 2) {
         if (collapse_cheapest(buffer_, queue_)) {
             ++stats_.collapses;
+        } else if (buffer_.full_resolution_first()) {
+            // The seam pass's seams have no valid collapse left: the rest of the target from
+            // every edge, cheapest first.
+            buffer_.set_full_resolution_first(false);
+            rate_all(buffer_, queue_);
+            rated_all = true;
         } else if (!rated_all) {
             // The queue ran out of valid collapses: every edge rated afresh, refused ones too
             // (a refusal may have lapsed without a neighbour of its ends changing).

@@ -37,7 +37,8 @@ enum class Part : uint8_t {
     // The seam pass over the ranges' outputs in range order (push() with weights, finish_at()):
     // each triangle stands for the input triangles its range said, so where the ranges' outputs
     // are already at the ratio nothing is decimated, and the full-resolution strips along the
-    // seams are decimated down to it once both sides have been read.
+    // seams are decimated once both sides have been read: collapses along the seams first
+    // (HalfEdgeBuffer::full_resolution_first), then, if the target needs more, anywhere.
     kSeams,
 };
 
@@ -109,8 +110,10 @@ public:
     // Part::kSeams: the end of input, landing on `target` triangles in total (the ratio over
     // the ranges' input counts, or --target); otherwise as finish().
     void finish_at(uint64_t target, const Emit& out);
-    // Part::kRange: the end of the range. Decimates what can be decimated to the ratio and writes
-    // it to `interior` (faces with no corner left on P_in; push() writes there too), then the
+    // Part::kRange: the end of the range. Decimates what can be decimated and writes it to
+    // `interior` (faces with no corner left on P_in; push() writes there too), each vertex on
+    // P_in counting for one of the faces on P_in, the face the seam pass removes with it
+    // (range_end_budget in schedule.hpp), then the
     // faces with a corner on P_in, as they are (their P_in corners keep their input positions):
     // those read in the first half of the range to `first_seam` (on streaming input they border
     // the range before), the others to `last_seam`. Each output is flushed; a triangle written to

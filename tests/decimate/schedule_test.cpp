@@ -51,3 +51,16 @@ TEST(Schedule, DecimateTargetNeverExceedsCapacity) {
     EXPECT_EQ(plan.decimate_to, 1000u);
     EXPECT_EQ(plan.write_to, 500u);
 }
+
+TEST(Schedule, ARangeEndsWithOneFaceForEachVertexOnPin) {
+    // A range that read 100 000 triangles at 10 % and wrote 9 000 holds 3 000 faces on P_in
+    // around 2 300 vertices on P_in (a seam strip: about one face a vertex on each side of it,
+    // plus the faces reaching the decimated side). The seam pass removes one face with each
+    // such vertex, so the range keeps 2 300 for them, not 0.9 · 3 000.
+    EXPECT_DOUBLE_EQ(part_budget(0.1, 100000, 9000, 3000), 1000.0 + 2700.0);
+    EXPECT_DOUBLE_EQ(range_end_budget(0.1, 100000, 9000, 3000, 2300), 1000.0 + 2300.0);
+    // Never above part_budget: vertices on P_in with few faces (a strip one face wide).
+    EXPECT_DOUBLE_EQ(range_end_budget(0.1, 100000, 9000, 3000, 3500), part_budget(0.1, 100000, 9000, 3000));
+    // Nothing on P_in: the ratio.
+    EXPECT_DOUBLE_EQ(range_end_budget(0.1, 100000, 9000, 0, 0), 1000.0);
+}
