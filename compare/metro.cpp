@@ -722,10 +722,14 @@ std::string describe_attributes(const io::Channels& c) {
 
 double one_sided_hausdorff(const std::vector<float>& from, std::vector<float> to, uint64_t samples, uint64_t seed) {
     TriangleIndex index;
-    index.xyz.reserve(to.size());
+    size_t kept = 0;  // the finite triangles moved down in place
     for (size_t t = 0; t + 9 <= to.size(); t += 9)
-        if (finite_triangle(&to[t])) index.xyz.insert(index.xyz.end(), &to[t], &to[t] + 9);
-    to = {};
+        if (finite_triangle(&to[t])) {
+            if (kept != t) std::copy_n(&to[t], 9, &to[kept]);
+            kept += 9;
+        }
+    to.resize(kept);
+    index.xyz = std::move(to);
     if (index.xyz.empty()) return 0;
     index.build();
     double area = 0;

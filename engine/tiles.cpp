@@ -390,9 +390,10 @@ public:
     void sort(const std::string& mesh, std::string_view format, CellCounts* counts, ProgressSink& progress,
               Warnings* warnings, TilesResult* result) {
         // The reader's share of the memory budget (what a PLY or OBJ reader holds: its vertex
-        // table, spilled past it), beside the sort's half and the cell counts' quarter.
+        // table, spilled past it): 3/16, beside the sort's 3/8 and the cell counts' 3/16; the
+        // last quarter for the rest (chunks, the tiles being written).
         io::ReadOptions read = s_.read;
-        read.memory_budget_bytes = s_.read.memory_budget_bytes / 4;
+        read.memory_budget_bytes = s_.read.memory_budget_bytes * 3 / 16;
         io::TriangleInput in(io::open_input(mesh, format, read), io::BadTriangles::kDrop);
         const io::MeshHeader& header = in.header();
         const io::Format& glb = io::output_format("x.glb", "glb");
@@ -420,7 +421,7 @@ public:
         }
 
         sort::SorterOptions so;
-        so.memory_budget_bytes = s_.read.memory_budget_bytes / 2;
+        so.memory_budget_bytes = s_.read.memory_budget_bytes * 3 / 8;
         so.tmpdir = s_.read.tmpdir;
         so.channels = wo_.channels;
         so.key = [this](const float* xyz) { return cube_.triangle_key(xyz); };
@@ -649,18 +650,24 @@ void append_within(const std::vector<float>& xyz, const Box& crop, std::vector<f
 // beyond the margin is measured as it is to the triangles within it: never less than the true
 // one.
 double tile_error(const Node& n, const Tree& tree, const Cube& cube, TileCache& cache, const TilesSettings& s) {
-    std::vector<float> children;
     double child_error = 0;
-    for (int c : n.child) {
-        if (c < 0) continue;
-        const Node& ch = tree.nodes[size_t(c)];
-        child_error = std::max(child_error, ch.error);
-        if (!ch.uri.empty()) {
-            const TileCache::Positions xyz = cache.get(c);
-            children.insert(children.end(), xyz->begin(), xyz->end());
+    bool any_child = false;
+    for (int c : n.child)
+        if (c >= 0) {
+            child_error = std::max(child_error, tree.nodes[size_t(c)].error);
+            any_child = any_child || !tree.nodes[size_t(c)].uri.empty();
         }
-    }
-    if (n.uri.empty() || children.empty()) return child_error;
+    if (n.uri.empty() || !any_child) return child_error;
+    // The children's triangles, gathered each time they are needed rather than held twice.
+    auto gather_children = [&] {
+        std::vector<float> xyz;
+        for (int c : n.child)
+            if (c >= 0 && !tree.nodes[size_t(c)].uri.empty()) {
+                const TileCache::Positions part = cache.get(c);
+                xyz.insert(xyz.end(), part->begin(), part->end());
+            }
+        return xyz;
+    };
     const int id = int(&n - tree.nodes.data());
     const TileCache::Positions own = cache.get(id);
     const double margin = cube.extent / double(1 << n.depth) / 16;
@@ -688,7 +695,8 @@ double tile_error(const Node& n, const Tree& tree, const Cube& cube, TileCache& 
     };
     const uint64_t samples = std::max<uint64_t>(10000, own->size() / 9);  // about one a tile triangle
     const double from_tile =
-        compare::one_sided_hausdorff(*own, surface_near(children, *own, n.depth + 1), samples, s.seed);
+        compare::one_sided_hausdorff(*own, surface_near(gather_children(), *own, n.depth + 1), samples, s.seed);
+    const std::vector<float> children = gather_children();
     const double from_children =
         compare::one_sided_hausdorff(children, surface_near(*own, children, n.depth), samples, s.seed);
     return std::max(from_tile, from_children) + child_error;
@@ -696,11 +704,11 @@ double tile_error(const Node& n, const Tree& tree, const Cube& cube, TileCache& 
 
 // Sets the errors of `parents` (tiles of one depth, whose children's errors are set) on
 // s.threads threads, each tile's on one, so the figures do not depend on the threads. Memory:
-// a quarter of the budget for the tiles read back (TileCache), and per thread a tile, its
-// children and the triangles of their neighbours near them.
+// an eighth of the budget for the tiles read back (TileCache), and per thread a tile, its
+// children twice (as samples, and with their neighbours' triangles near the tile, indexed).
 void measure_errors(const std::vector<Node*>& parents, const Tree& tree, const Cube& cube, const std::string& root,
                     const TilesSettings& s, ProgressSink& progress) {
-    TileCache cache(tree, root, s.read.memory_budget_bytes / 4);
+    TileCache cache(tree, root, s.read.memory_budget_bytes / 8);
     std::atomic<size_t> next{0}, done{0};
     std::atomic<bool> stop{false};
     std::exception_ptr failure;
@@ -822,7 +830,7 @@ TilesResult tile_file(const TilesSettings& s, ProgressSink& progress) {
     std::vector<uint64_t> region;
     {
         StepProgress step(progress, "leaves");
-        CellCounts counts(s.read.memory_budget_bytes / 4);
+        CellCounts counts(s.read.memory_budget_bytes * 3 / 16);
         writer.sort(input, input_format, &counts, step, &result.warnings, &result);
         if (counts.empty()) throw io::Error(s.input, "no triangle to tile");
         const std::vector<std::pair<uint32_t, uint64_t>> cells = counts.sorted();

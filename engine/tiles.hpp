@@ -21,9 +21,11 @@
 // bounding cube). Every three depths a subtree goes to a tileset file of its own
 // (tiles/<depth>/<cell>.json, an external tileset), so no JSON file grows with the input.
 //
-// Memory: the decimations' (engine/decimate.hpp) within the reader's memory budget, the sorts'
-// half of it, up to three tiles per thread in the glTF writers, one tile and its children in
-// the error measure, and the octree's cell counts (a quarter of the budget). Disk: a sorted copy
+// Memory, within the reader's memory budget: while the input is read, the sort's 3/8, the
+// cell counts' 3/16 and the reader's 3/16; then up to three tiles per thread in the glTF
+// writers; the decimations' (engine/decimate.hpp; their buffers a third of the budget); in the
+// error measure an eighth for the tiles read back and, per thread, a tile's children twice
+// (a few times `tile_triangles` triangles). Disk: a sorted copy
 // of the input and the level meshes in meshstream's triangle stream and the sorts' runs in the
 // temporary directory, and the tileset itself, built beside OUTDIR and renamed into place when
 // complete; nothing is left of either on an error or a cancel.
