@@ -84,6 +84,11 @@ struct Box {
     void add(const Box& b) {
         for (int a = 0; a < 3; ++a) min[a] = std::min(min[a], b.min[a]), max[a] = std::max(max[a], b.max[a]);
     }
+    bool meets(const Box& b) const {
+        for (int a = 0; a < 3; ++a)
+            if (min[a] > b.max[a] || max[a] < b.min[a]) return false;
+        return true;
+    }
     double diagonal() const {
         if (empty()) return 0;
         double d = 0;
@@ -634,9 +639,7 @@ void append_within(const std::vector<float>& xyz, const Box& crop, std::vector<f
     for (size_t t = 0; t < xyz.size(); t += 9) {
         Box b;
         for (int c = 0; c < 3; ++c) b.add(&xyz[t + 3 * size_t(c)]);
-        bool meets = true;
-        for (int a = 0; a < 3; ++a) meets = meets && b.min[a] <= crop.max[a] && b.max[a] >= crop.min[a];
-        if (meets) out.insert(out.end(), &xyz[t], &xyz[t] + 9);
+        if (b.meets(crop)) out.insert(out.end(), &xyz[t], &xyz[t] + 9);
     }
 }
 
@@ -686,10 +689,7 @@ double tile_error(const Node& n, const Tree& tree, const Cube& cube, TileCache& 
             const bool drawn = other.depth == depth || (other.leaf && other.depth < depth);
             if (!drawn || other.uri.empty() || other.box.empty() || int(o) == id) continue;
             if (std::find(n.child.begin(), n.child.end(), int(o)) != n.child.end()) continue;  // in `side`
-            bool meets = true;
-            for (int a = 0; a < 3; ++a)
-                meets = meets && other.box.min[a] <= model.max[a] && other.box.max[a] >= model.min[a];
-            if (meets) append_within(*cache.get(int(o)), around, side);
+            if (other.box.meets(model)) append_within(*cache.get(int(o)), around, side);
         }
         return side;
     };
