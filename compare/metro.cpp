@@ -243,18 +243,25 @@ struct BvhNode {
 };
 
 // Builds a BVH over n primitives whose boxes `box(i, lo, hi)` gives. Returns the nodes and
-// writes the primitive order into `order` (the caller permutes its data by it).
+// writes the primitive order into `order` (the caller permutes its data by it). Top down: each
+// node's primitives are split at the median centroid along the longest axis of their
+// centroids' box, down to `leaf_size`; the boxes are then set bottom up. The split works on a
+// contiguous array of (centroid, primitive) and each primitive's box is computed once.
 template <class BoxFn>
 std::vector<BvhNode> build_bvh(uint32_t n, BoxFn box, uint32_t leaf_size, std::vector<uint32_t>& order) {
     std::vector<BvhNode> nodes;
     order.resize(n);
-    for (uint32_t i = 0; i < n; ++i) order[i] = i;
     if (n == 0) return nodes;
-    std::vector<float> centroid(size_t{3} * n);
+    struct Item {
+        float c[3];
+        uint32_t i;
+    };
+    std::vector<Item> items(n);
     for (uint32_t i = 0; i < n; ++i) {
         float lo[3], hi[3];
         box(i, lo, hi);
-        for (int a = 0; a < 3; ++a) centroid[3 * size_t{i} + a] = 0.5f * (lo[a] + hi[a]);
+        for (int a = 0; a < 3; ++a) items[i].c[a] = 0.5f * (lo[a] + hi[a]);
+        items[i].i = i;
     }
     nodes.reserve(2 * (size_t{n} / leaf_size + 1));
     nodes.push_back({});
@@ -265,41 +272,54 @@ std::vector<BvhNode> build_bvh(uint32_t n, BoxFn box, uint32_t leaf_size, std::v
     while (!stack.empty()) {
         Job job = stack.back();
         stack.pop_back();
-        float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-        float clo[3] = {INFINITY, INFINITY, INFINITY}, chi[3] = {-INFINITY, -INFINITY, -INFINITY};
-        for (uint32_t k = job.begin; k < job.end; ++k) {
-            float blo[3], bhi[3];
-            box(order[k], blo, bhi);
-            for (int a = 0; a < 3; ++a) {
-                lo[a] = std::min(lo[a], blo[a]);
-                hi[a] = std::max(hi[a], bhi[a]);
-                float c = centroid[3 * size_t{order[k]} + a];
-                clo[a] = std::min(clo[a], c);
-                chi[a] = std::max(chi[a], c);
-            }
-        }
-        BvhNode& node = nodes[job.node];
-        std::memcpy(node.lo, lo, sizeof lo);
-        std::memcpy(node.hi, hi, sizeof hi);
         if (job.end - job.begin <= leaf_size) {
-            node.first = job.begin;
-            node.count = job.end - job.begin;
+            nodes[job.node].first = job.begin;
+            nodes[job.node].count = job.end - job.begin;
             continue;
         }
+        float clo[3] = {INFINITY, INFINITY, INFINITY}, chi[3] = {-INFINITY, -INFINITY, -INFINITY};
+        for (uint32_t k = job.begin; k < job.end; ++k)
+            for (int a = 0; a < 3; ++a) {
+                clo[a] = std::min(clo[a], items[k].c[a]);
+                chi[a] = std::max(chi[a], items[k].c[a]);
+            }
         int axis = 0;
         for (int a = 1; a < 3; ++a)
             if (chi[a] - clo[a] > chi[axis] - clo[axis]) axis = a;
         uint32_t mid = job.begin + (job.end - job.begin) / 2;
-        std::nth_element(
-            order.begin() + job.begin, order.begin() + mid, order.begin() + job.end,
-            [&](uint32_t x, uint32_t y) { return centroid[3 * size_t{x} + axis] < centroid[3 * size_t{y} + axis]; });
+        std::nth_element(items.begin() + job.begin, items.begin() + mid, items.begin() + job.end,
+                         [axis](const Item& x, const Item& y) { return x.c[axis] < y.c[axis]; });
         uint32_t left = static_cast<uint32_t>(nodes.size());
-        node.first = left;
-        node.count = 0;
-        nodes.push_back({});  // invalidates `node`
+        nodes[job.node].first = left;
+        nodes[job.node].count = 0;
+        nodes.push_back({});
         nodes.push_back({});
         stack.push_back({left, job.begin, mid});
         stack.push_back({left + 1, mid, job.end});
+    }
+    for (uint32_t k = 0; k < n; ++k) order[k] = items[k].i;
+    // Children come after their parent: in reverse, every node's children are done before it.
+    for (size_t j = nodes.size(); j-- > 0;) {
+        BvhNode& node = nodes[j];
+        float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+        auto add = [&](const float blo[3], const float bhi[3]) {
+            for (int a = 0; a < 3; ++a) {
+                lo[a] = std::min(lo[a], blo[a]);
+                hi[a] = std::max(hi[a], bhi[a]);
+            }
+        };
+        if (node.count > 0) {
+            for (uint32_t k = node.first; k < node.first + node.count; ++k) {
+                float blo[3], bhi[3];
+                box(order[k], blo, bhi);
+                add(blo, bhi);
+            }
+        } else {
+            add(nodes[node.first].lo, nodes[node.first].hi);
+            add(nodes[node.first + 1].lo, nodes[node.first + 1].hi);
+        }
+        std::memcpy(node.lo, lo, sizeof lo);
+        std::memcpy(node.hi, hi, sizeof hi);
     }
     return nodes;
 }

@@ -8,6 +8,8 @@
 #include <cmath>
 #include <limits>
 #include <optional>
+#include <span>
+#include <vector>
 #include <utility>
 
 namespace meshstream::engine {
@@ -17,25 +19,55 @@ bool is_regular_file(const std::string& path) {
     return path != "-" && ::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
 }
 
+namespace {
+
+// Widens `box` by the finite coordinates of `xyz` (a NaN or inf coordinate decides nothing).
+void add_corners(io::Bounds& box, std::span<const float> xyz) {
+    for (size_t i = 0; i + 3 <= xyz.size(); i += 3)
+        for (int a = 0; a < 3; ++a)
+            if (std::isfinite(xyz[i + a])) {
+                box.min[a] = std::min(box.min[a], xyz[i + a]);
+                box.max[a] = std::max(box.max[a], xyz[i + a]);
+            }
+}
+
+}  // namespace
+
 io::Bounds input_bounds(const std::string& path, std::string_view from, const io::ReadOptions& options,
                         ProgressSink& progress) {
     io::ReadOptions positions = options;  // nothing but positions is looked at
     positions.channels = io::ChannelKinds::none();
+    positions.memory_budget_bytes = options.memory_budget_bytes / 8 * 7;  // beside the marks below
     io::Input in = io::open_input(path, from, positions);
     io::Bounds box;
     box.min.fill(std::numeric_limits<float>::infinity());
     box.max.fill(-std::numeric_limits<float>::infinity());
-    io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity);
     progress.phase("bounding box", in.reader->triangle_count());
     uint64_t done = 0;
+    // A file of vertices and faces (PLY) whose vertices' marks fit in an eighth of the budget:
+    // the faces' indices mark the vertices used, then the vertices are read in order, which is
+    // much cheaper than a triangle's corners looked up one by one. The same corners, the same box.
+    io::IndexedSource* own = in.reader->indexed();
+    if (own != nullptr && (own->vertex_count() + 7) / 8 <= options.memory_budget_bytes / 8) {
+        std::vector<uint64_t> used((own->vertex_count() + 63) / 64);
+        std::vector<uint32_t> indices;
+        while (own->next_triangles(indices, io::TriangleChunk::kDefaultCapacity)) {
+            for (uint32_t v : indices) used[v / 64] |= uint64_t{1} << (v % 64);
+            progress.update(done += indices.size() / 3, in.source->stored_offset(), in.source->stored_size());
+            if (progress.cancelled()) throw Cancelled();
+            indices.clear();
+        }
+        for (uint64_t v = 0; v < own->vertex_count(); ++v)
+            if (used[v / 64] >> (v % 64) & 1) {
+                float xyz[3];
+                own->vertex(v, xyz, nullptr);
+                add_corners(box, xyz);
+            }
+        return box;
+    }
+    io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity);
     while (in.reader->next(chunk)) {
-        auto xyz = chunk.xyz();
-        for (size_t i = 0; i < xyz.size(); i += 3)
-            for (int a = 0; a < 3; ++a)
-                if (std::isfinite(xyz[i + a])) {  // a NaN or inf corner would decide nothing
-                    box.min[a] = std::min(box.min[a], xyz[i + a]);
-                    box.max[a] = std::max(box.max[a], xyz[i + a]);
-                }
+        add_corners(box, chunk.xyz());
         progress.update(done += chunk.size(), in.source->stored_offset(), in.source->stored_size());
         if (progress.cancelled()) throw Cancelled();
     }

@@ -14,10 +14,11 @@ namespace meshstream::engine {
 // True for an existing regular file (not "-", a pipe or a device): one that can be read twice.
 bool is_regular_file(const std::string& path);
 
-// The input's bounding box: from its header when the format states it, else from a first pass
-// over the file (finite coordinates only; reported to `progress` as the phase "bounding box").
+// The input's bounding box, the box of its triangles' corners, from a pass over the file (finite
+// coordinates only; reported to `progress` as the phase "bounding box").
 // An input without finite coordinates gives min = +inf, max = -inf. Throws io::Error like
-// io::open_input.
+// io::open_input. Memory: within options.memory_budget_bytes (the reader's tables 7/8 of it; a
+// PLY's marks of the vertices its faces use, a bit a vertex, the rest when they fit there).
 io::Bounds input_bounds(const std::string& path, std::string_view from, const io::ReadOptions& options,
                         ProgressSink& progress);
 // The axis along which `box` is longest (z for an empty or flat box, the usual scan axis).

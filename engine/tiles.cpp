@@ -7,6 +7,7 @@
 #include "engine/files.hpp"
 #include "engine/units.hpp"
 #include "io/gltf.hpp"
+#include "io/pipeline.hpp"
 #include "io/triangle_input.hpp"
 #include "sort/external_sort.hpp"
 
@@ -381,13 +382,59 @@ private:
     std::exception_ptr failure_;
 };
 
+// A tile's triangles as read back from its GLB (positions as stored: y-up).
+std::vector<float> tile_positions(const std::string& path) {
+    io::ReadOptions positions;
+    positions.channels = io::ChannelKinds::none();
+    io::TriangleInput in(io::open_input(path, "glb", positions), io::BadTriangles::kKeep);
+    io::TriangleChunk chunk;
+    std::vector<float> xyz;
+    while (in.next(chunk)) xyz.insert(xyz.end(), chunk.xyz().begin(), chunk.xyz().end());
+    return xyz;
+}
+
+// Every tile's positions as a viewer gets them (read back from its GLB once, as it is written),
+// in one temporary file, for the error measure: a tile is needed again each time a tile near it
+// is measured, and then costs a read of its bytes (from the page cache, mostly), not a decode.
+// Disk: 36 bytes a triangle of every tile (the levels above the leaves add at most a third).
+class TileStore {
+public:
+    explicit TileStore(const std::string& dir) : file_(dir, "tile-positions") {}
+
+    // Thread-safe.
+    void add(int node, const std::vector<float>& xyz) {
+        const std::lock_guard<std::mutex> lock(mutex_);
+        at_[node] = {file_.size(), xyz.size()};
+        file_.write(xyz.data(), xyz.size() * sizeof(float));
+    }
+    // Makes what add() wrote readable by get(); call once the tiles of a depth are written.
+    void flush() {
+        const std::lock_guard<std::mutex> lock(mutex_);
+        file_.flush();
+    }
+    // Tile `node`'s positions (y-up), 9 floats a triangle. Thread-safe while nothing is added.
+    std::vector<float> get(int node) const {
+        const auto [offset, floats] = at_.at(node);
+        std::vector<float> xyz(floats);
+        file_.read_flushed_at(offset, xyz.data(), floats * sizeof(float));
+        return xyz;
+    }
+
+private:
+    io::TempFile file_;
+    std::mutex mutex_;
+    std::unordered_map<int, std::pair<uint64_t, size_t>> at_;  // node: byte offset, floats
+};
+
 // One level's tiles from a mesh file: its triangles sorted by cell key (sort()), then each run
 // of a tile's cell written as that tile's GLB (write()), on s.threads threads.
 class TileWriter {
 public:
     // Builds in `root`; notes name the tiles under `shown_root`, where they will be.
-    TileWriter(const TilesSettings& s, Tree& tree, const Cube& cube, const std::string& root, std::string shown_root)
-        : s_(s), tree_(tree), cube_(cube), root_(root), shown_root_(std::move(shown_root)) {}
+    // Each tile's positions go to `store` too, as read back.
+    TileWriter(const TilesSettings& s, Tree& tree, const Cube& cube, const std::string& root, std::string shown_root,
+               TileStore& store)
+        : s_(s), tree_(tree), cube_(cube), root_(root), shown_root_(std::move(shown_root)), store_(store) {}
 
     // Reads `mesh` into the sorter by cell key, counting the keys in `counts` when given.
     // Notes what the reader dropped or changed in `warnings` and the input's name and count in
@@ -433,12 +480,20 @@ public:
         sorter_.emplace(so);
         io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity, wo_.channels);
         progress.phase("sorting by cell", header.triangle_count);
-        while (in.next(chunk)) {
+        // With threads, the input is read on a thread of its own; this thread sorts (and counts).
+        const std::optional<uint64_t> file_bytes = in.source().stored_size();
+        auto add = [&](uint64_t read_so_far, uint64_t offset) {
             sorter_->add(chunk);
             if (counts != nullptr)
                 for (size_t i = 0; i < chunk.size(); ++i) counts->add(cube_.triangle_key(&chunk.xyz()[9 * i]));
-            progress.update(in.count().read, in.source().stored_offset(), in.source().stored_size());
+            progress.update(read_so_far, offset, file_bytes);
             throw_if_cancelled(progress);
+        };
+        if (s_.threads < 2) {
+            while (in.next(chunk)) add(in.count().read, in.source().stored_offset());
+        } else {
+            io::ReadAhead reader(in, chunk.capacity(), wo_.channels);
+            while (reader.next(chunk)) add(reader.count().read, reader.stored_offset());
         }
         sorter_->finish_input();
         // The material table is whole once the input is read.
@@ -567,6 +622,7 @@ private:
         tile.finish();
         notes = tile.writer->raw_notes();
         n.bytes = fs::file_size(fs::path(root_) / n.uri);
+        store_.add(job.node, tile_positions((fs::path(root_) / n.uri).string()));
     }
 
     static constexpr uint64_t kNotedTiles = 5;
@@ -577,61 +633,9 @@ private:
     const Cube& cube_;
     std::string root_;
     std::string shown_root_;
+    TileStore& store_;
     std::optional<sort::ExternalSorter> sorter_;
     io::WriteOptions wo_;
-};
-
-// A tile's triangles as read back from its GLB (positions as stored: y-up).
-std::vector<float> tile_positions(const std::string& path) {
-    std::vector<float> xyz;
-    io::TriangleInput in(io::open_input(path, "glb", {}), io::BadTriangles::kKeep);
-    io::TriangleChunk chunk;
-    while (in.next(chunk)) xyz.insert(xyz.end(), chunk.xyz().begin(), chunk.xyz().end());
-    return xyz;
-}
-
-// Tiles' positions as read back, kept for the error measure's threads, the least recently used
-// dropped past `budget_bytes` (a tile in use stays until its users let it go): the tiles of a
-// depth and their neighbours are read once each as long as the neighbourhoods of the tiles
-// measured at the same time fit.
-class TileCache {
-public:
-    using Positions = std::shared_ptr<const std::vector<float>>;
-    TileCache(const Tree& tree, std::string root, uint64_t budget_bytes)
-        : tree_(tree), root_(std::move(root)), budget_(budget_bytes) {}
-
-    Positions get(int node) {
-        {
-            const std::lock_guard<std::mutex> lock(mutex_);
-            if (auto it = entries_.find(node); it != entries_.end()) {
-                used_.splice(used_.begin(), used_, it->second.second);
-                return it->second.first;
-            }
-        }
-        Positions xyz = std::make_shared<const std::vector<float>>(
-            tile_positions((fs::path(root_) / tree_.nodes[size_t(node)].uri).string()));
-        const std::lock_guard<std::mutex> lock(mutex_);
-        if (entries_.count(node) == 0) {
-            used_.push_front(node);
-            entries_.emplace(node, std::make_pair(xyz, used_.begin()));
-            bytes_ += xyz->size() * sizeof(float);
-            while (bytes_ > budget_ && used_.size() > 1) {
-                const int last = used_.back();
-                bytes_ -= entries_.at(last).first->size() * sizeof(float);
-                entries_.erase(last);
-                used_.pop_back();
-            }
-        }
-        return xyz;
-    }
-
-private:
-    const Tree& tree_;
-    std::string root_;
-    uint64_t budget_, bytes_ = 0;
-    std::mutex mutex_;
-    std::list<int> used_;  // most recently used first
-    std::unordered_map<int, std::pair<Positions, std::list<int>::iterator>> entries_;
 };
 
 // Appends to `out` the triangles of `xyz` whose bounding box meets `crop` (both y-up).
@@ -652,7 +656,7 @@ void append_within(const std::vector<float>& xyz, const Box& crop, std::vector<f
 // above it) within `margin` (a sixteenth of the tile's cell) of the samples' box. A distance
 // beyond the margin is measured as it is to the triangles within it: never less than the true
 // one.
-double tile_error(const Node& n, const Tree& tree, const Cube& cube, TileCache& cache, const TilesSettings& s) {
+double tile_error(const Node& n, const Tree& tree, const Cube& cube, const TileStore& store, const TilesSettings& s) {
     double child_error = 0;
     bool any_child = false;
     for (int c : n.child)
@@ -666,13 +670,13 @@ double tile_error(const Node& n, const Tree& tree, const Cube& cube, TileCache& 
         std::vector<float> xyz;
         for (int c : n.child)
             if (c >= 0 && !tree.nodes[size_t(c)].uri.empty()) {
-                const TileCache::Positions part = cache.get(c);
-                xyz.insert(xyz.end(), part->begin(), part->end());
+                const std::vector<float> part = store.get(c);
+                xyz.insert(xyz.end(), part.begin(), part.end());
             }
         return xyz;
     };
     const int id = int(&n - tree.nodes.data());
-    const TileCache::Positions own = cache.get(id);
+    const std::vector<float> own = store.get(id);
     const double margin = cube.extent / double(1 << n.depth) / 16;
     // `side` and what the viewer draws with the tiles of `depth` around the samples' box.
     auto surface_near = [&](std::vector<float> side, const std::vector<float>& samples, int depth) {
@@ -689,26 +693,26 @@ double tile_error(const Node& n, const Tree& tree, const Cube& cube, TileCache& 
             const bool drawn = other.depth == depth || (other.leaf && other.depth < depth);
             if (!drawn || other.uri.empty() || other.box.empty() || int(o) == id) continue;
             if (std::find(n.child.begin(), n.child.end(), int(o)) != n.child.end()) continue;  // in `side`
-            if (other.box.meets(model)) append_within(*cache.get(int(o)), around, side);
+            if (other.box.meets(model)) append_within(store.get(int(o)), around, side);
         }
         return side;
     };
-    const uint64_t samples = std::max<uint64_t>(10000, own->size() / 9);  // about one a tile triangle
+    const uint64_t samples = std::max<uint64_t>(10000, own.size() / 9);  // about one a tile triangle
     const double from_tile =
-        compare::one_sided_hausdorff(*own, surface_near(gather_children(), *own, n.depth + 1), samples, s.seed);
+        compare::one_sided_hausdorff(own, surface_near(gather_children(), own, n.depth + 1), samples, s.seed);
     const std::vector<float> children = gather_children();
     const double from_children =
-        compare::one_sided_hausdorff(children, surface_near(*own, children, n.depth), samples, s.seed);
+        compare::one_sided_hausdorff(children, surface_near(own, children, n.depth), samples, s.seed);
     return std::max(from_tile, from_children) + child_error;
 }
 
 // Sets the errors of `parents` (tiles of one depth, whose children's errors are set) on
 // s.threads threads, each tile's on one, so the figures do not depend on the threads. Memory:
-// an eighth of the budget for the tiles read back (TileCache), and per thread a tile, its
-// children twice (as samples, and with their neighbours' triangles near the tile, indexed).
-void measure_errors(const std::vector<Node*>& parents, const Tree& tree, const Cube& cube, const std::string& root,
+// per thread a tile, its children twice (as samples, and with their neighbours' triangles near
+// the tile, indexed); the tiles are read back from `store`.
+void measure_errors(const std::vector<Node*>& parents, const Tree& tree, const Cube& cube, TileStore& store,
                     const TilesSettings& s, ProgressSink& progress) {
-    TileCache cache(tree, root, s.read.memory_budget_bytes / 8);
+    store.flush();
     std::atomic<size_t> next{0}, done{0};
     std::atomic<bool> stop{false};
     std::exception_ptr failure;
@@ -718,7 +722,7 @@ void measure_errors(const std::vector<Node*>& parents, const Tree& tree, const C
         const size_t i = stop.load() ? parents.size() : next.fetch_add(1);
         if (i >= parents.size()) return false;
         try {
-            parents[i]->error = tile_error(*parents[i], tree, cube, cache, s);
+            parents[i]->error = tile_error(*parents[i], tree, cube, store, s);
             done.fetch_add(1);
         } catch (...) {
             const std::lock_guard<std::mutex> lock(failure_mutex);
@@ -825,7 +829,8 @@ TilesResult tile_file(const TilesSettings& s, ProgressSink& progress) {
     // the counts, then each leaf's triangles written at full resolution, and all of them, in
     // cell order, as the first level's input.
     Tree tree;
-    TileWriter writer(s, tree, cube, building.path(), outdir.string());
+    TileStore store(work.path());
+    TileWriter writer(s, tree, cube, building.path(), outdir.string(), store);
     const std::string sorted_input = (fs::path(work.path()) / "input.sorted.mstream").string();
     std::vector<uint64_t> region;
     {
@@ -910,7 +915,7 @@ TilesResult tile_file(const TilesSettings& s, ProgressSink& progress) {
         std::vector<Node*> parents;
         for (Node& n : tree.nodes)
             if (n.depth == depth && !n.leaf) parents.push_back(&n);
-        measure_errors(parents, tree, cube, building.path(), s, step);
+        measure_errors(parents, tree, cube, store, s, step);
     }
 
     writer.report_notes(result.warnings);

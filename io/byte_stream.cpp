@@ -553,6 +553,10 @@ void TempFile::flush() {
 
 void TempFile::read_at(uint64_t offset, void* dst, size_t n) {
     flush();
+    read_flushed_at(offset, dst, n);
+}
+
+void TempFile::read_flushed_at(uint64_t offset, void* dst, size_t n) const {
     auto* p = static_cast<char*>(dst);
     while (n > 0) {
         ssize_t got = ::pread(fd_, p, n, static_cast<off_t>(offset));

@@ -177,6 +177,9 @@ public:
     uint64_t size() const { return offset_ + buf_.size(); }
     // Reads n bytes at `offset` (pread), flushing pending writes first. Throws on short read.
     void read_at(uint64_t offset, void* dst, size_t n);
+    // The same of what was flushed, without flushing: safe on several threads at once while
+    // nothing is written.
+    void read_flushed_at(uint64_t offset, void* dst, size_t n) const;
 
 private:
     std::string path_;
