@@ -378,12 +378,8 @@ ClosedHole closed_hole(const HalfEdgeBuffer& buffer, uint32_t h) {
     if (qa == kNoIndex) return out;
     const uint32_t a = buffer.corner_vertex(next_in_face(qa));
     if (a == buffer.corner_vertex(prev_in_face(h)) || a == p) return out;
-    // a's open edges must be final: off P_in, and manifold (its fans are known). Only a hole
-    // through a vertex where loops touch closes: elsewhere a hole of three edges costs one face,
-    // and meshes without touching loops decimate as before.
-    const uint16_t a_flags = buffer.vertex(a).flags;
-    if ((a_flags & (kInHash | kNonManifold)) != 0) return out;
-    if (((a_flags | buffer.vertex(p).flags | buffer.vertex(q).flags) & kManyFans) == 0) return out;
+    // a's open edges must be final: off P_in, and manifold (its fans are known).
+    if ((buffer.vertex(a).flags & (kInHash | kNonManifold)) != 0) return out;
     const uint32_t ap = fan_end(buffer, a, next_in_face(qa));
     if (ap == kNoIndex || buffer.corner_vertex(next_in_face(ap)) != p) return out;
     out.a = a;
