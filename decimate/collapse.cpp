@@ -53,19 +53,6 @@ Edge edge_of(const HalfEdgeBuffer& buffer, uint32_t h) {
     return e;
 }
 
-// The open half-edge out of v that ends the fan of `from` (a half-edge out of v), walking
-// round v away from from's twin (e → next(twin(e))); kNoIndex when the fan ends at a written or
-// non-manifold edge, or the walk passes v's face count (a closed fan).
-uint32_t fan_end(const HalfEdgeBuffer& buffer, uint32_t v, uint32_t from) {
-    uint32_t e = from;
-    for (uint32_t steps = 0; steps <= buffer.vertex(v).face_count; ++steps) {
-        const uint32_t t = buffer.twin(e);
-        if (!is_half_edge(t)) return t == kOpenEdge ? e : kNoIndex;
-        e = next_in_face(t);
-    }
-    return kNoIndex;
-}
-
 }  // namespace
 
 bool moves_keep_faces_valid(const HalfEdgeBuffer& buffer, uint32_t v, const double from[3], const double to[3],
@@ -370,21 +357,26 @@ bool may_double_written_edge(const HalfEdgeBuffer& buffer, const Edge& e) {
 }  // namespace
 
 ClosedHole closed_hole(const HalfEdgeBuffer& buffer, uint32_t h) {
-    // From q round its fan to the loop's next open edge q→a, from a round its fan to a→b: the
-    // loop is p→q→a→p when b = p. a = r is the face of h itself (a lone triangle), no hole.
+    // An open half-edge q→a out of q and an open a→p out of a: the three open half-edges form a
+    // cycle. Searched in the corner lists, not by walking fans: where loops touch at q or a, the
+    // cycle passes from one fan to another there. a = r is the face of h itself (a lone
+    // triangle), no hole.
     ClosedHole out;
     const uint32_t p = buffer.corner_vertex(h), q = buffer.corner_vertex(next_in_face(h));
-    const uint32_t qa = fan_end(buffer, q, next_in_face(h));
-    if (qa == kNoIndex) return out;
-    const uint32_t a = buffer.corner_vertex(next_in_face(qa));
-    if (a == buffer.corner_vertex(prev_in_face(h)) || a == p) return out;
-    // a's open edges must be final: off P_in, and manifold (its fans are known).
-    if ((buffer.vertex(a).flags & (kInHash | kNonManifold)) != 0) return out;
-    const uint32_t ap = fan_end(buffer, a, next_in_face(qa));
-    if (ap == kNoIndex || buffer.corner_vertex(next_in_face(ap)) != p) return out;
-    out.a = a;
-    out.qa = qa;
-    out.ap = ap;
+    const uint32_t r = buffer.corner_vertex(prev_in_face(h));
+    for (uint32_t c = buffer.vertex(q).first_corner; c != kNoIndex; c = buffer.next_corner(c)) {
+        if (buffer.twin(c) != kOpenEdge) continue;
+        const uint32_t a = buffer.corner_vertex(next_in_face(c));
+        // a's open edges must be final: off P_in, and manifold (its fans are known).
+        if (a == r || a == p || (buffer.vertex(a).flags & (kInHash | kNonManifold)) != 0) continue;
+        for (uint32_t d = buffer.vertex(a).first_corner; d != kNoIndex; d = buffer.next_corner(d))
+            if (buffer.twin(d) == kOpenEdge && buffer.corner_vertex(next_in_face(d)) == p) {
+                out.a = a;
+                out.qa = c;
+                out.ap = d;
+                return out;
+            }
+    }
     return out;
 }
 
