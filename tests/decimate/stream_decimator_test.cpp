@@ -400,8 +400,8 @@ TEST(StreamDecimator, BadTopologyIsFrozenAndPassedThrough) {
 // each: chains of holes of four edges whose loops touch at the chained cells' shared corners, as
 // a low-poly model's boundary loops do. Once those holes had shrunk to three edges nothing on
 // them could collapse, the touching vertices never moved, and the decimator stopped far above
-// its target with most of the sheet's area gone to the few collapses left (before closing
-// holes of three edges: 22 % above the target, RMS 1.5 % of the diagonal).
+// its target (before closing holes of three edges: 1 822 triangles for a target of 603, 1 782
+// boundary edges, over two thirds of the input's, RMS 0.24 % of the diagonal).
 TEST(StreamDecimator, Issue40_ChainsOfTouchingHolesReachTheTargetAndClose) {
     constexpr int kCells = 60;
     auto point = [](int i, int j, float* out) {
@@ -442,7 +442,7 @@ TEST(StreamDecimator, Issue40_ChainsOfTouchingHolesReachTheTargetAndClose) {
     const meshstream::compare::CompareResult r =
         meshstream::compare::compare_meshes(meshstream::compare::memory_source("sheet", soup),
                                             meshstream::compare::memory_source("decimated", d.xyz), co);
-    // Measured 0.05 % (CGAL's edge_collapse 0.07 % on a 92-cell sheet of the same pattern).
+    // Measured 0.11 %.
     EXPECT_LT(100.0 * r.rms() / r.diagonal, 0.15);
 }
 
