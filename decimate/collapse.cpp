@@ -34,10 +34,12 @@ void sub(const double a[3], const double b[3], double out[3]) {
 double dot(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
 // The corners around h = p→q: p, q, r (opposite h) and s (opposite the twin; kNoIndex on a
-// boundary edge).
+// boundary edge); on a hole of three edges p→q→a→p (closed_hole), a and the open half-edges
+// q→a and a→p, which the collapse makes twins.
 struct Edge {
     uint32_t p, q, r, s, t;
     bool boundary;
+    ClosedHole hole;
 };
 Edge edge_of(const HalfEdgeBuffer& buffer, uint32_t h) {
     Edge e;
@@ -47,6 +49,7 @@ Edge edge_of(const HalfEdgeBuffer& buffer, uint32_t h) {
     e.t = buffer.twin(h);
     e.boundary = !is_half_edge(e.t);
     e.s = e.boundary ? kNoIndex : buffer.corner_vertex(prev_in_face(e.t));
+    e.hole = e.t == kOpenEdge ? closed_hole(buffer, h) : ClosedHole{};
     return e;
 }
 
@@ -273,7 +276,9 @@ bool collapses_tetrahedron(const HalfEdgeBuffer& buffer, const Edge& e) {
 }
 
 bool pinches_link(HalfEdgeBuffer& buffer, const Edge& e) {
-    auto other = [&](uint32_t x) { return x != e.p && x != e.q && x != e.r && x != e.s; };
+    // The third corner of a hole of three edges is a common neighbour the collapse may keep: the
+    // edges p–a and q–a become one, with a face on each side (closes_hole_badly checks them).
+    auto other = [&](uint32_t x) { return x != e.p && x != e.q && x != e.r && x != e.s && x != e.hole.a; };
     const Vertex& vp = buffer.vertex(e.p);
     const Vertex& vq = buffer.vertex(e.q);
     if (vq.face_count <= kMaxRing) {
@@ -323,6 +328,16 @@ bool pinches_link(HalfEdgeBuffer& buffer, const Edge& e) {
     return false;
 }
 
+bool closes_hole_badly(const HalfEdgeBuffer& buffer, const Edge& e) {
+    // The faces on q→a and a→p end up back to back when they share their third corner (a
+    // tetrahedron open at p, q, a would fold into two faces); and a seam corner (attribute_store.hpp)
+    // would join corners across the new edge whose values were never compared.
+    if (e.hole.a == kNoIndex) return false;
+    const uint32_t x = buffer.corner_vertex(prev_in_face(e.hole.qa)), y = buffer.corner_vertex(prev_in_face(e.hole.ap));
+    if (x == y) return true;
+    return ((buffer.vertex(e.p).flags | buffer.vertex(e.q).flags | buffer.vertex(e.hole.a).flags) & kSeam) != 0;
+}
+
 bool may_double_written_edge(const HalfEdgeBuffer& buffer, const Edge& e) {
     // Into a written q: p's other written neighbours y would gain an edge q–y, which the
     // written mesh may already hold (two P_out stretches meeting, a written triangle q, y, z
@@ -341,6 +356,31 @@ bool may_double_written_edge(const HalfEdgeBuffer& buffer, const Edge& e) {
 
 }  // namespace
 
+ClosedHole closed_hole(const HalfEdgeBuffer& buffer, uint32_t h) {
+    // An open half-edge q→a out of q and an open a→p out of a: the three open half-edges form a
+    // cycle. Searched in the corner lists, not by walking fans: where loops touch at q or a, the
+    // cycle passes from one fan to another there. a = r is the face of h itself (a lone
+    // triangle), no hole.
+    ClosedHole out;
+    const uint32_t p = buffer.corner_vertex(h), q = buffer.corner_vertex(next_in_face(h));
+    const uint32_t r = buffer.corner_vertex(prev_in_face(h));
+    for (uint32_t c = buffer.vertex(q).first_corner; c != kNoIndex; c = buffer.next_corner(c)) {
+        if (buffer.twin(c) != kOpenEdge) continue;
+        const uint32_t a = buffer.corner_vertex(next_in_face(c));
+        // a's open edges must be final: off P_in, and manifold (its fans are known).
+        if (a == r || a == p || (buffer.vertex(a).flags & (kInHash | kNonManifold)) != 0) continue;
+        for (uint32_t d = buffer.vertex(a).first_corner; d != kNoIndex; d = buffer.next_corner(d))
+            if (buffer.twin(d) == kOpenEdge && buffer.corner_vertex(next_in_face(d)) == p) {
+                out.a = a;
+                out.qa = c;
+                out.ap = d;
+                return out;
+            }
+    }
+    return out;
+}
+
+bool closes_hole_badly(const HalfEdgeBuffer& buffer, uint32_t h) { return closes_hole_badly(buffer, edge_of(buffer, h)); }
 bool shares_apex(const HalfEdgeBuffer& buffer, uint32_t h) { return shares_apex(edge_of(buffer, h)); }
 bool collapses_tetrahedron(const HalfEdgeBuffer& buffer, uint32_t h) {
     return collapses_tetrahedron(buffer, edge_of(buffer, h));
@@ -397,7 +437,7 @@ bool collapse_valid(HalfEdgeBuffer& buffer, uint32_t h) {
 bool collapse_valid(HalfEdgeBuffer& buffer, uint32_t h, const double target[3]) {
     const PhaseTimer timer(Phase::kValidate);
     const Edge e = edge_of(buffer, h);
-    if (shares_apex(e) || collapses_tetrahedron(buffer, e) || pinches_link(buffer, e) ||
+    if (shares_apex(e) || collapses_tetrahedron(buffer, e) || closes_hole_badly(buffer, e) || pinches_link(buffer, e) ||
         may_double_written_edge(buffer, e))
         return false;
     const uint32_t skip1 = e.boundary ? kNoIndex : face_of(e.t);
@@ -468,6 +508,16 @@ void apply_collapse(HalfEdgeBuffer& buffer, uint32_t h) {
     buffer.vertex(e.q).open_edges += vp.open_edges;
     vp.open_edges = 0;
     buffer.free_vertex(e.p);
+    if (e.hole.a != kNoIndex) {
+        // The hole p→q→a closes: a→p is a→q now, the twin of q→a. q and a may have gained a
+        // closed fan, or lost one of several: their fans are walked again.
+        buffer.set_twin(e.hole.qa, e.hole.ap);
+        buffer.set_twin(e.hole.ap, e.hole.qa);
+        opened(e.q, -2);
+        opened(e.hole.a, -2);
+        buffer.classify_fans(e.q);
+        buffer.classify_fans(e.hole.a);
+    }
     // An ear collapse can leave a vertex without faces.
     for (uint32_t v : {e.q, e.r, e.s}) {
         if (v == kNoIndex) continue;

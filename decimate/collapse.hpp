@@ -92,12 +92,27 @@ CollapsePlacement collapse_placement(const HalfEdgeBuffer& buffer, uint32_t h);
 // no minimum: the best of q, p and their midpoint.
 CollapsePlacement singular_merge(const HalfEdgeBuffer& buffer, const Quadric& sum, uint32_t p, uint32_t q);
 
+// A hole of three edges (beyond the paper, as meshoptimizer's simplifier lets it happen): when
+// the open half-edge h = p→q lies on a hole p→q→a→p, off P_in at all three corners, its collapse
+// closes the hole, making a→p (then a→q) and q→a twins; the link condition lets a pass as a
+// common neighbour of p and q. Small holes shrink to three edges and then stayed: where loops
+// touch at vertices (low-poly models) they kept the touching vertices from ever moving, and
+// many small holes held much of a 10 % budget. Its boundary planes price the closing like any
+// other collapse. `a` is kNoIndex when h is on no such hole (or h is a lone triangle's edge).
+struct ClosedHole {
+    uint32_t a = kNoIndex;
+    uint32_t qa = kNoIndex, ap = kNoIndex;  // the open half-edges q→a and a→p
+};
+ClosedHole closed_hole(const HalfEdgeBuffer& buffer, uint32_t h);
+
 // The vetoes: an eligible collapse h = p→q with the merged vertex at `target` (relative
 // coordinates) is refused when
 //  - the faces on the edge share their third vertex (r == s: two faces back to back);
+//  - it closes a hole of three edges (closed_hole) whose faces on q→a and a→p share their third
+//    vertex (they would end up back to back), or at a seam vertex (kSeam);
 //  - it would collapse a tetrahedron (p and q in three faces each, the edge interior);
-//  - p and q have a common neighbour besides r and s (the link condition, Dey et al.;
-//    Hoppe's edge collapse legality): the mesh would pinch there;
+//  - p and q have a common neighbour besides r, s and a closed hole's third corner (the link
+//    condition, Dey et al.; Hoppe's edge collapse legality): the mesh would pinch there;
 //  - q is written and p has another written neighbour: the new edge may already be in the
 //    output, where the link condition, which sees only in-core edges, cannot find it;
 //  - a remaining face of p (or of q, when q moves) would flip, fold or degenerate
@@ -106,6 +121,7 @@ CollapsePlacement singular_merge(const HalfEdgeBuffer& buffer, const Quadric& su
 // (kOpenFans), whose faces the link condition walks all of: a face of another fan on p and q
 // would have a third corner next to both.
 bool shares_apex(const HalfEdgeBuffer& buffer, uint32_t h);
+bool closes_hole_badly(const HalfEdgeBuffer& buffer, uint32_t h);
 bool collapses_tetrahedron(const HalfEdgeBuffer& buffer, uint32_t h);
 bool pinches_link(HalfEdgeBuffer& buffer, uint32_t h);
 bool may_double_written_edge(const HalfEdgeBuffer& buffer, uint32_t h);
@@ -127,8 +143,9 @@ bool moves_keep_faces_valid(const HalfEdgeBuffer& buffer, uint32_t v, const doub
                             uint32_t skip0, uint32_t skip1);
 
 // Performs the collapse p→q: removes the one or two faces on the edge, re-links their outer
-// neighbours, moves p's corners to q and adds Q_p to Q_q, frees p, and moves q to `target`
-// (when it differs from q's position). Vertices whose open edges changed are listed for
+// neighbours, moves p's corners to q and adds Q_p to Q_q, frees p, closes a hole of three edges
+// (closed_hole: q's and a's fans walked again, HalfEdgeBuffer::classify_fans), and moves q to
+// `target` (when it differs from q's position). Vertices whose open edges changed are listed for
 // rating (mark_pending). Precondition: collapse_valid(buffer, h, target), and q free
 // (collapse_target_free) unless target is q's position.
 void apply_collapse(HalfEdgeBuffer& buffer, uint32_t h, const double target[3]);

@@ -448,7 +448,7 @@ void HalfEdgeBuffer::finalize_vertex(uint32_t v) {
     // A vertex where two fans touch is no manifold vertex: it moves only when every fan is open
     // (boundary loops touching there, collapse.hpp). Finding out now, once, spares every
     // collapse the walks.
-    if (!one_fan(v)) x.flags |= open_fans(v) ? kManyFans | kOpenFans : kManyFans;
+    classify_fans(v);
     mark_pending(v);
 }
 

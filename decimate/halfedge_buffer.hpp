@@ -185,6 +185,14 @@ public:
     // Marks the vertex written (P_out) with output id `id`, and lists it for take_pending()
     // (collapses into it are rated differently now).
     void freeze(uint32_t v, uint64_t id);
+    // Walks v's fans again and sets kManyFans (its faces are not one fan) and kOpenFans (with
+    // it: every fan open) as they are now; finalize_vertex() does so once, and a collapse that
+    // closes a hole (collapse.hpp, closed_hole) where the fans at v have changed.
+    void classify_fans(uint32_t v) {
+        Vertex& x = slots_[v].vertex;
+        x.flags &= ~(kManyFans | kOpenFans);
+        if (x.face_count > 0 && !one_fan(v)) x.flags |= open_fans(v) ? kManyFans | kOpenFans : kManyFans;
+    }
     // Removes face f from the vertex lists and frees it. Twins and open-edge counts are the
     // caller's business. Vertices left without faces are not freed here.
     void detach_face(uint32_t f);

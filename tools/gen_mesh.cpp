@@ -5,7 +5,9 @@
 // inside random spheres (scan occlusions); --touching-holes keeps, inside the same spheres, the
 // triangles of every other grid cell (a 3D checkerboard): cells that share a grid edge keep the
 // surface vertex on it, so the patches' boundary loops touch at shared vertices, as hand-made
-// and CAD-exported low-poly models' do; --shuffle writes the triangles in random order,
+// and CAD-exported low-poly models' do; --hole-chains removes single cells along diagonal
+// chains all over the surface, small holes whose loops touch where chained cells share a grid
+// edge (a long boundary, as a low-poly model's); --shuffle writes the triangles in random order,
 // out of core (random buckets in temporary files, each shuffled in memory). --color gives every
 // corner an 8-bit RGB colour that is a function of its position (colour_at): smooth bands, and
 // one sharp border (a plane across the solid) where warm colours meet cool ones, so welded
@@ -190,6 +192,13 @@ struct Hole {
     bool checker = false;  // keeps the cells whose i + j + k is even (--touching-holes)
 };
 
+// --hole-chains: cell (i, j, k) loses its triangles when i − j is a multiple of this and k is
+// even. Cells (i, j, k) and (i + 1, j + 1, k) share the grid edge along z between them, whose
+// surface vertex both holes' loops pass through; cells of one chain share no face, so the holes
+// stay apart. 12 gives about 1 300 boundary edges at 17 000 triangles.
+constexpr int kChainPeriod = 12;
+bool on_chain(int i, int j, int k) { return (i - j) % kChainPeriod == 0 && (k & 1) == 0; }
+
 std::vector<Hole> make_holes(uint64_t seed, int count, bool checker) {
     Rng rng{seed ^ 0x484f4c4553ull};
     std::vector<Hole> holes;
@@ -207,8 +216,8 @@ std::vector<Hole> make_holes(uint64_t seed, int count, bool checker) {
 // Marches slabs [k_begin, k_end) of an n³ grid over [-1, 1]³ along z, passing each triangle
 // (9 floats) to `emit`; returns the number of triangles emitted.
 template <class Emit>
-uint64_t march(const CaseTable& table, const Shape& shape, int n, const std::vector<Hole>& holes, int k_begin,
-               int k_end, Emit emit) {
+uint64_t march(const CaseTable& table, const Shape& shape, int n, const std::vector<Hole>& holes, bool chains,
+               int k_begin, int k_end, Emit emit) {
     AxisTable X(shape, 0, n), Y(shape, 1, n), Z(shape, 2, n);
     const float h = 2.0f / float(n);
     const size_t stride = size_t(n) + 1;
@@ -276,6 +285,7 @@ uint64_t march(const CaseTable& table, const Shape& shape, int n, const std::vec
                         }
                         std::memcpy(&tri[3 * v], vertex[e], sizeof vertex[e]);
                     }
+                    if (chains && on_chain(i, j, k)) continue;
                     if (!holes.empty()) {
                         float cx = (tri[0] + tri[3] + tri[6]) / 3, cy = (tri[1] + tri[4] + tri[7]) / 3,
                               cz = (tri[2] + tri[5] + tri[8]) / 3;
@@ -299,10 +309,11 @@ uint64_t march(const CaseTable& table, const Shape& shape, int n, const std::vec
 
 // Grid resolution for about `target` triangles: surface triangles grow like n², so scale from
 // counting passes at lower resolutions (each at most ~2 M triangles, a fraction of a second).
-int resolution_for(const CaseTable& table, const Shape& shape, const std::vector<Hole>& holes, uint64_t target) {
+int resolution_for(const CaseTable& table, const Shape& shape, const std::vector<Hole>& holes, bool chains,
+                   uint64_t target) {
     constexpr double kCountCap = 4e5;
     auto count_at = [&](int n) {
-        return double(std::max<uint64_t>(march(table, shape, n, holes, 0, n, [](const float*) {}), 1));
+        return double(std::max<uint64_t>(march(table, shape, n, holes, chains, 0, n, [](const float*) {}), 1));
     };
     int n = 48;
     double count = count_at(n);
@@ -320,7 +331,7 @@ int resolution_for(const CaseTable& table, const Shape& shape, const std::vector
 // buffer, while the calling thread hands the bands to `emit` in slab order: the output is the
 // same as a single-threaded march. Memory: at most 2 × threads bands of triangles.
 template <class Emit>
-uint64_t march_parallel(const CaseTable& table, const Shape& shape, int n, const std::vector<Hole>& holes,
+uint64_t march_parallel(const CaseTable& table, const Shape& shape, int n, const std::vector<Hole>& holes, bool chains,
                         unsigned threads, Emit emit) {
     constexpr int kBandSlabs = 4;
     const int bands = (n + kBandSlabs - 1) / kBandSlabs;
@@ -344,7 +355,7 @@ uint64_t march_parallel(const CaseTable& table, const Shape& shape, int n, const
             }
             local.clear();
             int k0 = band * kBandSlabs, k1 = std::min(n, k0 + kBandSlabs);
-            march(table, shape, n, holes, k0, k1, [&](const float* tri) { local.insert(local.end(), tri, tri + 9); });
+            march(table, shape, n, holes, chains, k0, k1, [&](const float* tri) { local.insert(local.end(), tri, tri + 9); });
             std::lock_guard lock(mutex);
             Slot& slot = ring[size_t(band) % ring.size()];
             slot.xyz.swap(local);
@@ -389,7 +400,7 @@ struct GenOptions {
     std::string output, to;
     uint64_t triangles = 1'000'000;
     uint64_t seed = 1;
-    bool shuffle = false, holes = false, touching_holes = false, quiet = false, color = false;
+    bool shuffle = false, holes = false, touching_holes = false, hole_chains = false, quiet = false, color = false;
     unsigned threads = 0;  // 0: one per core
     std::string tmpdir;
 };
@@ -412,7 +423,7 @@ int run(const GenOptions& opt) {
     Shape shape(opt.seed);
     std::vector<Hole> holes;
     if (opt.holes || opt.touching_holes) holes = make_holes(opt.seed, 40, opt.touching_holes);
-    int n = resolution_for(table, shape, holes, opt.triangles);
+    int n = resolution_for(table, shape, holes, opt.hole_chains, opt.triangles);
     unsigned threads = opt.threads ? opt.threads : std::max(1u, std::thread::hardware_concurrency());
 
     io::WriteOptions wo;
@@ -433,7 +444,7 @@ int run(const GenOptions& opt) {
     };
     uint64_t count = 0;
     if (!opt.shuffle) {
-        count = march_parallel(table, shape, n, holes, threads, [&](const float* tri) {
+        count = march_parallel(table, shape, n, holes, opt.hole_chains, threads, [&](const float* tri) {
             std::memcpy(chunk.push_slot(), tri, 9 * sizeof(float));
             colour_last();
             if (chunk.full()) flush();
@@ -447,7 +458,7 @@ int run(const GenOptions& opt) {
         for (size_t b = 0; b < buckets; ++b)
             files.push_back(std::make_unique<io::TempFile>(opt.tmpdir, "meshstream-gen"));
         Rng rng{opt.seed ^ 0x53485546ull};
-        count = march_parallel(table, shape, n, holes, threads,
+        count = march_parallel(table, shape, n, holes, opt.hole_chains, threads,
                                [&](const float* tri) { files[rng.next() % buckets]->write(tri, 9 * sizeof(float)); });
         // One allocation for the largest bucket: growing the vector from bucket to bucket held
         // two buckets at once while it copied (251 MB for 10 M triangles, now 134).
@@ -473,9 +484,9 @@ int run(const GenOptions& opt) {
     out.finish();
     double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (!opt.quiet)
-        std::fprintf(stderr, "meshstream-gen: %llu triangles (grid %d³%s%s%s) in %.2f s, %.2f M triangles/s -> %s\n",
+        std::fprintf(stderr, "meshstream-gen: %llu triangles (grid %d³%s%s%s%s) in %.2f s, %.2f M triangles/s -> %s\n",
                      (unsigned long long)count, n, opt.touching_holes ? ", touching holes" : opt.holes ? ", holes" : "",
-                     opt.shuffle ? ", shuffled" : "",
+                     opt.hole_chains ? ", hole chains" : "", opt.shuffle ? ", shuffled" : "",
                      opt.color ? ", coloured" : "", seconds, double(count) / seconds / 1e6, opt.output.c_str());
     return 0;
 }
@@ -521,6 +532,8 @@ int main(int argc, char** argv) {
     app.add_flag("--touching-holes", opt.touching_holes,
                  "the holes of --holes keep every other grid cell: boundary loops that touch\n"
                  "at shared vertices, as hand-made and CAD-exported low-poly models have them");
+    app.add_flag("--hole-chains", opt.hole_chains,
+                 "one-cell holes in diagonal chains everywhere: loops touching at vertices");
     app.add_flag("--color", opt.color,
                  "an 8-bit RGB colour per corner from its position: smooth bands, a sharp border\n"
                  "For formats that hold vertex colours (PLY, OBJ, Draco, glTF)");

@@ -1,6 +1,6 @@
 // Tests of decimate/collapse: the boundary rules of §4 (which half-edges may collapse), boundary
-// loops that touch at a vertex, the link condition, and that collapses keep the half-edge
-// structure consistent.
+// loops that touch at a vertex, holes of three edges that close, the link condition, and that
+// collapses keep the half-edge structure consistent.
 #include "decimate/collapse.hpp"
 #include "decimate/greedy.hpp"
 
@@ -694,4 +694,76 @@ TEST(CollapseVeto, MayDoubleWrittenEdgeOnlyIntoAWrittenVertexWithAnotherWrittenN
     other.freeze(w, 2);
     other.freeze(r, 3);
     EXPECT_FALSE(may_double_written_edge(other, g));
+}
+
+// A flat 5×5 vertex grid without the face (1,1) (2,1) (2,2), or also without (2,2) (3,2) (3,3)
+// (`second`): holes of three edges, which touch at (2,2) when there are two.
+void add_triangle_holes(HalfEdgeBuffer& buffer, bool second) {
+    std::vector<std::array<int, 3>> faces;
+    for (const auto& f : grid_faces(5))
+        if (f != std::array<int, 3>{6, 7, 12} && (!second || f != std::array<int, 3>{12, 13, 18})) faces.push_back(f);
+    add_indexed(buffer, curved_grid(5, 0, 0, 0), faces);
+    buffer.finalize_all();
+}
+
+TEST(Collapse, HoleOfThreeEdgesClosesAndItsCornersBecomeInterior) {
+    HalfEdgeBuffer buffer(64, 0);
+    add_triangle_holes(buffer, false);
+    const uint32_t p = vertex_at(buffer, {2, 1, 0}), q = vertex_at(buffer, {1, 1, 0}), a = vertex_at(buffer, {2, 2, 0});
+    const uint32_t h = half_edge(buffer, p, q);  // the hole's loop runs p→q→a→p
+    ASSERT_EQ(buffer.twin(h), kOpenEdge);
+    ASSERT_TRUE(collapse_eligible(buffer, h));
+    const ClosedHole hole = closed_hole(buffer, h);
+    EXPECT_EQ(hole.a, a);
+    EXPECT_EQ(hole.qa, half_edge(buffer, q, a));
+    EXPECT_EQ(hole.ap, half_edge(buffer, a, p));
+    // a is a common neighbour of p and q besides the face's apex: the link condition alone
+    // refused this, and the hole stayed.
+    EXPECT_FALSE(closes_hole_badly(buffer, h));
+    EXPECT_FALSE(pinches_link(buffer, h));
+    ASSERT_TRUE(collapse_valid(buffer, h));
+    apply_collapse(buffer, h);
+    EXPECT_TRUE(buffer_consistent(buffer));
+    EXPECT_EQ(buffer.face_count(), 30u);
+    for (const uint32_t v : {q, a}) {
+        EXPECT_EQ(buffer.vertex(v).open_edges, 0u);
+        EXPECT_EQ(buffer.vertex(v).flags & (kManyFans | kOpenFans), 0);
+        for (uint32_t c = buffer.vertex(v).first_corner; c != kNoIndex; c = buffer.next_corner(c))
+            EXPECT_TRUE(is_half_edge(buffer.twin(c)));
+    }
+    EXPECT_EQ(buffer.twin(hole.qa), hole.ap);
+}
+
+TEST(Collapse, HoleOfThreeEdgesWhereLoopsTouchClosesAndTheFansJoin) {
+    HalfEdgeBuffer buffer(64, 0);
+    add_triangle_holes(buffer, true);
+    const uint32_t p = vertex_at(buffer, {2, 1, 0}), q = vertex_at(buffer, {1, 1, 0}), a = vertex_at(buffer, {2, 2, 0});
+    ASSERT_EQ(buffer.vertex(a).flags & (kManyFans | kOpenFans), kManyFans | kOpenFans);
+    const uint32_t h = half_edge(buffer, p, q);
+    EXPECT_EQ(closed_hole(buffer, h).a, a);
+    ASSERT_TRUE(collapse_valid(buffer, h));
+    apply_collapse(buffer, h);
+    EXPECT_TRUE(buffer_consistent(buffer));
+    // a is on the other hole alone now: one open fan, a rim vertex that slides along it.
+    EXPECT_EQ(buffer.vertex(a).flags & (kManyFans | kOpenFans), 0);
+    EXPECT_EQ(buffer.vertex(a).open_edges, 2u);
+    EXPECT_TRUE(collapse_eligible(buffer, half_edge(buffer, a, vertex_at(buffer, {3, 3, 0}))));
+}
+
+TEST(Collapse, HoleOfThreeEdgesStaysWhenItsFacesWouldEndBackToBack) {
+    // Three faces of a tetrahedron round the apex 3: the open base 0→1→2 is a hole of three
+    // edges whose faces on 1→2 and 2→0 share the apex; closing it would fold them together.
+    HalfEdgeBuffer buffer(16, 0);
+    add_indexed(buffer, {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0.3f, 0.3f, 1}}, {{0, 1, 3}, {1, 2, 3}, {2, 0, 3}});
+    buffer.finalize_all();
+    const uint32_t h = half_edge(buffer, vertex_at(buffer, {0, 0, 0}), vertex_at(buffer, {1, 0, 0}));
+    ASSERT_TRUE(collapse_eligible(buffer, h));
+    EXPECT_EQ(closed_hole(buffer, h).a, vertex_at(buffer, {0, 1, 0}));
+    EXPECT_TRUE(closes_hole_badly(buffer, h));
+    EXPECT_FALSE(collapse_valid(buffer, h));
+    // A lone triangle's edge is on no hole.
+    HalfEdgeBuffer lone(16, 0);
+    add_indexed(lone, {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {{0, 1, 2}});
+    lone.finalize_all();
+    EXPECT_EQ(closed_hole(lone, half_edge(lone, vertex_at(lone, {0, 0, 0}), vertex_at(lone, {1, 0, 0}))).a, kNoIndex);
 }

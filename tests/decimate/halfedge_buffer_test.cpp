@@ -191,3 +191,17 @@ TEST(HalfEdgeBuffer, FinalizedOpenVertexLeavesPin) {
     buffer.finalize_all();
     EXPECT_EQ(buffer.oldest_interior_face(), 0u);
 }
+
+TEST(HalfEdgeBuffer, ClassifyFansFollowsTheFansAsTheyAreNow) {
+    // Two triangles sharing vertex 0 only: two open fans (boundary loops touching there).
+    HalfEdgeBuffer buffer(64, 0);
+    const std::vector<uint32_t> faces =
+        add_indexed(buffer, {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {-1, 0, 0}, {0, -1, 0}}, {{0, 1, 2}, {0, 3, 4}});
+    buffer.finalize_all();
+    const uint32_t centre = buffer.corner_vertex(half_edge(faces[0], 0));
+    EXPECT_EQ(buffer.vertex(centre).flags & (kManyFans | kOpenFans), kManyFans | kOpenFans);
+    // One of them gone: one fan, walked again by classify_fans.
+    buffer.detach_face(faces[1]);
+    buffer.classify_fans(centre);
+    EXPECT_EQ(buffer.vertex(centre).flags & (kManyFans | kOpenFans), 0);
+}
