@@ -82,6 +82,29 @@ compare::EdgeCounts edges_of(const std::vector<std::array<float, 9>>& tris) {
     return counter.finish();
 }
 
+// The vertices (by position) on the boundary, and of those the ones where boundary loops touch
+// (four or more boundary edges). An edge (a, b) is on the boundary when no face holds (b, a).
+struct BoundaryVertices {
+    size_t count = 0, touching = 0;
+};
+BoundaryVertices boundary_vertices(const std::vector<std::array<float, 9>>& tris) {
+    using Point = std::array<float, 3>;
+    std::map<std::pair<Point, Point>, int> directed;
+    auto corner = [](const std::array<float, 9>& t, int k) { return Point{t[3 * k], t[3 * k + 1], t[3 * k + 2]}; };
+    for (const auto& t : tris)
+        for (int k = 0; k < 3; ++k) ++directed[{corner(t, k), corner(t, (k + 1) % 3)}];
+    std::map<Point, int> edges_at;
+    for (const auto& [edge, n] : directed)
+        if (!directed.contains({edge.second, edge.first})) {
+            ++edges_at[edge.first];
+            ++edges_at[edge.second];
+        }
+    BoundaryVertices b;
+    b.count = edges_at.size();
+    for (const auto& [point, n] : edges_at) b.touching += n >= 4;
+    return b;
+}
+
 }  // namespace
 
 TEST(GenMesh, CountWithinFivePercentAndSortedAlongZ) {
@@ -131,23 +154,9 @@ TEST(GenMesh, TouchingHolesMeetAtVertices) {
     const compare::EdgeCounts e = edges_of(tris);
     EXPECT_EQ(e.non_manifold_edges, 0u);
     EXPECT_GT(tris.size(), read_all(dir.path() / "h.stl").size());
-    // Boundary edges per corner position: an edge (a, b) is on the boundary when no face
-    // holds (b, a).
-    using Point = std::array<float, 3>;
-    std::map<std::pair<Point, Point>, int> directed;
-    auto corner = [](const std::array<float, 9>& t, int k) { return Point{t[3 * k], t[3 * k + 1], t[3 * k + 2]}; };
-    for (const auto& t : tris)
-        for (int k = 0; k < 3; ++k) ++directed[{corner(t, k), corner(t, (k + 1) % 3)}];
-    std::map<Point, int> boundary_edges;
-    for (const auto& [edge, n] : directed)
-        if (!directed.contains({edge.second, edge.first})) {
-            ++boundary_edges[edge.first];
-            ++boundary_edges[edge.second];
-        }
-    size_t touching = 0;
-    for (const auto& [point, n] : boundary_edges) touching += n >= 4;
-    EXPECT_GT(touching, 50u);
-    EXPECT_GT(e.boundary_edges, boundary_edges.size());  // more boundary edges than boundary vertices
+    const BoundaryVertices b = boundary_vertices(tris);
+    EXPECT_GT(b.touching, 50u);
+    EXPECT_GT(e.boundary_edges, b.count);  // more boundary edges than boundary vertices
 }
 
 TEST(GenMesh, HoleChainsGiveALowPolyModelsBoundaryOfTouchingLoops) {
@@ -164,20 +173,7 @@ TEST(GenMesh, HoleChainsGiveALowPolyModelsBoundaryOfTouchingLoops) {
     EXPECT_EQ(e.non_manifold_edges, 0u);
     EXPECT_GT(e.boundary_edges, 1000u);
     EXPECT_LT(e.boundary_edges, 1600u);
-    using Point = std::array<float, 3>;
-    std::map<std::pair<Point, Point>, int> directed;
-    auto corner = [](const std::array<float, 9>& t, int k) { return Point{t[3 * k], t[3 * k + 1], t[3 * k + 2]}; };
-    for (const auto& t : tris)
-        for (int k = 0; k < 3; ++k) ++directed[{corner(t, k), corner(t, (k + 1) % 3)}];
-    std::map<Point, int> boundary_edges;
-    for (const auto& [edge, n] : directed)
-        if (!directed.contains({edge.second, edge.first})) {
-            ++boundary_edges[edge.first];
-            ++boundary_edges[edge.second];
-        }
-    size_t touching = 0;
-    for (const auto& [point, n] : boundary_edges) touching += n >= 4;
-    EXPECT_GT(touching, 50u);
+    EXPECT_GT(boundary_vertices(tris).touching, 50u);
 }
 
 TEST(GenMesh, ShuffleKeepsTheTrianglesInRandomOrder) {
