@@ -452,17 +452,8 @@ public:
         wo_ = io::WriteOptions{};
         wo_.tmpdir = s_.read.tmpdir;
         wo_.memory_budget_bytes = s_.read.memory_budget_bytes;
-        io::GltfSettings gs;
-        gs.compression = gltf_compression(s_.compression);
-        if (gs.compression == io::GltfSettings::Compression::kMeshopt) {
-            io::GltfSettings::Grid grid;
-            // The cube turned y-up, as the positions are: (x, z, -y).
-            grid.origin[0] = float(cube_.origin[0]);
-            grid.origin[1] = float(cube_.origin[2]);
-            grid.origin[2] = float(-(cube_.origin[1] + cube_.extent));
-            grid.extent = float(cube_.extent);
-            gs.grid = grid;
-        }
+        io::GltfSettings gs(gltf_compression(s_.compression));
+        gs.grid = grid_;  // the levels' tiles on the leaves' grid
         wo_.format_options.set(gs);
         const io::Channels wanted = s_.read.channels.of(header.channels);
         wo_.channels = io::writable_channels(glb, wanted, wo_);
@@ -507,6 +498,32 @@ public:
             result->input_format = std::string(in.format().name);
             result->triangles_in = in.count().read;
         }
+    }
+
+    // Quantizes every tile's positions on one grid over the cube, so that a position two tiles
+    // share decodes to the same float in both: meshopt's 16 bits (the most KHR_mesh_quantization
+    // holds); Draco's 14 bits over the deepest leaves' cells (its default over a mesh's own box),
+    // so 14 + `deepest` over the cube, at most 24 (a float's precision) and fewer while the
+    // writers' coding tables (4 bytes a step, one set a thread) would pass an eighth of the
+    // memory budget. Returns the step.
+    double set_grid(int deepest) {
+        io::GltfSettings gs = wo_.format_options.get<io::GltfSettings>();
+        if (gs.compression == io::GltfSettings::Compression::kNone) return 0;
+        io::GltfSettings::Grid grid;
+        // The cube turned y-up, as the positions are: (x, z, -y).
+        grid.origin[0] = float(cube_.origin[0]);
+        grid.origin[1] = float(cube_.origin[2]);
+        grid.origin[2] = float(-(cube_.origin[1] + cube_.extent));
+        grid.extent = float(cube_.extent);
+        grid.bits = 16;
+        if (gs.compression == io::GltfSettings::Compression::kDraco) {
+            grid.bits = std::min(14 + deepest, 24);
+            const uint64_t tables = s_.read.memory_budget_bytes / 8 / uint64_t(std::max(s_.threads, 1u));
+            while (grid.bits > 14 && (uint64_t{4} << grid.bits) > tables) --grid.bits;
+        }
+        gs.grid = grid_ = grid;
+        wo_.format_options.set(gs);
+        return cube_.extent / double((uint64_t{1} << grid.bits) - 1);
     }
 
     // Writes the tiles of the sorted triangles whose cell `select` picks (a node id, or -1 to
@@ -636,6 +653,7 @@ private:
     TileStore& store_;
     std::optional<sort::ExternalSorter> sorter_;
     io::WriteOptions wo_;
+    std::optional<io::GltfSettings::Grid> grid_;  // set_grid's, for every level
 };
 
 // Appends to `out` the triangles of `xyz` whose bounding box meets `crop` (both y-up).
@@ -833,6 +851,7 @@ TilesResult tile_file(const TilesSettings& s, ProgressSink& progress) {
     TileWriter writer(s, tree, cube, building.path(), outdir.string(), store);
     const std::string sorted_input = (fs::path(work.path()) / "input.sorted.mstream").string();
     std::vector<uint64_t> region;
+    double grid_step = 0;  // the quantization grid's step (0: float positions)
     {
         StepProgress step(progress, "leaves");
         CellCounts counts(s.read.memory_budget_bytes * 3 / 16);
@@ -840,6 +859,7 @@ TilesResult tile_file(const TilesSettings& s, ProgressSink& progress) {
         if (counts.empty()) throw io::Error(s.input, "no triangle to tile");
         const std::vector<std::pair<uint32_t, uint64_t>> cells = counts.sorted();
         tree.build(cells, 0, cells.size(), 0, 0, s.tile_triangles, counts.depth());
+        grid_step = writer.set_grid(tree.max_depth);
         region.assign(size_t(std::max(tree.max_depth, 1)), 0);
         writer.write(
             [&](uint32_t key) {
@@ -926,14 +946,8 @@ TilesResult tile_file(const TilesSettings& s, ProgressSink& progress) {
         for (int c : n.child)
             if (c >= 0) n.box.add(tree.nodes[size_t(c)].box);
     }
-    // Boxes cover the quantized positions too: a quantization step beyond the exact ones (the
-    // common grid's with meshopt; Draco's 14 bits over the tile's own box).
-    auto pad = [&](const Box& b) {
-        if (s.compression == TileCompression::kMeshopt) return cube.extent / 65535.0;
-        double extent = 0;
-        for (int a = 0; a < 3; ++a) extent = std::max(extent, b.max[a] - b.min[a]);
-        return s.compression == TileCompression::kDraco ? extent / 16383.0 : cube.extent * 1e-7;
-    };
+    // Boxes cover the quantized positions too: a step of the common grid beyond the exact ones.
+    const double pad = grid_step > 0 ? grid_step : cube.extent * 1e-7;
 
     // A tileset file: the tile `root` under the asset, with `error` as the tileset's.
     uint64_t json_bytes = 0;
@@ -959,7 +973,7 @@ TilesResult tile_file(const TilesSettings& s, ProgressSink& progress) {
     std::function<Json(int, const fs::path&)> tile_json = [&](int id, const fs::path& dir) {
         const Node& n = tree.nodes[size_t(id)];
         Json t;
-        t["boundingVolume"] = box_json(n.box, pad(n.box));
+        t["boundingVolume"] = box_json(n.box, pad);
         t["geometricError"] = n.error;
         if (!n.uri.empty()) t["content"] = {{"uri", fs::path(n.uri).lexically_relative(dir).generic_string()}};
         Json children = Json::array();
@@ -976,7 +990,7 @@ TilesResult tile_file(const TilesSettings& s, ProgressSink& progress) {
             sub["refine"] = "REPLACE";
             write_tileset(file, sub, child.error);
             Json reference;
-            reference["boundingVolume"] = box_json(child.box, pad(child.box));
+            reference["boundingVolume"] = box_json(child.box, pad);
             reference["geometricError"] = n.error;
             reference["content"] = {{"uri", file.lexically_relative(dir).generic_string()}};
             children.push_back(reference);

@@ -17,15 +17,17 @@
 // Content: one GLB a tile (tiles/<depth>/<cell>.glb), written on `threads` threads, positions
 // turned y-up as glTF wants them ((x, y, z) as (x, z, -y); 3D Tiles turns them back), with every
 // channel the glTF writer keeps and materials with their images embedded in each tile that uses
-// them. With meshopt compression all tiles share one quantization grid (16 bits over the
-// bounding cube). Every three depths a subtree goes to a tileset file of its own
+// them. Compressed, all tiles share one quantization grid over the bounding cube (meshopt: 16
+// bits; Draco: 14 bits over the deepest leaves' cells), so a position two tiles share decodes
+// to the same float in both. Every three depths a subtree goes to a tileset file of its own
 // (tiles/<depth>/<cell>.json, an external tileset), so no JSON file grows with the input.
 //
 // Memory, within the reader's memory budget: while the input is read, the sort's 3/8, the
 // cell counts' 3/16 and the reader's 3/16; then up to three tiles per thread in the glTF
-// writers; the decimations' (engine/decimate.hpp; their buffers a third of the budget); in the
-// error measure an eighth for the tiles read back and, per thread, a tile's children twice
-// (a few times `tile_triangles` triangles). Disk: a sorted copy
+// writers (with Draco, their coding tables within an eighth); the decimations'
+// (engine/decimate.hpp; their buffers a third of the budget); in the error measure, per
+// thread, a tile's children twice (a few times `tile_triangles` triangles, not bounded by the
+// budget). Disk: a sorted copy
 // of the input and the level meshes in meshstream's triangle stream and the sorts' runs in the
 // temporary directory, and the tileset itself, built beside OUTDIR and renamed into place when
 // complete; nothing is left of either on an error or a cancel.

@@ -422,9 +422,28 @@ int64_t first_repeated_vertex(const std::vector<uint32_t>& indices) {
     return -1;
 }
 
-DracoEncoded encode_draco(const std::vector<float>& positions, const std::vector<uint32_t>& indices,
+DracoEncoded encode_draco(const std::vector<float>& input_positions, const std::vector<uint32_t>& indices,
                           const VertexValues& values, const Channels& channels, const DracoSettings& settings,
-                          const std::string& file_name, bool flip_v) {
+                          const std::string& file_name, bool flip_v, const DracoGrid* grid) {
+    // On a grid, a position beyond it is moved onto its nearest side, as meshopt's quantizer
+    // clamps (Draco's would wrap around).
+    std::vector<float> clamped;
+    if (grid != nullptr) {
+        auto outside = [&](size_t i) {
+            const float lo = grid->origin[i % 3], hi = lo + grid->range;
+            return !(input_positions[i] >= lo && input_positions[i] <= hi);
+        };
+        for (size_t i = 0; i < input_positions.size(); ++i)
+            if (outside(i)) {
+                clamped = input_positions;
+                for (size_t k = i; k < clamped.size(); ++k) {
+                    const float lo = grid->origin[k % 3], hi = lo + grid->range;
+                    clamped[k] = std::clamp(clamped[k], lo, hi);
+                }
+                break;
+            }
+    }
+    const std::vector<float>& positions = clamped.empty() ? input_positions : clamped;
     // Draco's encoder drops triangles with a repeated vertex: left out here, so they are counted.
     std::vector<uint32_t> kept;
     kept.reserve(indices.size());
@@ -450,6 +469,7 @@ DracoEncoded encode_draco(const std::vector<float>& positions, const std::vector
         // decoded to one point far away). Refused, as Draco's own encoder cannot do them.
         float range = 0;
         for (int a = 0; a < 3; ++a) range = std::max(range, box.max[a] - box.min[a]);
+        if (grid != nullptr) range = grid->range;
         const float max_q = float((uint32_t{1} << settings.position_bits) - 1);
         if (!std::isfinite(range))
             throw Error(file_name,
@@ -513,7 +533,11 @@ DracoEncoded encode_draco(const std::vector<float>& positions, const std::vector
     }
 
     draco::Encoder encoder;
-    encoder.SetAttributeQuantization(draco::GeometryAttribute::POSITION, settings.position_bits);
+    if (grid != nullptr)
+        encoder.SetAttributeExplicitQuantization(draco::GeometryAttribute::POSITION, settings.position_bits, 3,
+                                                 grid->origin, grid->range);
+    else
+        encoder.SetAttributeQuantization(draco::GeometryAttribute::POSITION, settings.position_bits);
     if (channels.normal) encoder.SetAttributeQuantization(draco::GeometryAttribute::NORMAL, settings.normal_bits);
     if (channels.uv_sets > 0)
         encoder.SetAttributeQuantization(draco::GeometryAttribute::TEX_COORD, settings.texcoord_bits);
@@ -539,7 +563,8 @@ DracoEncoded encode_draco(const std::vector<float>& positions, const std::vector
     for (int id : generic_atts) out.generic_ids.push_back(static_cast<int>(dm.attribute(id)->unique_id()));
     // The decoded positions' bounds, computed with Draco's own quantizer on the input bounds.
     draco::AttributeQuantizationTransform q;
-    if (!q.ComputeParameters(*dm.attribute(pos_att), settings.position_bits))
+    if (grid != nullptr ? !q.SetParameters(settings.position_bits, grid->origin, 3, grid->range)
+                        : !q.ComputeParameters(*dm.attribute(pos_att), settings.position_bits))
         throw Error(file_name, "Draco rejected the position quantization settings");
     for (int a = 0; a < 3; ++a) {
         out.decoded_bounds.min[a] = draco_roundtrip(box.min[a], q, a);

@@ -87,9 +87,17 @@ std::vector<std::string> draco_notes(const DracoEncoded& encoded, uint64_t trian
 // Triangles with a repeated vertex are left out (Draco's encoder drops them) and counted in `dropped` (a writer under
 // --strict refuses them before, with first_repeated_vertex). Throws io::Error naming `file_name` when Draco refuses
 // (e.g. an empty mesh).
+// `grid`, when given, quantizes the positions on it instead of on the mesh's own box (Draco's
+// explicit quantization: `settings.position_bits` steps over [origin, origin + range] on every
+// axis): meshes encoded on one grid decode a position they share to the same float. A position
+// beyond the grid is moved onto its nearest side.
+struct DracoGrid {
+    float origin[3] = {0, 0, 0};
+    float range = 1;
+};
 DracoEncoded encode_draco(const std::vector<float>& positions, const std::vector<uint32_t>& indices,
                           const VertexValues& values, const Channels& channels, const DracoSettings& settings,
-                          const std::string& file_name, bool flip_v = false);
+                          const std::string& file_name, bool flip_v = false, const DracoGrid* grid = nullptr);
 
 // The first triangle of `indices` (3 per triangle) with a repeated vertex, or -1.
 int64_t first_repeated_vertex(const std::vector<uint32_t>& indices);

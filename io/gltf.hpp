@@ -66,11 +66,14 @@ struct GltfSettings {
     GltfSettings() = default;
     explicit GltfSettings(Compression c) : compression(c) {}
     Compression compression = Compression::kDraco;
-    // meshopt: the positions' quantization grid, when the caller gives one: `origin` and the
-    // cube's `extent`, in 2^bits - 1 steps (bits 1-16). Meshes written on one grid (the tiles of
-    // a tileset) put a position shared by two of them on the same integer and the same node
-    // transform, so both decode it to the same float. None: each mesh's own bounding cube at
-    // 14 bits.
+    // meshopt and Draco: the positions' quantization grid, when the caller gives one: `origin`
+    // and the cube's `extent`, in 2^bits - 1 steps (bits 1-16 with meshopt, 1-30 with Draco,
+    // whose position bits they replace). Meshes written on one grid (the tiles of a tileset) put
+    // a position shared by two of them on the same integer (and, with meshopt, the same node
+    // transform), so both decode it to the same float; a position beyond the grid is decoded on
+    // its nearest side.
+    // None: each mesh's own box (meshopt: its bounding cube at 14 bits; Draco: its position
+    // bits over the largest extent). Plain (uncompressed) accessors ignore it.
     struct Grid {
         float origin[3] = {0, 0, 0};
         float extent = 1;

@@ -22,6 +22,7 @@
 #include <bit>
 #include <cctype>
 #include <cmath>
+#include <optional>
 #include <cstdio>
 #include <cstring>
 #include <map>
@@ -483,7 +484,21 @@ public:
         draco_ = writer_compression(options_) == GltfSettings::Compression::kDraco;
         meshopt_ = writer_compression(options_) == GltfSettings::Compression::kMeshopt;
         grid_ = options_.format_options.get<GltfSettings>().grid;
+        if (grid_ && (draco_ || meshopt_)) {
+            const int most = meshopt_ ? 16 : 30;
+            if (grid_->bits < 1 || grid_->bits > most || !(grid_->extent > 0) || !std::isfinite(grid_->extent))
+                throw Error(sink.name(), "the positions' quantization grid needs 1-" + std::to_string(most) +
+                                             " bits with " + (meshopt_ ? "meshopt" : "Draco") +
+                                             " and an extent above 0, got " + std::to_string(grid_->bits) +
+                                             " bits");
+        }
 #if MESHSTREAM_WITH_DRACO
+        if (draco_ && grid_) {
+            // The grid's bits are Draco's position bits: its coding tables are counted with them.
+            DracoSettings d = options_.format_options.get<DracoSettings>();
+            d.position_bits = grid_->bits;
+            options_.format_options.set(d);
+        }
         if (draco_) draco_settings_ = check_draco_settings(sink.name(), options_);
 #endif
         // Written in place (stdout, a pipe, a device), the .gltf has no directory entry of its
@@ -535,7 +550,7 @@ private:
     WriteOptions options_;
     bool binary_;
     bool draco_ = false, meshopt_ = false;
-    std::optional<GltfSettings::Grid> grid_;  // meshopt's common quantization grid
+    std::optional<GltfSettings::Grid> grid_;  // the positions' common quantization grid (meshopt, Draco)
 #if MESHSTREAM_WITH_DRACO
     DracoSettings draco_settings_;  // checked, when draco_
 #endif
@@ -633,8 +648,14 @@ Json GltfWriter::plain_primitive(Document& doc, PartData& d, const Channels& ch,
 
 #if MESHSTREAM_WITH_DRACO
 Json GltfWriter::draco_primitive(Document& doc, PartData& d, const Channels& ch, DracoEncoded* sums) {
-    DracoEncoded enc =
-        encode_draco(d.positions, d.indices, d.values, ch, draco_settings_, sink_.name(), /*flip_v=*/true);
+    std::optional<DracoGrid> grid;
+    if (grid_) {
+        grid.emplace();
+        for (int a = 0; a < 3; ++a) grid->origin[a] = grid_->origin[a];
+        grid->range = grid_->extent;
+    }
+    DracoEncoded enc = encode_draco(d.positions, d.indices, d.values, ch, draco_settings_, sink_.name(),
+                                    /*flip_v=*/true, grid ? &*grid : nullptr);
     sums->dropped += enc.dropped;
     sums->flattened += enc.flattened;
     sums->face_count += enc.face_count;

@@ -3,6 +3,7 @@
 // parent to child, a non-empty directory is refused and kept, a cancel leaves nothing behind.
 #include "engine/tiles.hpp"
 #include "compare/metro.hpp"
+#include "compare/topology.hpp"
 #include "io/error.hpp"
 #include "io/format.hpp"
 #include "io/triangle_input.hpp"
@@ -16,6 +17,7 @@
 #include <fstream>
 #include <iterator>
 #include <map>
+#include <set>
 #include <string>
 
 namespace meshstream {
@@ -44,6 +46,7 @@ struct Walk {
     int bad_errors = 0;
     double pad = 0;  // beyond the box: none, the boxes are padded by the writer
     std::map<std::string, uint64_t> tiles_in_file;  // JSON files (relative to `dir`) and their tiles
+    std::vector<fs::path> leaves;                   // the leaves' content
 
     void file(const fs::path& relative, double parent_error) {
         std::ifstream f(dir / relative);
@@ -68,6 +71,7 @@ struct Walk {
                 return;
             }
             if (leaf && e != 0) ++bad_errors;
+            if (leaf) leaves.push_back(dir / uri);
             ++tiles;
             io::TriangleInput in(io::open_input((dir / uri).string()), io::BadTriangles::kKeep);
             io::TriangleChunk chunk;
@@ -137,6 +141,102 @@ TEST(Tiles, InASmallMemoryBudgetEveryTriangleIsInTheLeavesAndTilesAboveAreNotRef
     EXPECT_EQ(w.outside, 0u);
     EXPECT_EQ(w.bad_errors, 0);
     EXPECT_LE(r.levels[0].triangles, 5050u);
+}
+
+// The boundary and non-manifold edges of these meshes' triangles together, their corners
+// welded where they are the same floats.
+compare::EdgeCounts welded_edges(const std::vector<fs::path>& meshes) {
+    compare::EdgeCounter counter;
+    for (const fs::path& m : meshes) {
+        io::TriangleInput in(io::open_input(m.string()), io::BadTriangles::kKeep);
+        io::TriangleChunk chunk;
+        while (in.next(chunk))
+            for (size_t t = 0; t < chunk.size(); ++t) counter.add_triangle(&chunk.xyz()[9 * t]);
+    }
+    return counter.finish();
+}
+
+TEST_P(Tiles, TheLeavesWeldedHaveTheInputsBoundaryEdgesExactly) {
+    // Leaves of three depths meet on one quantization grid: welded, the only boundary edges are
+    // the input's own (the bunny's holes), none is non-manifold.
+    TempDir dir;
+    engine::QuietProgress quiet;
+    engine::TilesSettings s = bunny_settings(dir / "t", GetParam());
+    s.tile_triangles = 1000;
+    const engine::TilesResult r = engine::tile_file(s, quiet);
+    Walk w;
+    w.dir = dir.path() / "t";
+    w.file("tileset.json", HUGE_VAL);
+    std::set<int> leaf_depths;
+    for (size_t d = 0; d < r.levels.size(); ++d)
+        if (r.levels[d].leaves > 0) leaf_depths.insert(int(d));
+    EXPECT_GE(leaf_depths.size(), 2u);
+    EXPECT_EQ(w.leaf_triangles, 69451u);
+    const compare::EdgeCounts input = welded_edges({kBunny}), leaves = welded_edges(w.leaves);
+    EXPECT_GT(input.boundary_edges, 100u);
+    EXPECT_EQ(leaves.boundary_edges, input.boundary_edges);
+    EXPECT_EQ(leaves.non_manifold_edges, input.non_manifold_edges);
+    EXPECT_EQ(leaves.edges, input.edges);
+}
+
+// The surface of an axis-aligned box, each face a grid of k × k squares of two triangles.
+std::vector<float> box_surface(int k) {
+    std::vector<float> tris;
+    for (int axis = 0; axis < 3; ++axis)
+        for (int side = 0; side < 2; ++side)
+            for (int i = 0; i < k; ++i)
+                for (int j = 0; j < k; ++j) {
+                    // Corners on the face: (u, v) in the other two axes, outward-facing order.
+                    auto corner = [&](int u, int v, float* p) {
+                        p[axis] = float(side * k);
+                        p[(axis + 1) % 3] = float(side ? u : v);
+                        p[(axis + 2) % 3] = float(side ? v : u);
+                    };
+                    float q[4][3];
+                    corner(i, j, q[0]), corner(i + 1, j, q[1]), corner(i + 1, j + 1, q[2]), corner(i, j + 1, q[3]);
+                    for (int c : {0, 1, 2, 0, 2, 3}) tris.insert(tris.end(), q[c], q[c] + 3);
+                }
+    return tris;
+}
+
+TEST_P(Tiles, TilesOfOneDepthWeldedAreClosedWhereTheInputIs) {
+    // A closed box, 64 × 64 squares a face, at 1 600 triangles a tile: every depth-1 octant
+    // holds 6 144 triangles and every depth-2 cell at most 1 536, so all 56 leaves are of depth 2
+    // and each depth is the whole surface. Welded, each depth's tiles are closed: they meet at
+    // the same vertices, also once quantized.
+    TempDir dir;
+    const std::vector<float> box = box_surface(64);
+    {
+        std::ofstream f(dir / "box.stl", std::ios::binary);
+        const uint32_t n = uint32_t(box.size() / 9);
+        f << std::string(80, ' ');
+        f.write(reinterpret_cast<const char*>(&n), 4);
+        for (uint32_t t = 0; t < n; ++t) {
+            f << std::string(12, '\0');
+            f.write(reinterpret_cast<const char*>(&box[9 * size_t(t)]), 36);
+            f << std::string(2, '\0');
+        }
+    }
+    ASSERT_EQ(welded_edges({dir / "box.stl"}).boundary_edges, 0u);
+    engine::QuietProgress quiet;
+    engine::TilesSettings s = bunny_settings(dir / "t", GetParam());
+    s.input = dir / "box.stl";
+    s.tile_triangles = 1600;
+    s.threads = 2;
+    const engine::TilesResult r = engine::tile_file(s, quiet);
+    ASSERT_EQ(r.levels.size(), 3u);
+    EXPECT_EQ(r.levels[1].tiles, 8u);
+    EXPECT_EQ(r.levels[2].leaves, 56u);
+    for (size_t d = 0; d < r.levels.size(); ++d) {
+        std::vector<fs::path> tiles;
+        for (const fs::directory_entry& e : fs::directory_iterator(dir.path() / "t/tiles" / std::to_string(d)))
+            if (e.path().extension() == ".glb") tiles.push_back(e.path());
+        EXPECT_EQ(tiles.size(), r.levels[d].tiles) << d;
+        const compare::EdgeCounts e = welded_edges(tiles);
+        EXPECT_EQ(e.boundary_edges, 0u) << "depth " << d;
+        EXPECT_EQ(e.non_manifold_edges, 0u) << "depth " << d;
+        EXPECT_GT(e.edges, 0u) << "depth " << d;
+    }
 }
 
 INSTANTIATE_TEST_SUITE_P(Compressions, Tiles,

@@ -21,6 +21,7 @@
 #include <cstring>
 #include <fstream>
 #include <functional>
+#include <map>
 #include <random>
 #include <set>
 #include <thread>
@@ -1003,6 +1004,93 @@ TEST(GltfWriter, MeshoptKeepsTheTriangleOrderOfASortedStream) {
 // Issue 21 §1: the writers receive degenerate triangles now that convert and sort are lossless.
 // glTF holds them (plain and meshopt: every triangle comes out); Draco's encoder drops those
 // with a repeated vertex and says how many; NaN no accessor holds. --strict refuses both.
+TEST(GltfWriter, MeshesOnOneGridDecodeASharedPositionToOneFloat) {
+    // The bunny's two halves written apart on one grid (the tiles of a tileset): each position
+    // both halves hold decodes to the same float in both, with meshopt and with Draco; each on
+    // its own box, many do not. A position beyond the grid is decoded on its side.
+    TempDir dir;
+    const Soup bunny = read_soup(fixture("bunny_from_draco.bin.stl"));
+    Soup halves[2];
+    const size_t cut = 9 * (bunny.triangles() / 2);
+    halves[0].xyz.assign(bunny.xyz.begin(), bunny.xyz.begin() + cut);
+    halves[1].xyz.assign(bunny.xyz.begin() + cut, bunny.xyz.end());
+    io::GltfSettings::Grid grid;
+    for (int a = 0; a < 3; ++a) grid.origin[a] = -0.1f;
+    grid.extent = 0.3f;
+    // Positions in both halves, as written.
+    std::set<std::array<float, 3>> first, shared;
+    for (size_t i = 0; i < halves[0].xyz.size(); i += 3) first.insert({halves[0].xyz[i], halves[0].xyz[i + 1], halves[0].xyz[i + 2]});
+    for (size_t i = 0; i < halves[1].xyz.size(); i += 3)
+        if (first.count({halves[1].xyz[i], halves[1].xyz[i + 1], halves[1].xyz[i + 2]}))
+            shared.insert({halves[1].xyz[i], halves[1].xyz[i + 1], halves[1].xyz[i + 2]});
+    ASSERT_GT(shared.size(), 100u);
+    // What each shared position decodes to in a half: the decoded positions within two steps
+    // of it (steps of 5 µm, vertices of the bunny farther apart).
+    auto decoded = [&](const std::string& path, const Soup& written) {
+        const Soup back = read_soup(path);
+        EXPECT_EQ(back.triangles(), written.triangles()) << path;
+        const float tol = 2e-5f;
+        std::map<std::array<float, 3>, std::array<float, 3>> out;
+        for (size_t i = 0; i < back.xyz.size(); i += 3) {
+            const std::array<float, 3> p = {back.xyz[i], back.xyz[i + 1], back.xyz[i + 2]};
+            for (auto it = shared.lower_bound({p[0] - tol, -1e9f, -1e9f}); it != shared.end() && (*it)[0] <= p[0] + tol;
+                 ++it)
+                if (std::fabs((*it)[1] - p[1]) <= tol && std::fabs((*it)[2] - p[2]) <= tol) out[*it] = p;
+        }
+        return out;
+    };
+    for (const Compression c : {Compression::kMeshopt, Compression::kDraco}) {
+        io::GltfSettings gs(c);
+        gs.grid = grid;
+        io::WriteOptions o;
+        o.format_options.set(gs);
+        write_soup(halves[0], dir / "a.glb", o);
+        write_soup(halves[1], dir / "b.glb", o);
+        expect_valid(dir / "a.glb");
+        const auto a = decoded(dir / "a.glb", halves[0]), b = decoded(dir / "b.glb", halves[1]);
+        size_t same = 0, compared = 0;
+        for (const auto& [input, p] : a)
+            if (auto it = b.find(input); it != b.end()) ++compared, same += it->second == p;
+        EXPECT_GT(compared, shared.size() / 2) << int(c);
+        EXPECT_EQ(same, compared) << int(c);
+        // Each on its own box: the same positions decode apart.
+        io::WriteOptions own;
+        own.format_options.set(io::GltfSettings(c));
+        write_soup(halves[0], dir / "a.glb", own);
+        write_soup(halves[1], dir / "b.glb", own);
+        const auto a2 = decoded(dir / "a.glb", halves[0]), b2 = decoded(dir / "b.glb", halves[1]);
+        size_t apart = 0;
+        for (const auto& [input, p] : a2)
+            if (auto it = b2.find(input); it != b2.end()) apart += it->second != p;
+        EXPECT_GT(apart, compared / 4) << int(c);
+
+        // Beyond the grid: decoded on its side.
+        Soup out;
+        out.xyz = {0.f, 0.f, 0.f, 0.1f, 0.f, 0.f, 0.f, 0.5f, 0.f};
+        write_soup(out, dir / "out.glb", o);
+        const Soup back = read_soup(dir / "out.glb");
+        ASSERT_EQ(back.triangles(), 1u) << int(c);
+        float most = 0;
+        for (float v : back.xyz) most = std::max(most, v);
+        EXPECT_NEAR(most, 0.2f, 1e-4f) << int(c);
+
+        // Bits a codec cannot hold are refused, naming the file.
+        io::GltfSettings bad = gs;
+        bad.grid->bits = c == Compression::kMeshopt ? 17 : 31;
+        io::WriteOptions bo;
+        bo.format_options.set(bad);
+        try {
+            write_soup(halves[0], dir / "bad.glb", bo);
+            ADD_FAILURE() << "no error for " << bad.grid->bits << " bits";
+        } catch (const io::Error& e) {
+            EXPECT_NE(std::string(e.what()).find("bad.glb: the positions' quantization grid needs 1-"),
+                      std::string::npos)
+                << e.what();
+        }
+        EXPECT_FALSE(fs::exists(dir / "bad.glb"));
+    }
+}
+
 Soup degenerate_soup() {
     Soup s;
     s.xyz = {0, 0, 0, 1, 0, 0, 0, 1, 0,   // fine
