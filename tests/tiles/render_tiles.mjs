@@ -19,12 +19,12 @@
 //           (red, orange, yellow, green, cyan, blue, ... from the root down)
 // Every file the page fetches below the tileset (its JSON too) is counted by the server, scene by
 // scene. Report:
-//   {tiles: {count, levels, leaves, bytes, leaf_bytes},                 // the whole tileset
+//   {tiles: {count, levels, leaves, bytes, leaf_bytes, external_tilesets}, // the whole tileset
 //    far|close|match|whole|levels: {settled, frames, ms, fetched_bytes, fetched_by_level (content
 //                       bytes), drawn_by_level (tiles), drawn_max_error (the largest
 //                       geometricError of the tiles drawn), fetched_leaves, leaves_in_view,
 //                       fetched_leaves_out_of_view, fetched_leaf_bytes_out_of_view,
-//                       out_of_view_parent_out_of_view, failed},
+//                       out_of_view_parent_out_of_view, fetched_external_tilesets, failed},
 //    match: {..., covered_reference, covered_tiles, missing, extra, colour_difference, colour_differs},
 //    error (when the page threw)}
 // A tile is in view when its box meets the camera's frustum (as the renderer culls);
@@ -82,6 +82,7 @@ function boxCorners(box, m) {
 // level (how many ancestors have content), whether it is a leaf, its parent's path, its bytes
 // and its box's corners in the tileset's coordinates.
 const inventory = [];
+const externalTilesets = new Set();  // their paths, relative to the tileset's directory
 function walk(file, tile, parentMatrix, level, parentPath) {
     const m = tile.transform ? multiply(parentMatrix, tile.transform) : parentMatrix;
     const uri = tile.content && (tile.content.uri || tile.content.url);
@@ -89,6 +90,7 @@ function walk(file, tile, parentMatrix, level, parentPath) {
     if (uri) {
         const target = path.join(path.dirname(file), decodeURIComponent(uri));
         if (target.endsWith('.json')) {
+            externalTilesets.add(path.relative(tilesetDir, target));
             walk(target, JSON.parse(fs.readFileSync(target, 'utf8')).root, m, level, parentPath);
         } else {
             const p = path.relative(tilesetDir, target);
@@ -286,6 +288,7 @@ const report = {
         count: inventory.length, levels: Math.max(0, ...inventory.map((t) => t.level)) + 1,
         leaves: inventory.filter((t) => t.leaf).length, bytes: tilesetBytes,
         leaf_bytes: inventory.filter((t) => t.leaf).reduce((s, t) => s + t.bytes, 0),
+        external_tilesets: externalTilesets.size,
     },
 };
 let phase = null;
@@ -335,6 +338,7 @@ const outcome = await runPage({
                 drawn_by_level: drawnByLevel,
                 drawn_max_error: drawnMaxError,
                 fetched_leaves: fetchedLeaves.length,
+                fetched_external_tilesets: new Set(files.filter((f) => externalTilesets.has(f.path)).map((f) => f.path)).size,
                 leaves_in_view: [...inView].filter((p) => byPath.get(p).leaf).length,
                 fetched_leaves_out_of_view: outOfView.length,
                 fetched_leaf_bytes_out_of_view: outOfView.reduce((s, p) => s + byPath.get(p).bytes, 0),

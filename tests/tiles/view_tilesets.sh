@@ -1,7 +1,8 @@
 #!/bin/bash
 # A tileset `meshstream tiles` writes, loaded as a web page shows it: three.js with
 # 3d-tiles-renderer in headless Chromium (render_tiles.mjs), on a generated coloured mesh of 200 k
-# triangles at 4 000 triangles a tile (4 levels, 288 leaves), against the same mesh converted whole.
+# triangles at 4 000 triangles a tile (4 levels, 288 leaves), against the same mesh converted whole;
+# then the bunny at 300 triangles a tile, whose subtrees from depth 3 are external tilesets.
 #   view_tilesets.sh MESHSTREAM MESHSTREAM_GEN TOOLS_DIR [KEEP_DIR]
 # Checks, from the report:
 #   every scene settles (nothing left loading) with no tile failed, and no error in the page;
@@ -49,7 +50,7 @@ cat "$work/report.json"
 if [ -n "$keep" ]; then
   mkdir -p "$keep" && cp "$work/shots"/*.png "$work/report.json" "$keep/"
 fi
-node - "$work/report.json" <<'EOF'
+node - "$work/report.json" <<'EOF' || exit 1
 const r = JSON.parse(require('fs').readFileSync(process.argv[2], 'utf8'));
 const failures = [];
 const check = (ok, what) => { if (!ok) failures.push(what); };
@@ -91,4 +92,50 @@ if (failures.length) {
 }
 console.log(`ok: far ${share(r.far.fetched_bytes)} of ${t.bytes} bytes, whole ${share(r.whole.fetched_bytes)}, close ${share(r.close.fetched_bytes)} (${r.close.fetched_leaves} of ${t.leaves} leaves), ` +
   `match missing ${(100 * r.match.missing).toFixed(4)} % extra ${(100 * r.match.extra).toFixed(4)} % colour ${r.match.colour_difference.toFixed(3)}`);
+EOF
+
+# External tilesets: the bunny at 300 triangles a tile has five levels, so the subtrees from
+# depth 3 are tileset files of their own. At a 1-pixel target the page follows them and its
+# picture matches the bunny drawn whole; from far away it fetches none of them.
+bunny=$here/../../fixtures/bunny_from_draco.bin.stl
+"$meshstream" -q tiles "$bunny" "$work/bunny_tiles" --tile-triangles 300 || { echo "FAILED: meshstream tiles (bunny)"; exit 1; }
+"$meshstream" -q convert "$bunny" "$work/bunny.glb" --compress none || { echo "FAILED: meshstream convert (bunny)"; exit 1; }
+if ! RENDER_TILES_SCENES=far,close,match node "$here/render_tiles.mjs" "$work/bunny_shots" "$work/bunny_tiles/tileset.json" \
+    "$work/bunny.glb" --modules "$modules" > "$work/bunny_report.json" 2> "$work/bunny_render.err"; then
+  echo "FAILED: render_tiles.mjs (bunny):"
+  grep -v -e dbus -e '^\[' "$work/bunny_render.err" | tail -20
+  exit 1
+fi
+if [ -n "$keep" ]; then
+  mkdir -p "$keep/bunny" && cp "$work/bunny_shots"/*.png "$work/bunny_report.json" "$keep/bunny/"
+fi
+node - "$work/bunny_report.json" <<'EOF'
+const r = JSON.parse(require('fs').readFileSync(process.argv[2], 'utf8'));
+const failures = [];
+const check = (ok, what) => { if (!ok) failures.push(what); };
+const t = r.tiles;
+check(!r.error, `bunny: the page threw: ${r.error}`);
+check(t.levels >= 5 && t.external_tilesets > 1, `bunny: ${t.levels} levels, ${t.external_tilesets} external tilesets (expected 5 or more, and more than one)`);
+for (const name of ['far', 'match']) {
+  const s = r[name];
+  if (!s) { failures.push(`bunny: no report of the ${name} scene`); continue; }
+  check(s.settled, `bunny ${name}: still loading after 20 s`);
+  check(s.failed === 0, `bunny ${name}: ${s.failed} tiles failed to load`);
+}
+if (r.far) check(r.far.fetched_external_tilesets === 0, `bunny far: ${r.far.fetched_external_tilesets} external tilesets fetched`);
+if (r.match) {
+  const m = r.match;
+  const deep = Object.keys(m.drawn_by_level).map(Number).filter((l) => l >= 3);
+  check(m.fetched_external_tilesets > 0 && deep.length > 0,
+    `bunny match: ${m.fetched_external_tilesets} external tilesets fetched, levels drawn ${Object.keys(m.drawn_by_level)}`);
+  check(m.covered_reference > 0.1, `bunny match: the reference covers ${m.covered_reference} of the picture`);
+  check(m.missing < 0.001, `bunny match: ${(100 * m.missing).toFixed(3)} % of the reference's pixels missing`);
+  check(m.extra < 0.001, `bunny match: ${(100 * m.extra).toFixed(3)} % extra pixels`);
+}
+if (failures.length) {
+  for (const f of failures) console.log('FAILED: ' + f);
+  process.exit(1);
+}
+console.log(`ok: bunny ${t.levels} levels, ${r.match.fetched_external_tilesets} of ${t.external_tilesets} external tilesets fetched at 1 px, ` +
+  `none from far; match missing ${(100 * r.match.missing).toFixed(4)} % extra ${(100 * r.match.extra).toFixed(4)} %`);
 EOF
