@@ -442,12 +442,10 @@ public:
     void sort(const std::string& mesh, std::string_view format, CellCounts* counts, ProgressSink& progress,
               Warnings* warnings, TilesResult* result) {
         // The reader's share of the memory budget (what a PLY or OBJ reader holds: its vertex
-        // table, spilled past it): 3/8, beside the sort's 3/16 and the cell counts' 3/16; the
-        // last quarter for the rest (chunks, the tiles being written). A vertex table past its
-        // share is read a page at a time for each corner it lacks, which costs far more than
-        // the sort's merging more, shorter runs.
+        // table, spilled past it): 3/16, beside the sort's 3/8 and the cell counts' 3/16; the
+        // last quarter for the rest (chunks, the tiles being written).
         io::ReadOptions read = s_.read;
-        read.memory_budget_bytes = s_.read.memory_budget_bytes * 3 / 8;
+        read.memory_budget_bytes = s_.read.memory_budget_bytes * 3 / 16;
         io::TriangleInput in(io::open_input(mesh, format, read), io::BadTriangles::kDrop);
         const io::MeshHeader& header = in.header();
         const io::Format& glb = io::output_format("x.glb", "glb");
@@ -466,7 +464,7 @@ public:
         }
 
         sort::SorterOptions so;
-        so.memory_budget_bytes = s_.read.memory_budget_bytes * 3 / 16;
+        so.memory_budget_bytes = s_.read.memory_budget_bytes * 3 / 8;
         so.tmpdir = s_.read.tmpdir;
         so.channels = wo_.channels;
         so.key = [this](const float* xyz) { return cube_.triangle_key(xyz); };
