@@ -586,6 +586,7 @@ DracoEncoded encode_draco(const std::vector<float>& input_positions, const std::
     };
     for (size_t f = 0; f < kept.size() / 3; ++f)
         out.flattened += zero_area(decoded, &kept[3 * f]) && !zero_area(positions, &kept[3 * f]);
+    out.on_grid = grid != nullptr;
     return out;
 }
 
@@ -595,7 +596,12 @@ std::vector<std::string> draco_notes(const DracoEncoded& encoded, uint64_t trian
         out.push_back(std::to_string(encoded.dropped) + " of the " + std::to_string(triangles) +
                       " triangles have two corners at one vertex (degenerate), which Draco's encoder drops: left out "
                       "(write without Draco to keep them; " + mention(Setting::kStrict) + " makes this an error)");
-    if (encoded.flattened)
+    if (encoded.flattened && encoded.on_grid)
+        out.push_back(std::to_string(encoded.flattened) + " of the " + std::to_string(triangles) +
+                      " triangles have zero area once decoded: thinner than the step of the " +
+                      std::to_string(settings.position_bits) +
+                      "-bit quantization grid they were written on (its extent / (2^bits - 1))");
+    else if (encoded.flattened)
         out.push_back(std::to_string(encoded.flattened) + " of the " + std::to_string(triangles) +
                       " triangles have zero area once decoded: thinner than Draco's " +
                       std::to_string(settings.position_bits) +

@@ -74,6 +74,7 @@ struct DracoEncoded {
     std::vector<int> generic_ids;   // per vertex scalar channel
     Bounds decoded_bounds;          // exact min/max of the dequantized positions
     uint64_t flattened = 0;         // triangles of nonzero area whose dequantized corners have none
+    bool on_grid = false;           // quantized on a caller's DracoGrid
     uint64_t dropped = 0;           // triangles the encoder left out (a repeated vertex)
 };
 // The notes a writer gives for what the encoding lost (flattened or dropped triangles), each

@@ -658,6 +658,7 @@ Json GltfWriter::draco_primitive(Document& doc, PartData& d, const Channels& ch,
                                     /*flip_v=*/true, grid ? &*grid : nullptr);
     sums->dropped += enc.dropped;
     sums->flattened += enc.flattened;
+    sums->on_grid = enc.on_grid;
     sums->face_count += enc.face_count;
     const int view = doc.add_view(enc.bytes.data(), enc.bytes.size(), 0, 0);
     size_t index_size = 0;

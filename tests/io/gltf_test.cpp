@@ -1074,6 +1074,18 @@ TEST(GltfWriter, MeshesOnOneGridDecodeASharedPositionToOneFloat) {
         for (float v : back.xyz) most = std::max(most, v);
         EXPECT_NEAR(most, 0.2f, 1e-4f) << int(c);
 
+        // A triangle thinner than the grid's step is said to be flattened by the grid.
+        if (c == Compression::kDraco) {
+            Soup thin;
+            thin.xyz = {0.f, 0.f, 0.f, 0.1f, 0.f, 0.f, 0.05f, 1e-7f, 0.f};
+            const std::vector<std::string> notes = write_soup(thin, dir / "thin.glb", o);
+            ASSERT_EQ(notes.size(), 1u);
+            EXPECT_NE(notes[0].find("1 of the 1 triangles have zero area once decoded: thinner than the step of the "
+                                    "16-bit quantization grid they were written on"),
+                      std::string::npos)
+                << notes[0];
+        }
+
         // Bits a codec cannot hold are refused, naming the file.
         io::GltfSettings bad = gs;
         bad.grid->bits = c == Compression::kMeshopt ? 17 : 31;
