@@ -34,7 +34,7 @@ void add_corners(io::Bounds& box, std::span<const float> xyz) {
 }  // namespace
 
 io::Bounds input_bounds(const std::string& path, std::string_view from, const io::ReadOptions& options,
-                        ProgressSink& progress) {
+                        ProgressSink& progress, uint64_t* vertex_table_bytes) {
     io::ReadOptions positions = options;  // nothing but positions is looked at
     positions.channels = io::ChannelKinds::none();
     positions.memory_budget_bytes = options.memory_budget_bytes / 8 * 7;  // beside the marks below
@@ -48,6 +48,7 @@ io::Bounds input_bounds(const std::string& path, std::string_view from, const io
     // the faces' indices mark the vertices used, then the vertices are read in order, which is
     // much cheaper than a triangle's corners looked up one by one. The same corners, the same box.
     io::IndexedSource* own = in.reader->indexed();
+    if (vertex_table_bytes != nullptr) *vertex_table_bytes = own != nullptr ? own->vertex_table_bytes() : 0;
     if (own != nullptr && (own->vertex_count() + 7) / 8 <= options.memory_budget_bytes / 8) {
         std::vector<uint64_t> used((own->vertex_count() + 63) / 64);
         std::vector<uint32_t> indices;

@@ -19,8 +19,10 @@ bool is_regular_file(const std::string& path);
 // An input without finite coordinates gives min = +inf, max = -inf. Throws io::Error like
 // io::open_input. Memory: within options.memory_budget_bytes (the reader's tables 7/8 of it; a
 // PLY's marks of the vertices its faces use, a bit a vertex, the rest when they fit there).
+// `vertex_table_bytes`, when given, is set to the input's vertex table's bytes
+// (io::IndexedSource::vertex_table_bytes; 0 for formats without one).
 io::Bounds input_bounds(const std::string& path, std::string_view from, const io::ReadOptions& options,
-                        ProgressSink& progress);
+                        ProgressSink& progress, uint64_t* vertex_table_bytes = nullptr);
 // The axis along which `box` is longest (z for an empty or flat box, the usual scan axis).
 int longest_axis(const io::Bounds& box);
 

@@ -440,12 +440,21 @@ public:
     // Notes what the reader dropped or changed in `warnings` and the input's name and count in
     // `result`, when given.
     void sort(const std::string& mesh, std::string_view format, CellCounts* counts, ProgressSink& progress,
-              Warnings* warnings, TilesResult* result) {
+              Warnings* warnings, TilesResult* result, uint64_t vertex_table_bytes = 0) {
         // The reader's share of the memory budget (what a PLY or OBJ reader holds: its vertex
         // table, spilled past it): 3/16, beside the sort's 3/8 and the cell counts' 3/16; the
-        // last quarter for the rest (chunks, the tiles being written).
+        // last quarter for the rest (chunks, the tiles being written). A vertex table (of
+        // `vertex_table_bytes`) that fits in 3/8 is given whole, out of the sort's share: past
+        // its share a table is read a page for each corner it lacks, which costs far more than
+        // the sort's merging more runs.
+        const uint64_t budget = s_.read.memory_budget_bytes;
+        uint64_t reader_bytes = budget * 3 / 16, sort_bytes = budget * 3 / 8;
+        if (vertex_table_bytes > reader_bytes && vertex_table_bytes + (64 << 10) <= budget * 3 / 8) {
+            reader_bytes = vertex_table_bytes + (64 << 10);
+            sort_bytes = budget * 9 / 16 - reader_bytes;
+        }
         io::ReadOptions read = s_.read;
-        read.memory_budget_bytes = s_.read.memory_budget_bytes * 3 / 16;
+        read.memory_budget_bytes = reader_bytes;
         io::TriangleInput in(io::open_input(mesh, format, read), io::BadTriangles::kDrop);
         const io::MeshHeader& header = in.header();
         const io::Format& glb = io::output_format("x.glb", "glb");
@@ -464,7 +473,7 @@ public:
         }
 
         sort::SorterOptions so;
-        so.memory_budget_bytes = s_.read.memory_budget_bytes * 3 / 8;
+        so.memory_budget_bytes = sort_bytes;
         so.tmpdir = s_.read.tmpdir;
         so.channels = wo_.channels;
         so.key = [this](const float* xyz) { return cube_.triangle_key(xyz); };
@@ -830,9 +839,10 @@ TilesResult tile_file(const TilesSettings& s, ProgressSink& progress) {
 
     // The bounding cube.
     Cube cube;
+    uint64_t vertex_table_bytes = 0;  // the input's, for the reader's share of the budget
     {
         StepProgress step(progress, "bounds");
-        const io::Bounds b = input_bounds(input, input_format, s.read, step);
+        const io::Bounds b = input_bounds(input, input_format, s.read, step, &vertex_table_bytes);
         double extent = 0;
         for (int a = 0; a < 3; ++a) {
             cube.origin[a] = b.min[a];
@@ -855,7 +865,7 @@ TilesResult tile_file(const TilesSettings& s, ProgressSink& progress) {
     {
         StepProgress step(progress, "leaves");
         CellCounts counts(s.read.memory_budget_bytes * 3 / 16);
-        writer.sort(input, input_format, &counts, step, &result.warnings, &result);
+        writer.sort(input, input_format, &counts, step, &result.warnings, &result, vertex_table_bytes);
         if (counts.empty()) throw io::Error(s.input, "no triangle to tile");
         const std::vector<std::pair<uint32_t, uint64_t>> cells = counts.sorted();
         tree.build(cells, 0, cells.size(), 0, 0, s.tile_triangles, counts.depth());

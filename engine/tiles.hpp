@@ -23,7 +23,8 @@
 // (tiles/<depth>/<cell>.json, an external tileset), so no JSON file grows with the input.
 //
 // Memory, within the reader's memory budget: while the input is read, the sort's 3/8, the
-// cell counts' 3/16 and the reader's 3/16; then up to three tiles per thread in the glTF
+// cell counts' 3/16 and the reader's 3/16 (a PLY's vertex table that fits in 3/8 whole, out of
+// the sort's share); then up to three tiles per thread in the glTF
 // writers (with Draco, their coding tables within an eighth); the decimations'
 // (engine/decimate.hpp; their buffers a third of the budget); in the error measure, per
 // thread, a tile's children twice (a few times `tile_triangles` triangles, not bounded by the

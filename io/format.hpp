@@ -110,6 +110,9 @@ public:
     virtual ~IndexedSource() = default;
     // The vertices the faces index (all of the file's, referenced or not); fewer than 2^32.
     virtual uint64_t vertex_count() const = 0;
+    // The bytes of the reader's vertex table: with a memory budget of this and 64 KiB more, a
+    // reader of the same file holds it whole, and reads each vertex's page once.
+    virtual uint64_t vertex_table_bytes() const = 0;
     // Vertex i (< vertex_count()): xyz[3] and, when `record` is non-null, its values as
     // CornerLayout(channels) packs them, `channels` being what the reader stores (ReadOptions::
     // channels of the header's). Cheapest in order.

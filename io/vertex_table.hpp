@@ -50,6 +50,9 @@ public:
     // Appends a vertex (owned tables only): xyz[3] and attribute_bytes() of `attributes`.
     void append(const float* xyz, const std::byte* attributes);
     uint64_t size() const { return size_; }
+    // The bytes its records take (in memory, in its temporary file or in the input file): a
+    // budget of this and two pages more holds them all, read once.
+    uint64_t bytes() const { return size_ * stride_; }
     size_t attribute_bytes() const { return attribute_bytes_; }
     Storage storage() const { return storage_; }
     // Copies vertex i (< size()) into xyz[3] and, when `attributes` is non-null, its
