@@ -61,6 +61,20 @@ TEST(EngineFiles, APlysBoxIsItsTrianglesCornersNotItsUnusedVertices) {
     expect_the_triangles_box(dir / "m.ply");
 }
 
+TEST(EngineFiles, AVertexTablesBytesAreSaidAndNoneForAnStl) {
+    // The 8 vertices of kPly, 12 bytes each (x, y, z): what a reader of it needs to hold them.
+    test::TempDir dir;
+    test::spit(dir / "m.ply", kPly);
+    test::spit(dir / "m.stl", kStl);
+    io::ReadOptions options;
+    engine::QuietProgress progress;
+    uint64_t bytes = 1;
+    engine::input_bounds(dir / "m.ply", "", options, progress, &bytes);
+    EXPECT_EQ(bytes, 8u * 12u);
+    engine::input_bounds(dir / "m.stl", "", options, progress, &bytes);
+    EXPECT_EQ(bytes, 0u);
+}
+
 TEST(EngineFiles, APlysNonFiniteCoordinateDecidesNothing) {
     test::TempDir dir;
     std::string ply = kPly;
