@@ -427,22 +427,13 @@ DracoEncoded encode_draco(const std::vector<float>& input_positions, const std::
                           const std::string& file_name, bool flip_v, const DracoGrid* grid) {
     // On a grid, a position beyond it is moved onto its nearest side, as meshopt's quantizer
     // clamps (Draco's would wrap around).
-    std::vector<float> clamped;
-    if (grid != nullptr) {
-        auto outside = [&](size_t i) {
-            const float lo = grid->origin[i % 3], hi = lo + grid->range;
-            return !(input_positions[i] >= lo && input_positions[i] <= hi);
-        };
-        for (size_t i = 0; i < input_positions.size(); ++i)
-            if (outside(i)) {
-                clamped = input_positions;
-                for (size_t k = i; k < clamped.size(); ++k) {
-                    const float lo = grid->origin[k % 3], hi = lo + grid->range;
-                    clamped[k] = std::clamp(clamped[k], lo, hi);
-                }
-                break;
-            }
-    }
+    std::vector<float> clamped;  // a copy, once a position is moved
+    if (grid != nullptr)
+        for (size_t i = 0; i < input_positions.size(); ++i) {
+            const float lo = grid->origin[i % 3], v = std::clamp(input_positions[i], lo, lo + grid->range);
+            if (v != input_positions[i] && clamped.empty()) clamped = input_positions;
+            if (!clamped.empty()) clamped[i] = v;
+        }
     const std::vector<float>& positions = clamped.empty() ? input_positions : clamped;
     // Draco's encoder drops triangles with a repeated vertex: left out here, so they are counted.
     std::vector<uint32_t> kept;

@@ -22,12 +22,12 @@
 #include <bit>
 #include <cctype>
 #include <cmath>
-#include <optional>
 #include <cstdio>
 #include <cstring>
 #include <map>
 #include <memory>
 #include <numeric>
+#include <optional>
 #include <set>
 
 #ifndef MESHSTREAM_VERSION
