@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cassert>
 #include <cmath>
 #include <cstring>
@@ -242,27 +243,67 @@ struct BvhNode {
     uint32_t count;  // primitives in a leaf, 0 for an inner node
 };
 
+// The 30-bit Morton code of a point with 10-bit coordinates: their bits interleaved.
+uint32_t morton30(uint32_t x, uint32_t y, uint32_t z) {
+    auto spread = [](uint32_t v) {  // bit b of v's 10 to bit 3b
+        v = (v | v << 16) & 0x030000FFu;
+        v = (v | v << 8) & 0x0300F00Fu;
+        v = (v | v << 4) & 0x030C30C3u;
+        return (v | v << 2) & 0x09249249u;
+    };
+    return spread(x) << 2 | spread(y) << 1 | spread(z);
+}
+
 // Builds a BVH over n primitives whose boxes `box(i, lo, hi)` gives. Returns the nodes and
-// writes the primitive order into `order` (the caller permutes its data by it). Top down: each
-// node's primitives are split at the median centroid along the longest axis of their
-// centroids' box, down to `leaf_size`; the boxes are then set bottom up. The split works on a
-// contiguous array of (centroid, primitive) and each primitive's box is computed once.
+// writes the primitive order into `order` (the caller permutes its data by it). The primitives
+// go in the Morton order of their centroids (10 bits an axis over the centroids' box, radix
+// sorted, ties in input order), then split top down where the highest bit of the code changes
+// (an octree's split along one axis; in the middle of a run of equal codes), down to
+// `leaf_size`; the boxes are then set bottom up. Linear but for the sort's three passes: a
+// median split at every node cost about four times as much (the tiles' errors build an index
+// for a few queries a triangle, where the build was a third of the time), and its tree was
+// searched only slightly faster. Depth: at most 30 splits by bits, then halvings.
 template <class BoxFn>
 std::vector<BvhNode> build_bvh(uint32_t n, BoxFn box, uint32_t leaf_size, std::vector<uint32_t>& order) {
     std::vector<BvhNode> nodes;
     order.resize(n);
     if (n == 0) return nodes;
-    struct Item {
-        float c[3];
-        uint32_t i;
-    };
-    std::vector<Item> items(n);
-    for (uint32_t i = 0; i < n; ++i) {
+    // The centroids' box, then their codes (each box computed twice: no array of centroids).
+    auto centroid = [&](uint32_t i, float c[3]) {
         float lo[3], hi[3];
         box(i, lo, hi);
-        for (int a = 0; a < 3; ++a) items[i].c[a] = 0.5f * (lo[a] + hi[a]);
-        items[i].i = i;
+        for (int a = 0; a < 3; ++a) c[a] = 0.5f * (lo[a] + hi[a]);
+    };
+    float clo[3] = {INFINITY, INFINITY, INFINITY}, chi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (uint32_t i = 0; i < n; ++i) {
+        float c[3];
+        centroid(i, c);
+        for (int a = 0; a < 3; ++a) clo[a] = std::min(clo[a], c[a]), chi[a] = std::max(chi[a], c[a]);
     }
+    std::vector<uint64_t> items(n);  // (code << 32 | primitive)
+    {
+        float scale[3];
+        for (int a = 0; a < 3; ++a) scale[a] = chi[a] > clo[a] ? 1023.0f / (chi[a] - clo[a]) : 0.0f;
+        for (uint32_t i = 0; i < n; ++i) {
+            float c[3];
+            centroid(i, c);
+            uint32_t q[3];
+            for (int a = 0; a < 3; ++a) {
+                const float t = (c[a] - clo[a]) * scale[a];
+                q[a] = t > 0 ? uint32_t(std::min(t, 1023.0f)) : 0;  // NaN: 0
+            }
+            items[i] = uint64_t{morton30(q[0], q[1], q[2])} << 32 | i;
+        }
+        std::vector<uint64_t> scratch(n);
+        for (int shift = 32; shift < 62; shift += 10) {
+            uint32_t count[1025] = {};
+            for (uint64_t v : items) ++count[((v >> shift) & 1023) + 1];
+            for (int b = 0; b < 1024; ++b) count[b + 1] += count[b];
+            for (uint64_t v : items) scratch[count[(v >> shift) & 1023]++] = v;
+            items.swap(scratch);
+        }
+    }
+    for (uint32_t k = 0; k < n; ++k) order[k] = uint32_t(items[k]);
     nodes.reserve(2 * (size_t{n} / leaf_size + 1));
     nodes.push_back({});
     struct Job {
@@ -277,18 +318,15 @@ std::vector<BvhNode> build_bvh(uint32_t n, BoxFn box, uint32_t leaf_size, std::v
             nodes[job.node].count = job.end - job.begin;
             continue;
         }
-        float clo[3] = {INFINITY, INFINITY, INFINITY}, chi[3] = {-INFINITY, -INFINITY, -INFINITY};
-        for (uint32_t k = job.begin; k < job.end; ++k)
-            for (int a = 0; a < 3; ++a) {
-                clo[a] = std::min(clo[a], items[k].c[a]);
-                chi[a] = std::max(chi[a], items[k].c[a]);
-            }
-        int axis = 0;
-        for (int a = 1; a < 3; ++a)
-            if (chi[a] - clo[a] > chi[axis] - clo[axis]) axis = a;
+        const uint32_t first = uint32_t(items[job.begin] >> 32), last = uint32_t(items[job.end - 1] >> 32);
         uint32_t mid = job.begin + (job.end - job.begin) / 2;
-        std::nth_element(items.begin() + job.begin, items.begin() + mid, items.begin() + job.end,
-                         [axis](const Item& x, const Item& y) { return x.c[axis] < y.c[axis]; });
+        if (first != last) {
+            // The first code with the highest differing bit set (all share the bits above).
+            const uint32_t bit = uint32_t{1} << (31 - std::countl_zero(first ^ last));
+            mid = uint32_t(std::partition_point(items.begin() + job.begin, items.begin() + job.end,
+                                                [&](uint64_t v) { return !(uint32_t(v >> 32) & bit); }) -
+                           items.begin());
+        }
         uint32_t left = static_cast<uint32_t>(nodes.size());
         nodes[job.node].first = left;
         nodes[job.node].count = 0;
@@ -297,7 +335,6 @@ std::vector<BvhNode> build_bvh(uint32_t n, BoxFn box, uint32_t leaf_size, std::v
         stack.push_back({left, job.begin, mid});
         stack.push_back({left + 1, mid, job.end});
     }
-    for (uint32_t k = 0; k < n; ++k) order[k] = items[k].i;
     // Children come after their parent: in reverse, every node's children are done before it.
     for (size_t j = nodes.size(); j-- > 0;) {
         BvhNode& node = nodes[j];
