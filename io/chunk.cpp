@@ -155,14 +155,6 @@ double get_scalar(const std::byte* src, ScalarType type) {
     return 0;
 }
 
-// A float colour component as the integer type stores it (rounded, clamped to the range).
-template <class T>
-T quantize(float v, float max) {
-    if (!(v > 0.0f)) return 0;  // also NaN
-    if (v >= 1.0f) return static_cast<T>(max);
-    return static_cast<T>(std::lround(v * max));
-}
-
 }  // namespace
 
 void CornerLayout::pack_values(const float* normal, const float* rgba, const float* uv, const double* scalars,
@@ -173,9 +165,9 @@ void CornerLayout::pack_values(const float* normal, const float* rgba, const flo
         const int n = channels_.color->alpha ? 4 : 3;
         for (int a = 0; a < n; ++a) {
             if (color_bytes_ == 1)
-                dst = put(dst, quantize<uint8_t>(rgba[a], 255.0f));
+                dst = put(dst, color_to_unorm<uint8_t>(rgba[a], 255.0f));
             else if (color_bytes_ == 2)
-                dst = put(dst, quantize<uint16_t>(rgba[a], 65535.0f));
+                dst = put(dst, color_to_unorm<uint16_t>(rgba[a], 65535.0f));
             else
                 dst = put(dst, rgba[a]);
         }

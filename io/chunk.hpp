@@ -39,6 +39,17 @@ struct ColorFormat {
     bool operator==(const ColorFormat&) const = default;
 };
 
+// A colour component (nominally 0..1) as an integer channel of `max` (255 or 65535) stores it:
+// clamped, rounded half away from zero; NaN is 0. Inline: it runs for every corner written.
+// The product is below 65536 with a float's 24 bits, so adding 0.5 in double is exact and
+// truncating rounds as std::lround would.
+template <class T>
+T color_to_unorm(float v, float max) {
+    if (!(v > 0.0f)) return 0;
+    if (v >= 1.0f) return static_cast<T>(max);
+    return static_cast<T>(double(v * max) + 0.5);
+}
+
 // A named scalar channel (PLY "intensity", "confidence", a face "label"; Draco generic).
 struct ScalarChannel {
     std::string name;

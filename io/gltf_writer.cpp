@@ -420,9 +420,9 @@ std::vector<Stream> vertex_streams(const PartData& d, const Channels& ch, bool n
                 const float x = d.values.colors[4 * v + c];
                 const size_t at = v * s.stride + c * cbytes;
                 if (t == ScalarType::kUInt8)
-                    put(s.data, at, uint8_t(std::lround(std::clamp(x, 0.0f, 1.0f) * 255.0f)));
+                    put(s.data, at, color_to_unorm<uint8_t>(x, 255.0f));
                 else if (t == ScalarType::kUInt16)
-                    put(s.data, at, uint16_t(std::lround(std::clamp(x, 0.0f, 1.0f) * 65535.0f)));
+                    put(s.data, at, color_to_unorm<uint16_t>(x, 65535.0f));
                 else
                     put(s.data, at, x);
             }

@@ -1076,7 +1076,7 @@ public:
                         continue;
                     }
                     const float max = ch.color->type == ScalarType::kUInt8 ? 255.0f : 65535.0f;
-                    put_scalar(out, std::lround(std::clamp(rgba[a], 0.0f, 1.0f) * max), ch.color->type, ascii_);
+                    put_scalar(out, color_to_unorm<uint16_t>(rgba[a], max), ch.color->type, ascii_);
                 }
                 for (int a = 0; a < 2 * ch.uv_sets; ++a) put_field(out, uv[a]);
                 for (size_t c = 0; c < scalars.size(); ++c) {
