@@ -60,10 +60,15 @@ struct Cube {
             const double t = (double(p[a]) - origin[a]) / extent * (1 << kMaxDepth);
             cell[a] = t <= 0 || !std::isfinite(t) ? 0 : uint32_t(std::min(t, double((1 << kMaxDepth) - 1)));
         }
-        uint32_t k = 0;
-        for (int bit = kMaxDepth - 1; bit >= 0; --bit)
-            for (int a = 0; a < 3; ++a) k = k << 1 | ((cell[a] >> bit) & 1);
-        return k;
+        // The cells' bits interleaved, x's highest: bit b of a coordinate to bit 3b.
+        auto spread = [](uint32_t v) {
+            v = (v | v << 16) & 0x030000FFu;
+            v = (v | v << 8) & 0x0300F00Fu;
+            v = (v | v << 4) & 0x030C30C3u;
+            return (v | v << 2) & 0x09249249u;
+        };
+        static_assert(kMaxDepth == 10, "spread() interleaves 10 bits");
+        return spread(cell[0]) << 2 | spread(cell[1]) << 1 | spread(cell[2]);
     }
     uint32_t triangle_key(const float* xyz) const {
         const float c[3] = {(xyz[0] + xyz[3] + xyz[6]) / 3, (xyz[1] + xyz[4] + xyz[7]) / 3,
