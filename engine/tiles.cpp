@@ -387,20 +387,22 @@ private:
     std::exception_ptr failure_;
 };
 
-// A tile's triangles as read back from its GLB (positions as stored: y-up).
-std::vector<float> tile_positions(const std::string& path) {
-    io::ReadOptions positions;
-    positions.channels = io::ChannelKinds::none();
-    io::TriangleInput in(io::open_input(path, "glb", positions), io::BadTriangles::kKeep);
-    io::TriangleChunk chunk;
-    std::vector<float> xyz;
-    while (in.next(chunk)) xyz.insert(xyz.end(), chunk.xyz().begin(), chunk.xyz().end());
-    return xyz;
+// Positions (y-up) as a tile's GLB stores them on `grid`: each coordinate the nearest of the
+// grid's 2^bits values over its extent, clamped to it, as meshopt's and Draco's quantizers
+// place it (to within a float's rounding of the decoder's arithmetic).
+void snap_to_grid(std::vector<float>& xyz, const io::GltfSettings::Grid& grid) {
+    const double steps = double((uint64_t{1} << grid.bits) - 1), step = double(grid.extent) / steps;
+    for (size_t i = 0; i < xyz.size(); ++i) {
+        const double origin = grid.origin[i % 3];
+        const double q = std::clamp(std::nearbyint((double(xyz[i]) - origin) / step), 0.0, steps);  // NaN stays
+        xyz[i] = float(origin + q * step);
+    }
 }
 
-// Every tile's positions as a viewer gets them (read back from its GLB once, as it is written),
-// in one temporary file, for the error measure: a tile is needed again each time a tile near it
-// is measured, and then costs a read of its bytes (from the page cache, mostly), not a decode.
+// Every tile's positions as a viewer gets them (on the quantization grid, as its GLB stores
+// them; what a writer leaves out, Draco's degenerate triangles, has no area), in one temporary
+// file, for the error measure: a tile is needed again each time a tile near it is measured,
+// and then costs a read of its bytes (from the page cache, mostly), not a decode.
 // Disk: 36 bytes a triangle of every tile (the levels above the leaves add at most a third).
 class TileStore {
 public:
@@ -647,13 +649,21 @@ private:
         // A leaf holds its input triangles; a tile above, a decimation of them (not known before).
         wo.expected_triangle_count = n.leaf && n.count ? n.count : std::optional<uint64_t>();
         io::Output tile = io::open_output((fs::path(root_) / n.uri).string(), "glb", wo);
-        for (const io::TriangleChunk& c : job.chunks) tile.write(c);
+        std::vector<float> drawn;  // the positions, for the errors
+        size_t triangles = 0;
+        for (const io::TriangleChunk& c : job.chunks) triangles += c.size();
+        drawn.reserve(9 * triangles);
+        for (const io::TriangleChunk& c : job.chunks) {
+            tile.write(c);
+            drawn.insert(drawn.end(), c.xyz().begin(), c.xyz().end());
+        }
         job.chunks.clear();
         if (wo.channels.material) tile.writer->update_materials(wo.materials);
         tile.finish();
         notes = tile.writer->raw_notes();
         n.bytes = fs::file_size(fs::path(root_) / n.uri);
-        store_.add(job.node, tile_positions((fs::path(root_) / n.uri).string()));
+        if (grid_) snap_to_grid(drawn, *grid_);
+        store_.add(job.node, drawn);
     }
 
     static constexpr uint64_t kNotedTiles = 5;
