@@ -411,6 +411,33 @@ double bvh_nearest(const std::vector<BvhNode>& nodes, const double p[3], double 
     return best2;
 }
 
+// Whether some primitive has leaf_dist2(i) < r2: the search stops at the first one (nearer
+// boxes first), where bvh_nearest would go on for the nearest.
+template <class LeafFn>
+bool bvh_any_within(const std::vector<BvhNode>& nodes, const double p[3], double r2, LeafFn leaf_dist2) {
+    if (nodes.empty()) return false;
+    uint32_t stack[128];
+    int top = 0;
+    stack[top++] = 0;
+    while (top > 0) {
+        const BvhNode& n = nodes[stack[--top]];
+        if (n.count) {
+            for (uint32_t i = n.first; i < n.first + n.count; ++i)
+                if (leaf_dist2(i) < r2) return true;
+            continue;
+        }
+        const double dl = box_dist2(nodes[n.first], p), dr = box_dist2(nodes[n.first + 1], p);
+        if (dl <= dr) {
+            if (dr < r2) stack[top++] = n.first + 1;
+            if (dl < r2) stack[top++] = n.first;
+        } else {
+            if (dl < r2) stack[top++] = n.first;
+            if (dr < r2) stack[top++] = n.first + 1;
+        }
+    }
+    return false;
+}
+
 // Triangles held in memory, with their BVH and their corners' attribute values.
 struct TriangleIndex {
     std::vector<float> xyz;            // 9 floats per triangle, in BVH order
@@ -447,6 +474,10 @@ struct TriangleIndex {
             interpolate(&corner_values[3 * size_t(values) * winner], values, bary, value);
         }
         return d2;
+    }
+    // Whether a triangle is nearer p than sqrt(r2).
+    bool any_within(const double p[3], double r2) const {
+        return bvh_any_within(nodes, p, r2, [&](uint32_t i) { return point_triangle_dist2(p, &xyz[9 * size_t{i}]); });
     }
 };
 
@@ -804,7 +835,7 @@ double one_sided_hausdorff(const std::vector<float>& from, std::vector<float> to
         for (uint64_t k = samples_for(triangle_area(tri), density, rng); k > 0; --k) {
             double p[3], bary[3];
             point_in_triangle(tri, rng, p, bary);
-            if (max2 > 0 && index.nearest_dist2(p, max2) < max2) continue;
+            if (max2 > 0 && index.any_within(p, max2)) continue;
             max2 = std::max(max2, index.nearest_dist2(p));
         }
     }

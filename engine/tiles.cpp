@@ -408,11 +408,41 @@ class TileStore {
 public:
     explicit TileStore(const std::string& dir) : file_(dir, "tile-positions") {}
 
-    // Thread-safe.
+    // Stores tile `node`'s positions (y-up, 9 floats a triangle). Thread-safe.
     void add(int node, const std::vector<float>& xyz) {
+        // The triangles by their centroid's cell of a 4 × 4 × 4 grid over the tile's box, each
+        // cell's run with its content's box, so that a crop reads the runs that meet it.
+        const size_t n = xyz.size() / 9;
+        Box box;
+        for (size_t i = 0; i < xyz.size(); i += 3) box.add(&xyz[i]);
+        std::vector<uint8_t> cell(n);
+        std::array<Run, kCells> runs{};
+        for (size_t t = 0; t < n; ++t) {
+            int c = 0;
+            for (int a = 0; a < 3; ++a) {
+                const double centre = (double(xyz[9 * t + a]) + xyz[9 * t + 3 + a] + xyz[9 * t + 6 + a]) / 3;
+                const double f = (centre - box.min[a]) / (box.max[a] - box.min[a]) * kSide;
+                c = c * kSide + (f > 0 ? std::min(int(f), kSide - 1) : 0);  // NaN, a flat box: 0
+            }
+            cell[t] = uint8_t(c);
+            ++runs[size_t(c)].count;
+        }
+        uint32_t first = 0;
+        for (Run& r : runs) r.first = first, first += r.count;
+        std::vector<float> sorted(xyz.size());
+        std::array<uint32_t, kCells> at{};
+        for (size_t c = 0; c < kCells; ++c) at[c] = runs[c].first;
+        for (size_t t = 0; t < n; ++t) {
+            const uint32_t to = at[cell[t]]++;
+            std::copy_n(&xyz[9 * t], 9, &sorted[9 * size_t(to)]);
+            Box b;
+            for (int k = 0; k < 3; ++k) b.add(&xyz[9 * t + 3 * size_t(k)]);
+            runs[cell[t]].box.add(b);
+        }
         const std::lock_guard<std::mutex> lock(mutex_);
-        at_[node] = {file_.size(), xyz.size()};
-        file_.write(xyz.data(), xyz.size() * sizeof(float));
+        at_[node] = {file_.size(), sorted.size()};
+        file_.write(sorted.data(), sorted.size() * sizeof(float));
+        file_.write(runs.data(), sizeof runs);
     }
     // Makes what add() wrote readable by get(); call once the tiles of a depth are written.
     void flush() {
@@ -426,8 +456,33 @@ public:
         file_.read_flushed_at(offset, xyz.data(), floats * sizeof(float));
         return xyz;
     }
+    // Appends to `out` the triangles of tile `node` whose bounding box meets `crop` (y-up),
+    // reading only the runs whose box meets it. Thread-safe while nothing is added.
+    void append_within(int node, const Box& crop, std::vector<float>& out) const {
+        const auto [offset, floats] = at_.at(node);
+        std::array<Run, kCells> runs;
+        file_.read_flushed_at(offset + floats * sizeof(float), runs.data(), sizeof runs);
+        thread_local std::vector<float> buffer;
+        for (const Run& r : runs) {
+            if (r.count == 0 || !r.box.meets(crop)) continue;
+            buffer.resize(9 * size_t(r.count));
+            file_.read_flushed_at(offset + 9 * sizeof(float) * uint64_t(r.first), buffer.data(),
+                                  buffer.size() * sizeof(float));
+            for (size_t t = 0; t < buffer.size(); t += 9) {
+                Box b;
+                for (int c = 0; c < 3; ++c) b.add(&buffer[t + 3 * size_t(c)]);
+                if (b.meets(crop)) out.insert(out.end(), &buffer[t], &buffer[t] + 9);
+            }
+        }
+    }
 
 private:
+    static constexpr int kSide = 4;
+    static constexpr size_t kCells = kSide * kSide * kSide;
+    struct Run {  // a grid cell's triangles in the file, after the tile's
+        uint32_t first = 0, count = 0;
+        Box box;
+    };
     io::TempFile file_;
     std::mutex mutex_;
     std::unordered_map<int, std::pair<uint64_t, size_t>> at_;  // node: byte offset, floats
@@ -680,15 +735,6 @@ private:
     std::optional<io::GltfSettings::Grid> grid_;  // set_grid's, for every level
 };
 
-// Appends to `out` the triangles of `xyz` whose bounding box meets `crop` (both y-up).
-void append_within(const std::vector<float>& xyz, const Box& crop, std::vector<float>& out) {
-    for (size_t t = 0; t < xyz.size(); t += 9) {
-        Box b;
-        for (int c = 0; c < 3; ++c) b.add(&xyz[t + 3 * size_t(c)]);
-        if (b.meets(crop)) out.insert(out.end(), &xyz[t], &xyz[t] + 9);
-    }
-}
-
 // The geometric error of a tile: the Hausdorff distance between what a viewer draws with it
 // and what it draws with its children instead, plus their largest error (0 without content:
 // nothing is drawn instead of the children). Triangles go to tiles by centroid, so near a
@@ -735,7 +781,7 @@ double tile_error(const Node& n, const Tree& tree, const Cube& cube, const TileS
             const bool drawn = other.depth == depth || (other.leaf && other.depth < depth);
             if (!drawn || other.uri.empty() || other.box.empty() || int(o) == id) continue;
             if (std::find(n.child.begin(), n.child.end(), int(o)) != n.child.end()) continue;  // in `side`
-            if (other.box.meets(model)) append_within(store.get(int(o)), around, side);
+            if (other.box.meets(model)) store.append_within(int(o), around, side);
         }
         return side;
     };
