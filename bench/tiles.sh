@@ -2,10 +2,11 @@
 # `meshstream tiles` against `meshstream decimate -r 0.01` on the same generated mesh with the same
 # threads (docs/tiles.md; the figures in docs/results.md): the median wall time and peak memory
 # of $RUNS (default 3) runs each, a tiles run just before its decimate run, and the tileset's
-# bytes against its leaves' (from the tiles run's --json).
+# bytes against its leaves' (from the last tiles run's --json).
 #
 # Usage: bench/tiles.sh [N triangles (default 10000000)] [threads (default: every core)]
 #                       [build dir (default build)] [work dir]
+# MESH=FILE: tile FILE (a mesh `meshstream-gen -n N --color` wrote before) instead of generating one.
 set -euo pipefail
 
 here=$(cd "$(dirname "$0")" && pwd)
@@ -20,20 +21,23 @@ meshstream=$build/tools/meshstream
 gen=$build/tools/meshstream-gen
 [ -x "$meshstream" ] && [ -x "$gen" ] || die "no meshstream or meshstream-gen in $build/tools"
 
-echo "# bench/tiles.sh: N = $n triangles with colours, --threads $threads, $(nproc) cores, load $(load), commit $(git -C "$here" rev-parse --short HEAD)"
-"$gen" -q -n "$n" --color "$work/mesh.ply"
-cat "$work/mesh.ply" >/dev/null  # the page cache holds it for every run
+echo "# bench/tiles.sh: N = $n triangles with colours${MESH:+ ($MESH)}, --threads $threads, $(nproc) cores, load $(load), commit $(git -C "$here" rev-parse --short HEAD)"
+mesh=${MESH:-$work/mesh.ply}
+[ -n "${MESH:-}" ] || "$gen" -q -n "$n" --color "$mesh"
+cat "$mesh" >/dev/null  # the page cache holds it for every run
 
 rows=$work/rows
 for i in $(seq "${RUNS:-3}"); do
   rm -rf "$work/tiles"
-  echo "tiles $(measure "$meshstream" -q tiles "$work/mesh.ply" "$work/tiles" --threads "$threads" --json)" >> "$rows"
-  echo "decimate $(measure "$meshstream" -q decimate "$work/mesh.ply" "$work/d.glb" -r 0.01 --threads "$threads")" >> "$rows"
+  echo "tiles $(measure "$meshstream" -q tiles "$mesh" "$work/tiles" --threads "$threads" --json)" >> "$rows"
+  cp "$work/cmd.out" "$work/sizes.json"
+  echo "decimate $(measure "$meshstream" -q decimate "$mesh" "$work/d.glb" -r 0.01 --threads "$threads")" >> "$rows"
 done
-"$meshstream" -q tiles "$work/mesh.ply" "$work/sizes" --threads "$threads" --json > "$work/sizes.json"
 python3 - "$rows" "$work/sizes.json" <<'PY'
 import json, statistics, sys
 rows = [line.split() for line in open(sys.argv[1])]
+for r in rows:
+    print(f"  run: {r[0]:<10} {float(r[1]):8.2f} s {int(r[3]) / 1024:6.0f} MiB")
 med = {}
 for tool in ("tiles", "decimate"):
     mine = [r for r in rows if r[0] == tool]
