@@ -33,6 +33,9 @@
 #include <memory>
 #include <unordered_map>
 #include <unistd.h>
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
 
 namespace meshstream::engine {
 
@@ -230,6 +233,17 @@ struct Tree {
         return n;
     }
 };
+
+// Gives the heap's free memory back to the system; called between the steps. Each step frees
+// its buffers at its end (the sort's runs, a level's decimators, the errors' indexes on threads
+// of their own), but glibc keeps freed memory below its heap's top and in each thread's arena:
+// the resident set carried 125 to 180 MiB from step to step at 10 M triangles, and each step's
+// peak stood on it.
+void release_free_memory() {
+#ifdef __GLIBC__
+    malloc_trim(0);
+#endif
+}
 
 // A directory removed with everything in it unless kept.
 class DirectoryGuard {
@@ -940,6 +954,7 @@ TilesResult tile_file(const TilesSettings& s, ProgressSink& progress) {
             },
             &region, step, tree.max_depth > 0 ? sorted_input : std::string());
     }
+    release_free_memory();
     const int deepest = tree.max_depth;
 
     // A spooled input is named as it came, with what its reader found.
@@ -988,6 +1003,7 @@ TilesResult tile_file(const TilesSettings& s, ProgressSink& progress) {
             level = ds.output;
             level_format = "stream";
             below_count = d.triangles_out;
+            release_free_memory();
         }
         std::fill(region.begin(), region.end(), 0);
         StepProgress step(progress, "level " + std::to_string(depth) + " tiles");
@@ -998,6 +1014,7 @@ TilesResult tile_file(const TilesSettings& s, ProgressSink& progress) {
                 return n >= 0 && !tree.nodes[size_t(n)].leaf && tree.nodes[size_t(n)].depth == depth ? n : -1;
             },
             &region, step);
+        release_free_memory();
         // The level below is no longer needed.
         if (below != level) fs::remove(below, ec);
         below = level, below_format = level_format;
@@ -1008,6 +1025,7 @@ TilesResult tile_file(const TilesSettings& s, ProgressSink& progress) {
         for (Node& n : tree.nodes)
             if (n.depth == depth && !n.leaf) parents.push_back(&n);
         measure_errors(parents, tree, cube, store, s, step);
+        release_free_memory();
     }
 
     writer.report_notes(result.warnings);
