@@ -379,8 +379,10 @@ double box_dist2(const BvhNode& n, const double p[3]) {
 }
 
 // Nearest primitive to p: returns the smallest leaf_dist2(i) below `best2`, or best2; and in
-// *winner (when not null) that primitive, left alone when none is below best2.
-template <class LeafFn>
+// *winner (when not null) that primitive, left alone when none is below best2. With kAny, the
+// search stops at the first primitive below best2 (nearer boxes first), returning its distance:
+// whether some primitive is, not which is nearest.
+template <bool kAny = false, class LeafFn>
 double bvh_nearest(const std::vector<BvhNode>& nodes, const double p[3], double best2, LeafFn leaf_dist2,
                    uint32_t* winner = nullptr) {
     if (nodes.empty()) return best2;
@@ -389,10 +391,14 @@ double bvh_nearest(const std::vector<BvhNode>& nodes, const double p[3], double 
     stack[top++] = 0;
     while (top > 0) {
         const BvhNode& n = nodes[stack[--top]];
-        if (box_dist2(n, p) >= best2) continue;
+        // (With kAny, best2 has not moved since the node was pushed below it.)
+        if (!kAny && box_dist2(n, p) >= best2) continue;
         if (n.count) {
             for (uint32_t i = n.first; i < n.first + n.count; ++i) {
                 const double d2 = leaf_dist2(i);
+                if constexpr (kAny) {
+                    if (d2 < best2) return d2;
+                }
                 if (winner && d2 < best2) *winner = i;
                 best2 = std::min(best2, d2);  // a min, not a branch on d2: the hot loop of compare
             }
@@ -409,33 +415,6 @@ double bvh_nearest(const std::vector<BvhNode>& nodes, const double p[3], double 
         }
     }
     return best2;
-}
-
-// Whether some primitive has leaf_dist2(i) < r2: the search stops at the first one (nearer
-// boxes first), where bvh_nearest would go on for the nearest.
-template <class LeafFn>
-bool bvh_any_within(const std::vector<BvhNode>& nodes, const double p[3], double r2, LeafFn leaf_dist2) {
-    if (nodes.empty()) return false;
-    uint32_t stack[128];
-    int top = 0;
-    stack[top++] = 0;
-    while (top > 0) {
-        const BvhNode& n = nodes[stack[--top]];
-        if (n.count) {
-            for (uint32_t i = n.first; i < n.first + n.count; ++i)
-                if (leaf_dist2(i) < r2) return true;
-            continue;
-        }
-        const double dl = box_dist2(nodes[n.first], p), dr = box_dist2(nodes[n.first + 1], p);
-        if (dl <= dr) {
-            if (dr < r2) stack[top++] = n.first + 1;
-            if (dl < r2) stack[top++] = n.first;
-        } else {
-            if (dl < r2) stack[top++] = n.first;
-            if (dr < r2) stack[top++] = n.first + 1;
-        }
-    }
-    return false;
 }
 
 // Triangles held in memory, with their BVH and their corners' attribute values.
@@ -477,7 +456,7 @@ struct TriangleIndex {
     }
     // Whether a triangle is nearer p than sqrt(r2).
     bool any_within(const double p[3], double r2) const {
-        return bvh_any_within(nodes, p, r2, [&](uint32_t i) { return point_triangle_dist2(p, &xyz[9 * size_t{i}]); });
+        return bvh_nearest<true>(nodes, p, r2, [&](uint32_t i) { return point_triangle_dist2(p, &xyz[9 * size_t{i}]); }) < r2;
     }
 };
 
