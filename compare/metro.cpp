@@ -259,10 +259,9 @@ uint32_t morton30(uint32_t x, uint32_t y, uint32_t z) {
 // go in the Morton order of their centroids (10 bits an axis over the centroids' box, radix
 // sorted, ties in input order), then split top down where the highest bit of the code changes
 // (an octree's split along one axis; in the middle of a run of equal codes), down to
-// `leaf_size`; the boxes are then set bottom up. Linear but for the sort's three passes: a
-// median split at every node cost about four times as much (the tiles' errors build an index
-// for a few queries a triangle, where the build was a third of the time), and its tree was
-// searched only slightly faster. Depth: at most 30 splits by bits, then halvings.
+// `leaf_size`; the boxes are then set bottom up. Linear but for the sort's three passes, so a
+// build costs about what a few queries a primitive cost: the tiles' errors build an index for
+// about one query a triangle. Depth: at most 30 splits by bits, then halvings.
 template <class BoxFn>
 std::vector<BvhNode> build_bvh(uint32_t n, BoxFn box, uint32_t leaf_size, std::vector<uint32_t>& order) {
     std::vector<BvhNode> nodes;
