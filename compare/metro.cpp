@@ -8,6 +8,7 @@
 #include "io/byte_stream.hpp"
 #include "io/error.hpp"
 #include "io/random.hpp"
+#include "sort/radix.hpp"
 
 #include <algorithm>
 #include <array>
@@ -243,17 +244,6 @@ struct BvhNode {
     uint32_t count;  // primitives in a leaf, 0 for an inner node
 };
 
-// The 30-bit Morton code of a point with 10-bit coordinates: their bits interleaved.
-uint32_t morton30(uint32_t x, uint32_t y, uint32_t z) {
-    auto spread = [](uint32_t v) {  // bit b of v's 10 to bit 3b
-        v = (v | v << 16) & 0x030000FFu;
-        v = (v | v << 8) & 0x0300F00Fu;
-        v = (v | v << 4) & 0x030C30C3u;
-        return (v | v << 2) & 0x09249249u;
-    };
-    return spread(x) << 2 | spread(y) << 1 | spread(z);
-}
-
 // Builds a BVH over n primitives whose boxes `box(i, lo, hi)` gives. Returns the nodes and
 // writes the primitive order into `order` (the caller permutes its data by it). The primitives
 // go in the Morton order of their centroids (10 bits an axis over the centroids' box, radix
@@ -291,16 +281,10 @@ std::vector<BvhNode> build_bvh(uint32_t n, BoxFn box, uint32_t leaf_size, std::v
                 const float t = (c[a] - clo[a]) * scale[a];
                 q[a] = t > 0 ? uint32_t(std::min(t, 1023.0f)) : 0;  // NaN: 0
             }
-            items[i] = uint64_t{morton30(q[0], q[1], q[2])} << 32 | i;
+            items[i] = uint64_t{sort::morton30(q[0], q[1], q[2])} << 32 | i;
         }
         std::vector<uint64_t> scratch(n);
-        for (int shift = 32; shift < 62; shift += 10) {
-            uint32_t count[1025] = {};
-            for (uint64_t v : items) ++count[((v >> shift) & 1023) + 1];
-            for (int b = 0; b < 1024; ++b) count[b + 1] += count[b];
-            for (uint64_t v : items) scratch[count[(v >> shift) & 1023]++] = v;
-            items.swap(scratch);
-        }
+        if (sort::radix_sort_by_key(items, scratch).data() == scratch.data()) items.swap(scratch);
     }
     for (uint32_t k = 0; k < n; ++k) order[k] = uint32_t(items[k]);
     nodes.reserve(2 * (size_t{n} / leaf_size + 1));

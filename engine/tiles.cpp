@@ -10,6 +10,7 @@
 #include "io/pipeline.hpp"
 #include "io/triangle_input.hpp"
 #include "sort/external_sort.hpp"
+#include "sort/radix.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -63,15 +64,8 @@ struct Cube {
             const double t = (double(p[a]) - origin[a]) / extent * (1 << kMaxDepth);
             cell[a] = t <= 0 || !std::isfinite(t) ? 0 : uint32_t(std::min(t, double((1 << kMaxDepth) - 1)));
         }
-        // The cells' bits interleaved, x's highest: bit b of a coordinate to bit 3b.
-        auto spread = [](uint32_t v) {
-            v = (v | v << 16) & 0x030000FFu;
-            v = (v | v << 8) & 0x0300F00Fu;
-            v = (v | v << 4) & 0x030C30C3u;
-            return (v | v << 2) & 0x09249249u;
-        };
-        static_assert(kMaxDepth == 10, "spread() interleaves 10 bits");
-        return spread(cell[0]) << 2 | spread(cell[1]) << 1 | spread(cell[2]);
+        static_assert(kMaxDepth == 10, "sort::morton30 interleaves 10 bits");
+        return sort::morton30(cell[0], cell[1], cell[2]);
     }
     uint32_t triangle_key(const float* xyz) const {
         const float c[3] = {(xyz[0] + xyz[3] + xyz[6]) / 3, (xyz[1] + xyz[4] + xyz[7]) / 3,
@@ -236,9 +230,8 @@ struct Tree {
 
 // Gives the heap's free memory back to the system; called between the steps. Each step frees
 // its buffers at its end (the sort's runs, a level's decimators, the errors' indexes on threads
-// of their own), but glibc keeps freed memory below its heap's top and in each thread's arena:
-// the resident set carried 125 to 180 MiB from step to step at 10 M triangles, and each step's
-// peak stood on it.
+// of their own), but glibc keeps freed memory below its heap's top and in each thread's arena,
+// where it would stay resident under the next step's peak.
 void release_free_memory() {
 #ifdef __GLIBC__
     malloc_trim(0);

@@ -39,6 +39,19 @@ inline uint32_t triangle_key(const float* xyz, int axis) {
     return m < c ? m : c;
 }
 
+// The 30-bit Morton code of a cell of a 1024^3 grid (x, y, z each below 1024): their bits
+// interleaved, x's highest (bit b of a coordinate to bit 3b, 3b+1, 3b+2 for z, y, x). Sorted
+// by it, cells follow a Z-order curve: an octree's cells in depth-first order.
+inline uint32_t morton30(uint32_t x, uint32_t y, uint32_t z) {
+    auto spread = [](uint32_t v) {
+        v = (v | v << 16) & 0x030000FFu;
+        v = (v | v << 8) & 0x0300F00Fu;
+        v = (v | v << 4) & 0x030C30C3u;
+        return (v | v << 2) & 0x09249249u;
+    };
+    return spread(x) << 2 | spread(y) << 1 | spread(z);
+}
+
 // Stable LSD radix sort of `items` by their high 32 bits (the key); the low 32 bits are a
 // payload (here: the triangle's position in the run), so equal keys keep their input order.
 // `scratch` must have items.size() elements. Three passes of 11/11/10 bits; a pass whose
