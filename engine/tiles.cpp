@@ -61,7 +61,7 @@ struct Cube {
     uint32_t key(const float* p) const {
         uint32_t cell[3];
         for (int a = 0; a < 3; ++a) {
-            const double t = (double(p[a]) - origin[a]) / extent * (1 << kMaxDepth);
+            const double t = (double(p[a]) - origin[a]) * (double(1 << kMaxDepth) / extent);
             cell[a] = t <= 0 || !std::isfinite(t) ? 0 : uint32_t(std::min(t, double((1 << kMaxDepth) - 1)));
         }
         static_assert(kMaxDepth == 10, "sort::morton30 interleaves 10 bits");
@@ -552,10 +552,13 @@ public:
         progress.phase("sorting by cell", header.triangle_count);
         // With threads, the input is read on a thread of its own; this thread sorts (and counts).
         const std::optional<uint64_t> file_bytes = in.source().stored_size();
+        std::vector<uint32_t> keys;  // a chunk's, for the sorter and the counts
         auto add = [&](uint64_t read_so_far, uint64_t offset) {
-            sorter_->add(chunk);
+            keys.resize(chunk.size());
+            for (size_t i = 0; i < chunk.size(); ++i) keys[i] = cube_.triangle_key(&chunk.xyz()[9 * i]);
+            sorter_->add(chunk, keys);
             if (counts != nullptr)
-                for (size_t i = 0; i < chunk.size(); ++i) counts->add(cube_.triangle_key(&chunk.xyz()[9 * i]));
+                for (const uint32_t key : keys) counts->add(key);
             progress.update(read_so_far, offset, file_bytes);
             throw_if_cancelled(progress);
         };

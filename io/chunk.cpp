@@ -2,6 +2,7 @@
 #include "io/chunk.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -155,6 +156,13 @@ double get_scalar(const std::byte* src, ScalarType type) {
     return 0;
 }
 
+// v / 255 for every 8-bit component v, as float: the division once, not for every corner.
+constexpr std::array<float, 256> kUnorm8 = [] {
+    std::array<float, 256> t{};
+    for (int v = 0; v < 256; ++v) t[size_t(v)] = float(v) / 255.0f;
+    return t;
+}();
+
 }  // namespace
 
 void CornerLayout::pack_values(const float* normal, const float* rgba, const float* uv, const double* scalars,
@@ -187,9 +195,7 @@ void CornerLayout::unpack_values(const std::byte* src, float* normal, float* rgb
         float c[4] = {0.0f, 0.0f, 0.0f, 1.0f};
         for (int a = 0; a < n; ++a) {
             if (color_bytes_ == 1) {
-                uint8_t v;
-                src = get(src, v);
-                c[a] = float(v) / 255.0f;
+                c[a] = kUnorm8[std::to_integer<uint8_t>(*src++)];
             } else if (color_bytes_ == 2) {
                 uint16_t v;
                 src = get(src, v);

@@ -509,6 +509,10 @@ public:
                               : inline_buffer_ ? plain_stdout_need
                                                : plain_need);
         if (!binary_ && !inline_buffer_) check_side_files(sink.name(), side_files_of(sink.name(), options_));
+        // The count known and its tables within the budget (checked above): sized once.
+        if (const std::optional<uint64_t> n = options_.triangle_count ? options_.triangle_count
+                                                                      : options_.expected_triangle_count)
+            indexer_.reserve(*n);
     }
 
     void write_chunk(const TriangleChunk& chunk) override {

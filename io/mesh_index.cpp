@@ -193,6 +193,19 @@ MeshIndexer::MeshIndexer(std::string file_name, std::string format, const Channe
     slots_.assign(1024, kEmpty);
 }
 
+void MeshIndexer::reserve(uint64_t triangles) {
+    if (mesh_.vertex_count() > 0) return;
+    triangles = std::min<uint64_t>(triangles, kMaxIndexCount / 3);
+    // Slots at most half full (vertex_for's growth rule) for triangles / 2 vertices.
+    size_t slots = slots_.size();
+    while (slots < triangles + 2) slots *= 2;
+    if (slots > slots_.size()) slots_.assign(slots, kEmpty);
+    const size_t vertices = size_t(triangles / 2 + 2);
+    mesh_.positions.reserve(3 * vertices);
+    mesh_.attributes.reserve(layout_.bytes() * vertices);
+    mesh_.indices.reserve(3 * size_t(triangles));
+}
+
 uint64_t MeshIndexer::memory_bytes() const {
     // What is resident: the growing arrays up to their size (the pages of a vector's spare
     // capacity are not touched; counting capacity made the figure jump by a quarter at each

@@ -125,6 +125,11 @@ public:
     // and under `strict` for a triangle with a NaN or infinite coordinate (naming its index in
     // the stream), which is otherwise dropped and counted.
     void add(const TriangleChunk& chunk);
+    // Sizes the tables for `triangles` triangles to come whose corners are shared as a closed
+    // surface's are (half as many vertices as triangles): the hash slots at once, the arrays'
+    // capacity (untouched pages). More vertices grow them as without it. For a writer that
+    // knows the count and has checked that such tables fit its budget.
+    void reserve(uint64_t triangles);
 
     uint64_t input_triangle_count() const { return input_triangles_; }
     // Triangles dropped for a NaN or infinite coordinate.

@@ -188,8 +188,16 @@ uint32_t ExternalSorter::key_of(const float* xyz) const {
 }
 
 void ExternalSorter::add(const io::TriangleChunk& chunk) {
+    keys_.resize(chunk.size());
+    auto xyz = chunk.xyz();
+    for (size_t i = 0; i < chunk.size(); ++i) keys_[i] = key_of(&xyz[9 * i]);
+    add(chunk, keys_);
+}
+
+void ExternalSorter::add(const io::TriangleChunk& chunk, std::span<const uint32_t> keys) {
     assert(!input_done_);
     assert(chunk.channels() == options_.channels);
+    assert(keys.size() == chunk.size());
     const uint64_t capacity = stats_.run_capacity;
     if (!records_) {
         // Uninitialised: pages are touched (and count toward RSS) only as the run fills.
@@ -198,11 +206,10 @@ void ExternalSorter::add(const io::TriangleChunk& chunk) {
         advise_huge_pages(records_.get(), capacity * record_bytes_);
         advise_huge_pages(items_.get(), capacity * sizeof(uint64_t));
     }
-    auto xyz = chunk.xyz();
     for (size_t i = 0; i < chunk.size(); ++i) {
         if (run_size_ == capacity) spill_run();
         codec_.encode(chunk, i, records_.get() + run_size_ * record_bytes_);
-        items_[run_size_] = uint64_t{key_of(&xyz[9 * i])} << 32 | run_size_;
+        items_[run_size_] = uint64_t{keys[i]} << 32 | run_size_;
         ++run_size_;
     }
     stats_.triangles += chunk.size();

@@ -68,6 +68,10 @@ public:
     // chunk.channels() == options.channels. Throws io::Error when a temporary file cannot be
     // created or written (e.g. the disk is full); the sorter is then unusable.
     void add(const io::TriangleChunk& chunk);
+    // The same for a caller that has computed the triangles' keys already: keys[i] is chunk
+    // triangle i's, as options.key gives it (the merge computes the keys of the runs' heads
+    // again from their triangles).
+    void add(const io::TriangleChunk& chunk, std::span<const uint32_t> keys);
     // Ends the input: sorts the last run and, when needed, runs the intermediate merge passes
     // (the long part for big inputs; reported through on_merge_progress). Throws io::Error.
     void finish_input();
@@ -114,6 +118,7 @@ private:
     size_t run_size_ = 0;
     size_t emit_pos_ = 0;  // in-memory output position when nothing was spilled
     std::vector<std::byte> staging_;
+    std::vector<uint32_t> keys_;  // add(chunk)'s keys of a chunk
 
     // Runs on disk.
     std::unique_ptr<io::TempFile> runs_file_;

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <vector>
 
 using namespace meshstream;
@@ -140,6 +141,26 @@ TEST(CornerLayout, EightBitColourWithoutAlphaTakesThreeBytesAndRoundsToItsSteps)
     EXPECT_EQ(out[1], 128.0f / 255.0f);
     EXPECT_EQ(out[2], 0.0f);
     EXPECT_EQ(out[3], 1.0f);
+}
+
+TEST(CornerLayout, EveryEightBitComponentUnpacksToItsQuotientBy255) {
+    io::Channels ch;
+    ch.color = io::ColorFormat{};
+    ch.color->alpha = true;
+    const io::CornerLayout layout(ch);
+    ASSERT_EQ(layout.bytes(), 4u);
+    for (int v = 0; v < 256; ++v) {
+        const std::byte rec[4] = {std::byte(v), std::byte(255 - v), std::byte(0), std::byte(v)};
+        float out[4];
+        layout.unpack_values(rec, nullptr, out, nullptr, nullptr);
+        EXPECT_EQ(out[0], float(v) / 255.0f) << v;
+        EXPECT_EQ(out[1], float(255 - v) / 255.0f) << v;
+        EXPECT_EQ(out[2], 0.0f);
+        EXPECT_EQ(out[3], float(v) / 255.0f) << v;
+        std::byte back[4];
+        layout.pack_values(nullptr, out, nullptr, nullptr, back);  // and back to the same bytes
+        EXPECT_EQ(std::memcmp(back, rec, 4), 0) << v;
+    }
 }
 
 TEST(Channels, DescribeWhatAnOutputLacks) {

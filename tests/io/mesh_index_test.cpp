@@ -1,7 +1,7 @@
 // MeshIndexer tests: exact welding (-0 == +0), vertex-id mode, vertices keyed by their attribute
 // record too (seams stay apart), degenerate triangles kept, non-finite ones dropped and counted
 // (refused under strict, naming the triangle), parts by material, growth past the initial table,
-// and unit-length area-weighted normals shared across seams.
+// tables reserved for a known count, and unit-length area-weighted normals shared across seams.
 #include "io/mesh_index.hpp"
 
 #include "io/error.hpp"
@@ -9,6 +9,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <optional>
+#include <utility>
+#include <vector>
 
 namespace io = meshstream::io;
 
@@ -169,6 +172,39 @@ TEST(MeshIndexer, GrowsPastTheInitialTable) {
     io::Bounds b = m.bounds();
     EXPECT_EQ(b.max[0], 100.0f);
     EXPECT_EQ(b.min[1], 0.0f);
+}
+
+TEST(MeshIndexer, ReservedTablesGiveTheSameMesh) {
+    // The 60 x 60 grid (3721 vertices, 7200 triangles) in chunks of 64, indexed without a
+    // reservation, with one for its count, with one too small (the tables grow past it) and with
+    // one made once a vertex is in (ignored): the same indices and positions each time.
+    std::vector<io::TriangleChunk> chunks;
+    for (int y = 0; y < 60; ++y)
+        for (int x = 0; x < 60; ++x) {
+            float a[9] = {float(x), float(y), 0, float(x + 1), float(y), 0, float(x + 1), float(y + 1), 0};
+            float b[9] = {float(x), float(y), 0, float(x + 1), float(y + 1), 0, float(x), float(y + 1), 0};
+            for (auto* t : {&a, &b}) {
+                if (chunks.empty() || chunks.back().full()) chunks.emplace_back(64);
+                chunks.back().push(*t);
+            }
+        }
+    auto index = [&](std::optional<uint64_t> reserve, bool after_first) {
+        io::MeshIndexer ix("grid.glb", "glTF", {}, false);
+        if (reserve && !after_first) ix.reserve(*reserve);
+        for (size_t i = 0; i < chunks.size(); ++i) {
+            ix.add(chunks[i]);
+            if (reserve && after_first && i == 0) ix.reserve(*reserve);
+        }
+        EXPECT_EQ(ix.vertex_count(), 61u * 61u);
+        return ix.take();
+    };
+    const io::IndexedMesh plain = index(std::nullopt, false);
+    for (const auto& [reserve, after_first] :
+         {std::pair<uint64_t, bool>{7200, false}, {100, false}, {7200, true}, {uint64_t{1} << 40, true}}) {
+        const io::IndexedMesh m = index(reserve, after_first);
+        EXPECT_EQ(m.indices, plain.indices) << reserve;
+        EXPECT_EQ(m.positions, plain.positions) << reserve;
+    }
 }
 
 // A count near 2^64 (a broken header) made the estimate wrap: "need at least 16777216 TiB …
