@@ -5,8 +5,8 @@
 // own vertex block is read in place (of_input_file). emit_polygon, at the end, turns a face
 // into triangles for both readers.
 //
-// Memory: records in a file are read through a direct-mapped cache of its 4 KiB pages, as
-// large as the budget and filled by pread, so resident memory is the budget (and 1/512 of it
+// Memory: records in a file are read through a direct-mapped cache of its 512-byte pages, as
+// large as the budget and filled by pread, so resident memory is the budget (and 1/64 of it
 // for the pages' tags) plus one 1 MiB append buffer, whatever the input size; the OS page
 // cache, which RSS does not count, keeps the file's pages between misses. A shared mmap did this before: its resident
 // pages had to be counted and dropped by hand, and Linux maps far more than the page a read faults in (the page's whole
@@ -85,7 +85,7 @@ private:
     uint64_t file_offset_ = 0;  // where record 0 is in the file
     uint64_t file_records_ = 0;
     std::vector<std::byte> tail_;
-    // A direct-mapped cache of the file's 4 KiB pages (numbered from the one holding record 0).
+    // A direct-mapped cache of the file's 512-byte pages (numbered from the one holding record 0).
     // Anonymous memory of its own, so that it goes back to the system with the reader (sort
     // frees the reader before merging; from malloc's heap its pages stayed resident).
     struct Unmap {
