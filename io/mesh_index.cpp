@@ -196,9 +196,10 @@ MeshIndexer::MeshIndexer(std::string file_name, std::string format, const Channe
 void MeshIndexer::reserve(uint64_t triangles) {
     if (mesh_.vertex_count() > 0) return;
     triangles = std::min<uint64_t>(triangles, kMaxIndexCount / 3);
-    // Slots at most half full (vertex_for's growth rule) for triangles / 2 vertices.
+    // Two slots a vertex for triangles / 2 vertices, as the writers' budget estimates count them
+    // (vertex_for grows the table once it is half full).
     size_t slots = slots_.size();
-    while (slots < triangles + 2) slots *= 2;
+    while (slots < triangles) slots *= 2;
     if (slots > slots_.size()) slots_.assign(slots, kEmpty);
     const size_t vertices = size_t(triangles / 2 + 2);
     mesh_.positions.reserve(3 * vertices);
