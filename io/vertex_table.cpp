@@ -118,8 +118,9 @@ void VertexTable::flush_tail() {
 
 void VertexTable::start_cache(uint64_t table_bytes) {
     // Slots for the whole table when it fits the budget (no two pages then share a slot),
-    // else for the budget; at least 16.
-    const uint64_t pages = std::min(table_bytes / kPageBytes + 2, std::max<uint64_t>(budget_bytes_ / kPageBytes, 16));
+    // else as many as the budget holds with their tags; at least 16.
+    const uint64_t pages = std::min(table_bytes / kPageBytes + 2,
+                                    std::max<uint64_t>(budget_bytes_ / (kPageBytes + sizeof(uint64_t)), 16));
     const size_t bytes = static_cast<size_t>(pages * kPageBytes);
     void* p = ::mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);  // resident when used
     if (p == MAP_FAILED) throw std::bad_alloc();

@@ -5,13 +5,13 @@
 // own vertex block is read in place (of_input_file). emit_polygon, at the end, turns a face
 // into triangles for both readers.
 //
-// Memory: records in a file are read through a direct-mapped cache of its 512-byte pages, as
-// large as the budget and filled by pread, so resident memory is the budget (and 1/64 of it
-// for the pages' tags) plus one 1 MiB append buffer, whatever the input size; the OS page
-// cache, which RSS does not count, keeps the file's pages between misses. A shared mmap did this before: its resident
-// pages had to be counted and dropped by hand, and Linux maps far more than the page a read faults in (the page's whole
-// page-cache folio, up to 2 MiB, and 64 KiB of neighbours), which made a budget either leak (counted too finely) or
-// cost 2 MiB mappings on every miss (counted per folio).
+// Memory: records in a file are read through a direct-mapped cache of its 512-byte pages,
+// filled by pread, its pages and their tags within the budget, so resident memory is the budget
+// plus one 1 MiB append buffer, whatever the input size; the OS page cache, which RSS does not
+// count, keeps the file's pages between misses. The file is not mmap'ed: Linux maps far more
+// than the page a read faults in (the page's whole page-cache folio, up to 2 MiB, and 64 KiB of
+// neighbours), so resident pages would have to be counted and dropped by hand, either too
+// finely (the budget leaks) or per folio (2 MiB mapped on every miss).
 #pragma once
 
 #include "io/byte_stream.hpp"
