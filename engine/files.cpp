@@ -5,6 +5,7 @@
 
 #include <sys/stat.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -34,21 +35,42 @@ void add_corners(io::Bounds& box, std::span<const float> xyz) {
 }  // namespace
 
 io::Bounds input_bounds(const std::string& path, std::string_view from, const io::ReadOptions& options,
-                        ProgressSink& progress, uint64_t* vertex_table_bytes) {
+                        ProgressSink& progress) {
+    return input_box(path, from, options, progress, false).box;
+}
+
+InputBox input_box(const std::string& path, std::string_view from, const io::ReadOptions& options,
+                   ProgressSink& progress, bool vertices_will_do) {
     io::ReadOptions positions = options;  // nothing but positions is looked at
     positions.channels = io::ChannelKinds::none();
     positions.memory_budget_bytes = options.memory_budget_bytes / 8 * 7;  // beside the marks below
     io::Input in = io::open_input(path, from, positions);
-    io::Bounds box;
+    InputBox found;
+    io::Bounds& box = found.box;
     box.min.fill(std::numeric_limits<float>::infinity());
     box.max.fill(-std::numeric_limits<float>::infinity());
-    progress.phase("bounding box", in.reader->triangle_count());
     uint64_t done = 0;
+    io::IndexedSource* own = in.reader->indexed();
+    if (own != nullptr) found.vertex_table_bytes = own->vertex_table_bytes();
+    // Every vertex, in order: no face is read.
+    if (own != nullptr && vertices_will_do) {
+        found.of_vertices = true;
+        progress.phase("bounding box of the vertices", own->vertex_count());
+        std::vector<float> xyz;
+        for (uint64_t v = 0; v < own->vertex_count();) {
+            const uint64_t n = std::min<uint64_t>(own->vertex_count() - v, 1 << 16);
+            xyz.resize(3 * n);
+            own->positions(v, n, xyz.data());
+            add_corners(box, xyz);
+            progress.update(v += n);
+            if (progress.cancelled()) throw Cancelled();
+        }
+        return found;
+    }
+    progress.phase("bounding box", in.reader->triangle_count());
     // A file of vertices and faces (PLY) whose vertices' marks fit in an eighth of the budget:
     // the faces' indices mark the vertices used, then the vertices are read in order, which is
     // much cheaper than a triangle's corners looked up one by one. The same corners, the same box.
-    io::IndexedSource* own = in.reader->indexed();
-    if (vertex_table_bytes != nullptr) *vertex_table_bytes = own != nullptr ? own->vertex_table_bytes() : 0;
     if (own != nullptr && (own->vertex_count() + 7) / 8 <= options.memory_budget_bytes / 8) {
         std::vector<uint64_t> used((own->vertex_count() + 63) / 64);
         std::vector<uint32_t> indices;
@@ -64,7 +86,7 @@ io::Bounds input_bounds(const std::string& path, std::string_view from, const io
                 own->vertex(v, xyz, nullptr);
                 add_corners(box, xyz);
             }
-        return box;
+        return found;
     }
     io::TriangleChunk chunk(io::TriangleChunk::kDefaultCapacity);
     while (in.reader->next(chunk)) {
@@ -72,7 +94,7 @@ io::Bounds input_bounds(const std::string& path, std::string_view from, const io
         progress.update(done += chunk.size(), in.source->stored_offset(), in.source->stored_size());
         if (progress.cancelled()) throw Cancelled();
     }
-    return box;
+    return found;
 }
 
 int longest_axis(const io::Bounds& box) {

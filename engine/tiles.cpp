@@ -21,6 +21,7 @@
 #include <exception>
 #include <mutex>
 #include <set>
+#include <limits>
 #include <thread>
 #include <array>
 #include <cmath>
@@ -508,9 +509,9 @@ public:
 
     // Reads `mesh` into the sorter by cell key, counting the keys in `counts` when given.
     // Notes what the reader dropped or changed in `warnings` and the input's name and count in
-    // `result`, when given.
-    void sort(const std::string& mesh, std::string_view format, CellCounts* counts, ProgressSink& progress,
-              Warnings* warnings, TilesResult* result, uint64_t vertex_table_bytes = 0) {
+    // `result`, when given. Returns the box of the triangles sorted.
+    io::Bounds sort(const std::string& mesh, std::string_view format, CellCounts* counts, ProgressSink& progress,
+                    Warnings* warnings, TilesResult* result, uint64_t vertex_table_bytes = 0) {
         // The reader's share of the memory budget (what a PLY or OBJ reader holds: its vertex
         // table, spilled past it): 3/16, beside the sort's 3/8 and the cell counts' 3/16; the
         // last quarter for the rest (chunks, the tiles being written). A vertex table (of
@@ -553,9 +554,19 @@ public:
         // With threads, the input is read on a thread of its own; this thread sorts (and counts).
         const std::optional<uint64_t> file_bytes = in.source().stored_size();
         std::vector<uint32_t> keys;  // a chunk's, for the sorter and the counts
+        io::Bounds box;
+        box.min.fill(std::numeric_limits<float>::infinity());
+        box.max.fill(-std::numeric_limits<float>::infinity());
         auto add = [&](uint64_t read_so_far, uint64_t offset) {
             keys.resize(chunk.size());
-            for (size_t i = 0; i < chunk.size(); ++i) keys[i] = cube_.triangle_key(&chunk.xyz()[9 * i]);
+            const float* xyz = chunk.xyz().data();
+            for (size_t i = 0; i < chunk.size(); ++i) keys[i] = cube_.triangle_key(xyz + 9 * i);
+            // (The policy dropped the triangles with a NaN or infinite coordinate.)
+            for (size_t i = 0; i < 9 * chunk.size(); i += 3)
+                for (int a = 0; a < 3; ++a) {
+                    box.min[a] = std::min(box.min[a], xyz[i + a]);
+                    box.max[a] = std::max(box.max[a], xyz[i + a]);
+                }
             sorter_->add(chunk, keys);
             if (counts != nullptr)
                 for (const uint32_t key : keys) counts->add(key);
@@ -580,6 +591,7 @@ public:
             result->input_format = std::string(in.format().name);
             result->triangles_in = in.count().read;
         }
+        return box;
     }
 
     // Quantizes every tile's positions on one grid over the cube, so that a position two tiles
@@ -909,12 +921,12 @@ TilesResult tile_file(const TilesSettings& s, ProgressSink& progress) {
         input_format = "stream";
     }
 
-    // The bounding cube.
-    Cube cube;
-    uint64_t vertex_table_bytes = 0;  // the input's, for the reader's share of the budget
-    {
-        StepProgress step(progress, "bounds");
-        const io::Bounds b = input_bounds(input, input_format, s.read, step, &vertex_table_bytes);
+    // The bounding cube: the box of the input's triangles, from its lowest corner, as wide as its
+    // longest side. A PLY's box is found from its vertices alone, without reading its faces
+    // (input_box); the leaves' sort then finds its triangles' box, and if some vertex no face
+    // uses lay outside it, the sort is done again on the triangles' cube.
+    auto cube_of = [&](const io::Bounds& b) {
+        Cube cube;
         double extent = 0;
         for (int a = 0; a < 3; ++a) {
             cube.origin[a] = b.min[a];
@@ -923,6 +935,14 @@ TilesResult tile_file(const TilesSettings& s, ProgressSink& progress) {
         if (!(extent >= 0) || !std::isfinite(extent))
             throw io::Error(s.input, "no triangle with finite coordinates: nothing to tile");
         cube.extent = extent > 0 ? extent * (1 + 1e-6) : 1;
+        return cube;
+    };
+    Cube cube;
+    InputBox found;
+    {
+        StepProgress step(progress, "bounds");
+        found = input_box(input, input_format, s.read, step, true);
+        cube = cube_of(found.box);
     }
 
     // The leaves: the input sorted by cell while its cells are counted, the octree built from
@@ -937,7 +957,16 @@ TilesResult tile_file(const TilesSettings& s, ProgressSink& progress) {
     {
         StepProgress step(progress, "leaves");
         CellCounts counts(s.read.memory_budget_bytes * 3 / 16);
-        writer.sort(input, input_format, &counts, step, &result.warnings, &result, vertex_table_bytes);
+        Warnings read;  // what the reader said, of the sort that is kept
+        const io::Bounds corners =
+            writer.sort(input, input_format, &counts, step, &read, &result, found.vertex_table_bytes);
+        if (found.of_vertices && !counts.empty() && (corners.min != found.box.min || corners.max != found.box.max)) {
+            cube = cube_of(corners);  // the writer's cube
+            counts = CellCounts(s.read.memory_budget_bytes * 3 / 16);
+            read = Warnings();
+            writer.sort(input, input_format, &counts, step, &read, &result, found.vertex_table_bytes);
+        }
+        result.warnings.merge(read);
         if (counts.empty()) throw io::Error(s.input, "no triangle to tile");
         const std::vector<std::pair<uint32_t, uint64_t>> cells = counts.sorted();
         tree.build(cells, 0, cells.size(), 0, 0, s.tile_triangles, counts.depth());

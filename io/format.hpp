@@ -117,6 +117,9 @@ public:
     // CornerLayout(channels) packs them, `channels` being what the reader stores (ReadOptions::
     // channels of the header's). Cheapest in order.
     virtual void vertex(uint64_t i, float* xyz, std::byte* record) = 0;
+    // The positions of vertices [first, first + count) (<= vertex_count()) into xyz, 3 floats
+    // each, read in bulk: the cheapest way through all of them in order.
+    virtual void positions(uint64_t first, uint64_t count, float* xyz) = 0;
     // Appends the triangles of the next faces (about `max` of them, a polygon triangulated as
     // next() would), 3 vertex indices each, counter-clockwise; returns false, appending
     // nothing, once the faces are done and the rest of the file checked. Throws io::Error for

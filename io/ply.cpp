@@ -192,6 +192,7 @@ private:
     uint64_t vertex_count() const override { return table_->size(); }
     uint64_t vertex_table_bytes() const override { return table_->bytes(); }
     void vertex(uint64_t i, float* xyz, std::byte* record) override { table_->get(i, xyz, layout_ ? record : nullptr); }
+    void positions(uint64_t first, uint64_t count, float* xyz) override { table_->positions(first, count, xyz); }
     bool next_triangles(std::vector<uint32_t>& indices, size_t max) override {
         const size_t start = indices.size();
         for (;;) {

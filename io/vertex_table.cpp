@@ -190,6 +190,23 @@ void VertexTable::get(uint64_t i, float* xyz, std::byte* attributes) {
     if (attributes && attribute_bytes_ > 0) field(12, attribute_bytes_, attributes);
 }
 
+void VertexTable::positions(uint64_t first, uint64_t count, float* xyz) {
+    const uint64_t end = first + count;
+    if (storage_ != Storage::kMemory && first < file_records_) {
+        constexpr size_t kReadBytes = size_t{1} << 20;
+        const uint64_t per_read = std::max<uint64_t>(1, kReadBytes / stride_);
+        std::vector<std::byte> buffer(static_cast<size_t>(std::min(per_read, file_records_ - first) * stride_));
+        while (first < std::min(end, file_records_)) {
+            const uint64_t n = std::min({per_read, end - first, file_records_ - first});
+            read_file(file_offset_ + first * stride_, buffer.data(), static_cast<size_t>(n * stride_));
+            for (uint64_t r = 0; r < n; ++r, xyz += 3)
+                for (int a = 0; a < 3; ++a) std::memcpy(&xyz[a], &buffer[r * stride_ + xyz_offsets_[a]], 4);
+            first += n;
+        }
+    }
+    for (; first < end; ++first, xyz += 3) get(first, xyz, nullptr);  // in memory, or the temp file's tail
+}
+
 bool emit_polygon(VertexTable& table, const CornerLayout* layout, const std::vector<uint64_t>& polygon,
                   PolygonScratch& scratch, size_t* next, TriangleChunk& chunk) {
     const size_t n = polygon.size();

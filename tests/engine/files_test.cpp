@@ -68,11 +68,25 @@ TEST(EngineFiles, AVertexTablesBytesAreSaidAndNoneForAnStl) {
     test::spit(dir / "m.stl", kStl);
     io::ReadOptions options;
     engine::QuietProgress progress;
-    uint64_t bytes = 1;
-    engine::input_bounds(dir / "m.ply", "", options, progress, &bytes);
-    EXPECT_EQ(bytes, 8u * 12u);
-    engine::input_bounds(dir / "m.stl", "", options, progress, &bytes);
-    EXPECT_EQ(bytes, 0u);
+    for (bool vertices : {false, true}) {
+        EXPECT_EQ(engine::input_box(dir / "m.ply", "", options, progress, vertices).vertex_table_bytes, 8u * 12u);
+        EXPECT_EQ(engine::input_box(dir / "m.stl", "", options, progress, vertices).vertex_table_bytes, 0u);
+    }
+}
+
+TEST(EngineFiles, WhereVerticesWillDoAPlysBoxIsAllItsVerticesAndAnStlsItsTriangles) {
+    test::TempDir dir;
+    test::spit(dir / "m.ply", kPly);
+    test::spit(dir / "m.stl", kStl);
+    io::ReadOptions options;
+    engine::QuietProgress progress;
+    const engine::InputBox ply = engine::input_box(dir / "m.ply", "", options, progress, true);
+    EXPECT_TRUE(ply.of_vertices);
+    expect_box(ply.box, {-1, -100, -2}, {100, 3, 100});  // the unused vertex (100, -100, 100) too
+    const engine::InputBox stl = engine::input_box(dir / "m.stl", "", options, progress, true);
+    EXPECT_FALSE(stl.of_vertices);
+    expect_box(stl.box, {-1, 0, -2}, {2, 3, 1});
+    EXPECT_FALSE(engine::input_box(dir / "m.ply", "", options, progress, false).of_vertices);
 }
 
 TEST(EngineFiles, APlysNonFiniteCoordinateDecidesNothing) {

@@ -6,19 +6,23 @@
 #include "compare/topology.hpp"
 #include "io/error.hpp"
 #include "io/format.hpp"
+#include "io/read_indexed.hpp"
 #include "io/triangle_input.hpp"
 #include "test_util.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <atomic>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <map>
+#include <optional>
 #include <set>
 #include <string>
+#include <vector>
 
 namespace meshstream {
 namespace {
@@ -339,6 +343,59 @@ TEST(Tiles, TilesWrittenOnThreadsAreTheSameRunToRunAndTheLeavesAsOnOne) {
         }
     EXPECT_EQ(leaves, two.levels.back().leaves);
     EXPECT_GT(leaves, 8u);
+}
+
+// The labels of the phases a call reports.
+struct PhaseLabels final : engine::ProgressSink {
+    std::vector<std::string> labels;
+    void phase(std::string label, std::optional<uint64_t>) override { labels.push_back(std::move(label)); }
+    void update(uint64_t) override {}
+    void update(uint64_t, uint64_t, std::optional<uint64_t>) override {}
+    void status(const std::string&) override {}
+    size_t count(const std::string& label) const { return size_t(std::count(labels.begin(), labels.end(), label)); }
+};
+
+// `mesh` as a binary PLY (float x, y, z; triangles), with the vertices `extra` after its own,
+// used by no face.
+void write_ply(const fs::path& path, const io::IndexedMesh& mesh, const std::vector<float>& extra) {
+    std::ofstream f(path, std::ios::binary);
+    f << "ply\nformat binary_little_endian 1.0\nelement vertex " << mesh.vertex_count() + extra.size() / 3
+      << "\nproperty float x\nproperty float y\nproperty float z\nelement face " << mesh.triangle_count()
+      << "\nproperty list uchar int vertex_indices\nend_header\n";
+    f.write(reinterpret_cast<const char*>(mesh.positions.data()), std::streamsize(mesh.positions.size() * 4));
+    f.write(reinterpret_cast<const char*>(extra.data()), std::streamsize(extra.size() * 4));
+    for (size_t t = 0; t < mesh.triangle_count(); ++t) {
+        f.put(3);
+        f.write(reinterpret_cast<const char*>(&mesh.indices[3 * t]), 12);
+    }
+}
+
+TEST(Tiles, APlysCubeIsItsTrianglesEvenWithVerticesNoFaceUsesOutsideThem) {
+    // The bunny as a PLY is tiled as the STL is, its box found from its vertices alone (one
+    // sort); with a vertex no face uses far outside it, the sort is done again on the
+    // triangles' cube, and the tileset is the same; one inside the box changes nothing.
+    TempDir dir;
+    const io::IndexedMesh bunny = io::read_indexed(kBunny).mesh;
+    write_ply(dir / "bunny.ply", bunny, {});
+    write_ply(dir / "outside.ply", bunny, {1000, -1000, 1000});
+    const io::Bounds box = bunny.bounds();
+    write_ply(dir / "inside.ply", bunny,
+              {(box.min[0] + box.max[0]) / 2, (box.min[1] + box.max[1]) / 2, (box.min[2] + box.max[2]) / 2});
+    engine::TilesSettings s = bunny_settings(dir / "stl", engine::TileCompression::kMeshopt);
+    engine::QuietProgress quiet;
+    engine::tile_file(s, quiet);
+    const std::string sorting = "tiles: leaves: sorting by cell";
+    for (const char* name : {"bunny", "outside", "inside"}) {
+        SCOPED_TRACE(name);
+        s.input = dir / (std::string(name) + ".ply");
+        s.outdir = dir / name;
+        PhaseLabels phases;
+        const engine::TilesResult r = engine::tile_file(s, phases);
+        EXPECT_EQ(r.triangles_in, bunny.triangle_count());
+        EXPECT_EQ(phases.count("tiles: bounds: bounding box of the vertices"), 1u);
+        EXPECT_EQ(phases.count(sorting), std::string(name) == "outside" ? 2u : 1u);
+        EXPECT_EQ(files_under(dir / name), files_under(dir / "stl"));
+    }
 }
 
 TEST(Tiles, ANonEmptyDirectoryIsRefusedAndKept) {

@@ -123,6 +123,49 @@ TEST(VertexTable, ReadsRecordsOfAnInputFileInPlace) {
     for (uint64_t i = n; i-- > 0;) expect_vertex(*t, (i * 31) % n);
 }
 
+// Positions read in bulk are the records' whatever the storage: from memory, from a spilled
+// temp file and its unflushed tail, and from an input file (past 1 MiB, in several reads),
+// from any first record.
+TEST(VertexTable, PositionsReadInBulkAreTheRecordsPositions) {
+    test::TempDir dir;
+    auto expect_positions = [](io::VertexTable& t) {
+        const uint64_t n = t.size();
+        for (uint64_t first : {uint64_t{0}, uint64_t{1}, n / 3}) {
+            std::vector<float> xyz(3 * (n - first) + 3, -7.0f);
+            t.positions(first, n - first, xyz.data());
+            for (uint64_t i = first; i < n; ++i) {
+                ASSERT_EQ(xyz[3 * (i - first)], static_cast<float>(i) * 0.5f) << i;
+                ASSERT_EQ(xyz[3 * (i - first) + 1], -static_cast<float>(i)) << i;
+                ASSERT_EQ(xyz[3 * (i - first) + 2], 3.0f) << i;
+            }
+            EXPECT_EQ(xyz.back(), -7.0f);  // nothing past the count
+        }
+        expect_vertex(t, n / 2);  // the cache still reads
+    };
+    for (uint64_t budget : {uint64_t{64} << 20, uint64_t{1} << 20}) {
+        io::VertexTable t(budget, dir.path(), 3);
+        for (uint64_t i = 0; i < 150000; ++i) {  // 2.25 MB
+            const float xyz[3] = {static_cast<float>(i) * 0.5f, -static_cast<float>(i), 3.0f};
+            const std::byte attributes[3] = {std::byte{1}, static_cast<std::byte>(i), std::byte{2}};
+            t.append(xyz, attributes);
+        }
+        EXPECT_EQ(t.storage(), budget > (4u << 20) ? io::VertexTable::Storage::kMemory : io::VertexTable::Storage::kTempFile);
+        expect_positions(t);
+    }
+    std::string bytes(5, 'j');
+    const uint64_t n = 100000;  // 20-byte records: 2 MB
+    for (uint64_t i = 0; i < n; ++i) {
+        char rec[20] = {};
+        const float xyz[3] = {static_cast<float>(i) * 0.5f, -static_cast<float>(i), 3.0f};
+        std::memcpy(rec + 2, xyz, 12);
+        bytes.append(rec, 20);
+    }
+    test::spit(dir / "v.bin", bytes);
+    const size_t xyz_offsets[3] = {2, 6, 10};
+    auto t = io::VertexTable::of_input_file(dir / "v.bin", 5, n, 20, xyz_offsets, 16 << 10);
+    expect_positions(*t);
+}
+
 namespace {
 // The process's resident set now (not its peak), from /proc/self/statm.
 uint64_t resident_bytes() {
