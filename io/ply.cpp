@@ -660,7 +660,14 @@ private:
         for (size_t i = 0; i < elements_.size(); ++i) {
             element_ = i;
             item_ = 0;
-            if (static_cast<int>(i) == face_) return;
+            if (static_cast<int>(i) == face_) {
+                // Binary triangles of one index list of integers: prefetch_ahead() can find them.
+                const Element& f = elements_[i];
+                if (encoding_ != Encoding::kAscii && !strips_ && table_ && f.props.size() == 1 &&
+                    f.props[0].is_list && !is_float_type(f.props[0].type) && index_prop_ == 0)
+                    face_bytes_ = scalar_type_bytes(f.props[0].count_type) + 3 * scalar_type_bytes(f.props[0].type);
+                return;
+            }
             if (static_cast<int>(i) == vertex_) {
                 read_vertices(i);
                 if (face_ < 0) return;  // a point cloud: nothing more to read
@@ -799,6 +806,7 @@ private:
     // ---- faces ----
     void read_face() {
         const Element& e = elements_[static_cast<size_t>(face_)];
+        if (face_bytes_ > 0) prefetch_ahead();
         polygon_.clear();
         polygon_next_ = 0;
         const uint64_t item_offset = src_.offset();  // binary: the face's first byte
@@ -819,6 +827,24 @@ private:
         item_ends();
         if (!strips_ && corners < 3) few_corners(corners, item_offset);
         ++item_;
+    }
+
+    // The vertices of the face kPrefetchFaces ahead, when a binary face element holds nothing
+    // but the index list and that face, read as a triangle, is one (a guess: faces of other
+    // sizes before it misplace it, and a wrong guess costs a few loads): asked of the vertex
+    // table ahead, so that its lookups overlap instead of each waiting for memory.
+    void prefetch_ahead() {
+        constexpr size_t kPrefetchFaces = 8;
+        const std::span<const std::byte> ahead = src_.peek(face_bytes_ * (kPrefetchFaces + 1));
+        if (ahead.size() < face_bytes_ * (kPrefetchFaces + 1)) return;
+        const Property& p = elements_[static_cast<size_t>(face_)].props[0];
+        const std::byte* face = ahead.data() + face_bytes_ * kPrefetchFaces;
+        if (decode_int(face, p.count_type) != 3) return;
+        const size_t count_bytes = scalar_type_bytes(p.count_type), index_bytes = scalar_type_bytes(p.type);
+        for (size_t k = 0; k < 3; ++k) {
+            const int64_t v = decode_int(face + count_bytes + k * index_bytes, p.type);
+            if (v >= 0 && static_cast<uint64_t>(v) < table_->size()) table_->prefetch(static_cast<uint64_t>(v));
+        }
     }
 
     // Reads a face's index list into polygon_ (a strip's into strip_triangles_); returns its length.
@@ -960,6 +986,7 @@ private:
     PolygonScratch polygon_scratch_;
     size_t polygon_next_ = 0;                // next triangle of polygon_ to emit
     bool strips_ = false;                    // face_ is a tristrips element
+    size_t face_bytes_ = 0;                  // a triangle's bytes, for prefetch_ahead (0: none)
     std::vector<uint64_t> strip_triangles_;  // index triples of the strips read, emitted from strip_next_
     size_t strip_next_ = 0;
 };

@@ -15,11 +15,6 @@
 namespace meshstream::io {
 namespace {
 
-// The cache's page: small, because faces refer to vertices scattered through a window of the
-// table, so a large page holds mostly vertices nobody asks for (fewer of the wanted ones fit
-// the budget, and each miss copies more); smaller pages than this miss about as often, and a
-// miss costs mostly the pread call (docs/results.md#formats).
-constexpr size_t kPageBytes = 512;
 constexpr uint64_t kNoPage = ~uint64_t{0};
 constexpr size_t kTailBytes = size_t{1} << 20;
 

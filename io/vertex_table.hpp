@@ -62,8 +62,38 @@ public:
     // in bulk: from a file, in reads of up to 1 MiB beside the page cache, which is left as it
     // is. The cheapest way through every record in order.
     void positions(uint64_t first, uint64_t count, float* xyz);
+    // A hint that record i (< size()) is read soon: its bytes are asked of the memory ahead (a
+    // record from a file, where its page would be cached), so that get() does not wait for
+    // them. The faces index vertices at random: without it a read waits for memory at most corners.
+    void prefetch(uint64_t i) const {
+        const std::byte* rec = nullptr;
+        if (storage_ == Storage::kMemory) {
+            rec = blocks_[i >> kBlockRecordsLog2].get() + (i & ((uint64_t{1} << kBlockRecordsLog2) - 1)) * stride_;
+        } else if (i < file_records_) {
+            const uint64_t at = file_offset_ % kPageBytes + i * stride_;
+            const size_t slot = static_cast<size_t>(at / kPageBytes % page_tags_.size());
+            prefetch_line(&page_tags_[slot]);
+            rec = pages_.get() + slot * kPageBytes + at % kPageBytes;
+        } else {
+            return;
+        }
+        prefetch_line(rec);
+        prefetch_line(rec + stride_ - 1);
+    }
 
 private:
+    // The cache line holding `p`, asked of the memory ahead. Not __builtin_prefetch: GCC takes a
+    // function that only prefetches for one without effects (pure) and drops the calls to it.
+    static void prefetch_line(const void* p) {
+#if defined(__x86_64__) || defined(__i386__)
+        asm volatile("prefetcht0 %0" : : "m"(*static_cast<const char*>(p)));
+#elif defined(__aarch64__)
+        asm volatile("prfm pldl1keep, %0" : : "Q"(*static_cast<const char*>(p)));
+#else
+        __builtin_prefetch(p);
+#endif
+    }
+
     VertexTable() = default;
     void spill();
     void flush_tail();
@@ -83,6 +113,11 @@ private:
 
     // kTempFile / kInputFile: records [0, file_records_) are read from a file through the page
     // cache below; later ones (temp file only) sit in tail_ until flushed.
+    // The cache's page: small, because faces refer to vertices scattered through a window of the
+    // table, so a large page holds mostly vertices nobody asks for (fewer of the wanted ones fit
+    // the budget, and each miss copies more); smaller pages than this miss about as often, and a
+    // miss costs mostly the pread call (docs/results.md#formats).
+    static constexpr size_t kPageBytes = 512;
     std::unique_ptr<TempFile> temp_;
     int input_fd_ = -1;
     std::string input_path_;

@@ -125,8 +125,8 @@ TEST(VertexTable, ReadsRecordsOfAnInputFileInPlace) {
 
 // Positions read in bulk are the records' whatever the storage: from memory, from a spilled
 // temp file and its unflushed tail, and from an input file (past 1 MiB, in several reads),
-// from any first record.
-TEST(VertexTable, PositionsReadInBulkAreTheRecordsPositions) {
+// from any first record. Prefetched records read the same.
+TEST(VertexTable, PositionsReadInBulkAndPrefetchedRecordsAreTheRecords) {
     test::TempDir dir;
     auto expect_positions = [](io::VertexTable& t) {
         const uint64_t n = t.size();
@@ -141,6 +141,8 @@ TEST(VertexTable, PositionsReadInBulkAreTheRecordsPositions) {
             EXPECT_EQ(xyz.back(), -7.0f);  // nothing past the count
         }
         expect_vertex(t, n / 2);  // the cache still reads
+        for (uint64_t i = 0; i < n; i += 97) t.prefetch(i);  // a hint: it changes nothing read
+        for (uint64_t i = 0; i < n; i += 89) expect_vertex(t, i);
     };
     for (uint64_t budget : {uint64_t{64} << 20, uint64_t{1} << 20}) {
         io::VertexTable t(budget, dir.path(), 3);
