@@ -575,6 +575,10 @@ public:
         };
         if (s_.threads < 2) {
             while (in.next(chunk)) add(in.count().read, in.source().stored_offset());
+        } else if (io::IndexedReadAhead::possible(in, wo_.channels)) {
+            // A PLY: its corners looked up on two threads (the lookups are most of its reading).
+            io::IndexedReadAhead reader(in, chunk.capacity(), wo_.channels, wanted);
+            while (reader.next(chunk)) add(reader.count().read, reader.stored_offset());
         } else {
             io::ReadAhead reader(in, chunk.capacity(), wo_.channels);
             while (reader.next(chunk)) add(reader.count().read, reader.stored_offset());

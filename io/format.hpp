@@ -101,6 +101,16 @@ inline constexpr const char* kPrecisionNote = "coordinates";
 inline constexpr const char* kLastLineNote = "last line";
 inline constexpr const char* kLastLineText = "has no line end: the file may be cut short inside it";
 
+// A way to an IndexedSource's vertices for a thread of its own (IndexedSource::split_lookup).
+class VertexLookup {
+public:
+    virtual ~VertexLookup() = default;
+    // As IndexedSource::vertex.
+    virtual void vertex(uint64_t i, float* xyz, std::byte* record) = 0;
+    // A hint that vertex(i) comes soon (i < vertex_count()): its bytes are asked of memory ahead.
+    virtual void prefetch(uint64_t i) = 0;
+};
+
 // What a reader of an indexed format gives a whole-mesh read (io::read_indexed) instead of its
 // triangle soup, when every corner carries nothing but its vertex's values (PLY): the file's
 // own vertices, in file order, and its faces as indices into them, so that nothing is welded
@@ -120,6 +130,12 @@ public:
     // The positions of vertices [first, first + count) (<= vertex_count()) into xyz, 3 floats
     // each, read in bulk: the cheapest way through all of them in order.
     virtual void positions(uint64_t first, uint64_t count, float* xyz) = 0;
+    // A hint that vertex(i) comes soon (i < vertex_count()).
+    virtual void prefetch(uint64_t i) = 0;
+    // A second way to the vertices for another thread, safe beside this source's own reading
+    // (faces and vertices) on one other thread; a vertex table read through a cache gives it half
+    // of its budget. It must not outlive this source.
+    virtual std::unique_ptr<VertexLookup> split_lookup() = 0;
     // Appends the triangles of the next faces (about `max` of them, a polygon triangulated as
     // next() would), 3 vertex indices each, counter-clockwise; returns false, appending
     // nothing, once the faces are done and the rest of the file checked. Throws io::Error for

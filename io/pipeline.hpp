@@ -110,6 +110,72 @@ private:
     std::thread thread_;
 };
 
+// ReadAhead for a reader that gives its vertices and faces apart (Reader::indexed(): PLY), where
+// looking the corners up in its vertex table is most of the reading: the reader thread reads the
+// faces' indices a batch at a time (a chunk's capacity) and looks up the corners of every other
+// batch; a second thread looks up the rest, through a second way to the vertices with a cache of
+// its own (IndexedSource::split_lookup: a table read from a file gives it half of its budget).
+// next() hands the chunks over in file order, the policy applied and counted by `in` as its
+// next() does: the same triangles in the same order, in chunks cut at other places.
+// Memory: kPipelineChunks batches of `capacity` triangles (their indices and chunks), counting
+// the caller's own chunk, as ReadAhead's.
+class IndexedReadAhead {
+public:
+    // True when `in` can be read so: its reader gives its IndexedSource (untouched), and
+    // `channels`, what the chunks carry, holds no per-triangle channel.
+    static bool possible(TriangleInput& in, const Channels& channels);
+    // Starts reading `in` (possible()) into chunks of `capacity` triangles with `channels`;
+    // `stored` is what the reader stores of each vertex, ReadOptions::channels of its header's
+    // (IndexedSource::vertex's records). As with ReadAhead, the caller must not call `in` until
+    // next() returned false or threw, or this is destroyed.
+    IndexedReadAhead(TriangleInput& in, size_t capacity, const Channels& channels, const Channels& stored);
+    // Stops the threads after the batch each is on and joins them.
+    ~IndexedReadAhead();
+    IndexedReadAhead(const IndexedReadAhead&) = delete;
+    IndexedReadAhead& operator=(const IndexedReadAhead&) = delete;
+
+    // As ReadAhead::next.
+    bool next(TriangleChunk& chunk);
+    const InputCount& count() const { return in_.count(); }
+    uint64_t stored_offset() const { return stored_offset_; }
+
+private:
+    enum class State : uint8_t { kFree, kRead, kResolved, kEnd, kFailed };
+    struct Batch {
+        uint64_t seq = 0;  // the batch's number in the file
+        State state = State::kFree;
+        std::vector<uint32_t> indices;
+        std::vector<TriangleChunk> chunks;  // its triangles, `used` of them (more than one only past a
+        size_t used = 0, taken = 0;         // chunk's capacity, as a large polygon makes); `taken` by next()
+        uint64_t stored_offset = 0;
+        std::exception_ptr error;
+    };
+    template <class Lookup>
+    void resolve(Batch& b, Lookup& lookup);
+    Batch& batch(uint64_t seq) { return batches_[seq % batches_.size()]; }
+    // Waits until batch `seq` is in one of the states `done` says, or stop; false on stop.
+    template <class Done>
+    bool wait_for(uint64_t seq, Done done);
+    void set(Batch& b, State state);
+    void read_faces();
+    void resolve_odd();
+    void join();
+
+    TriangleInput& in_;
+    IndexedSource& source_;
+    std::unique_ptr<VertexLookup> lookup_;  // the second thread's
+    size_t capacity_;
+    Channels channels_;
+    CornerLayout layout_;
+    std::vector<Batch> batches_;
+    std::mutex mutex_;
+    std::condition_variable changed_;
+    bool stopped_ = false;
+    uint64_t next_seq_ = 0;  // the batch next() is on
+    uint64_t stored_offset_ = 0;
+    std::thread reader_, resolver_;
+};
+
 class WriteBehind {
 public:
     // Starts a writer thread that writes to `out` chunks of `capacity` triangles with

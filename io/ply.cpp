@@ -193,6 +193,21 @@ private:
     uint64_t vertex_table_bytes() const override { return table_->bytes(); }
     void vertex(uint64_t i, float* xyz, std::byte* record) override { table_->get(i, xyz, layout_ ? record : nullptr); }
     void positions(uint64_t first, uint64_t count, float* xyz) override { table_->positions(first, count, xyz); }
+    void prefetch(uint64_t i) override { table_->prefetch(i); }
+    std::unique_ptr<VertexLookup> split_lookup() override {
+        struct Lookup final : VertexLookup {
+            std::unique_ptr<VertexTable> table;
+            bool records = false;  // the table's records are corner records (layout_)
+            void vertex(uint64_t i, float* xyz, std::byte* record) override {
+                table->get(i, xyz, records ? record : nullptr);
+            }
+            void prefetch(uint64_t i) override { table->prefetch(i); }
+        };
+        auto lookup = std::make_unique<Lookup>();
+        lookup->table = table_->split();
+        lookup->records = layout_.has_value();
+        return lookup;
+    }
     bool next_triangles(std::vector<uint32_t>& indices, size_t max) override {
         const size_t start = indices.size();
         for (;;) {

@@ -40,21 +40,29 @@ bool TriangleInput::next(TriangleChunk& chunk) {
     }
     for (;;) {
         if (!input_.reader->next(chunk)) {
-            at_end_ = true;
-            if (end_ && count_.read != *end_)
-                throw Error(name(), "the input ends at triangle " + std::to_string(count_.read) +
-                                        ", before the end of the triangles read, " + std::to_string(*end_));
-            if (!end_ && count_.promised && count_.read != *count_.promised)
-                throw Error(name(), "header promises " + std::to_string(*count_.promised) + " triangles, read " +
-                                        std::to_string(count_.read));
+            end_of_input();
             return false;
         }
-        const size_t read = chunk.size();
-        const size_t dropped = policy_ == BadTriangles::kKeep ? 0 : apply_policy(chunk);
-        count_.read += read;
-        count_.dropped += dropped;
+        admit(chunk);
         if (!chunk.empty()) return true;
     }
+}
+
+void TriangleInput::admit(TriangleChunk& chunk) {
+    const size_t read = chunk.size();
+    const size_t dropped = policy_ == BadTriangles::kKeep ? 0 : apply_policy(chunk);
+    count_.read += read;
+    count_.dropped += dropped;
+}
+
+void TriangleInput::end_of_input() {
+    at_end_ = true;
+    if (end_ && count_.read != *end_)
+        throw Error(name(), "the input ends at triangle " + std::to_string(count_.read) +
+                                ", before the end of the triangles read, " + std::to_string(*end_));
+    if (!end_ && count_.promised && count_.read != *count_.promised)
+        throw Error(name(), "header promises " + std::to_string(*count_.promised) + " triangles, read " +
+                                std::to_string(count_.read));
 }
 
 bool TriangleInput::select_triangles(uint64_t first, uint64_t end) {

@@ -49,6 +49,13 @@ public:
     // reaches the end. Returns false, changing nothing, when the reader cannot.
     bool select_triangles(uint64_t first, uint64_t end);
 
+    // For a caller that reads the reader itself (io::IndexedReadAhead, through its IndexedSource):
+    // counts the triangles of `chunk`, the reader's next ones, as read and applies the policy
+    // to them, as next() does; throws as next() would for a refused triangle.
+    void admit(TriangleChunk& chunk);
+    // ...and once the reader has no more: the checks next() makes there (the header's promise).
+    void end_of_input();
+
     const InputCount& count() const { return count_; }
     uint64_t non_finite() const { return non_finite_; }  // dropped for a NaN/inf coordinate
     uint64_t degenerate() const { return degenerate_; }  // dropped for a repeated corner

@@ -45,6 +45,26 @@ std::unique_ptr<VertexTable> VertexTable::of_input_file(const std::string& path,
     return t;
 }
 
+std::unique_ptr<VertexTable> VertexTable::split() {
+    std::unique_ptr<VertexTable> t(new VertexTable());
+    t->records_ = records_;
+    t->storage_ = storage_;
+    t->attribute_bytes_ = attribute_bytes_;
+    t->size_ = size_;
+    t->stride_ = stride_;
+    std::copy(std::begin(xyz_offsets_), std::end(xyz_offsets_), t->xyz_offsets_);
+    t->file_offset_ = file_offset_;
+    t->file_records_ = file_records_;
+    if (storage_ != Storage::kMemory && file_records_ > 0) {
+        budget_bytes_ /= 2;
+        t->budget_bytes_ = budget_bytes_;
+        pages_.reset();  // the old cache goes before the new ones are mapped
+        start_cache(file_records_ * stride_);
+        t->start_cache(file_records_ * stride_);
+    }
+    return t;
+}
+
 VertexTable::~VertexTable() {
     if (input_fd_ >= 0) ::close(input_fd_);
 }
@@ -126,12 +146,13 @@ void VertexTable::start_cache(uint64_t table_bytes) {
 void VertexTable::Unmap::operator()(std::byte* p) const { ::munmap(p, bytes); }
 
 void VertexTable::read_file(uint64_t offset, void* dst, size_t n) {
-    const int fd = storage_ == Storage::kInputFile ? input_fd_ : temp_->fd();
+    const VertexTable& owner = *records_;
+    const int fd = storage_ == Storage::kInputFile ? owner.input_fd_ : owner.temp_->fd();
     auto* p = static_cast<char*>(dst);
     while (n > 0) {
         const ssize_t got = ::pread(fd, p, n, static_cast<off_t>(offset));
         if (got < 0 && errno == EINTR) continue;
-        const std::string& path = storage_ == Storage::kInputFile ? input_path_ : temp_->path();
+        const std::string& path = storage_ == Storage::kInputFile ? owner.input_path_ : owner.temp_->path();
         if (got < 0) throw Error(path, offset, 0, "cannot read the vertex table: " + std::string(std::strerror(errno)));
         if (got == 0) throw Error(path, offset, 0, "the vertex table ends early (was the file changed while read?)");
         p += got;
@@ -158,9 +179,10 @@ void VertexTable::get(uint64_t i, float* xyz, std::byte* attributes) {
     const std::byte* rec = nullptr;  // the record, when it is in memory
     uint64_t at = 0;                 // else where it starts, from the start of cached page 0
     if (storage_ == Storage::kMemory) {
-        rec = blocks_[i >> kBlockRecordsLog2].get() + (i & ((uint64_t{1} << kBlockRecordsLog2) - 1)) * stride_;
+        rec = records_->blocks_[i >> kBlockRecordsLog2].get() +
+              (i & ((uint64_t{1} << kBlockRecordsLog2) - 1)) * stride_;
     } else if (i >= file_records_) {
-        rec = tail_.data() + (i - file_records_) * stride_;
+        rec = records_->tail_.data() + (i - file_records_) * stride_;
     } else {
         at = file_offset_ % kPageBytes + i * stride_;
         // Most records lie within one cached page: found once for all their fields.

@@ -62,13 +62,20 @@ public:
     // in bulk: from a file, in reads of up to 1 MiB beside the page cache, which is left as it
     // is. The cheapest way through every record in order.
     void positions(uint64_t first, uint64_t count, float* xyz);
+    // A second reader of this table's records, for another thread: get(), positions() and
+    // prefetch() as this table's, safe beside this table's own reads on one other thread (records
+    // in memory are read in place; from a file, through a page cache of its own). A table read
+    // from a file gives it half of its budget (both caches are made anew). It must not outlive
+    // this table, nor this table be appended to while it lives.
+    std::unique_ptr<VertexTable> split();
     // A hint that record i (< size()) is read soon: its bytes are asked of the memory ahead (a
     // record from a file, where its page would be cached), so that get() does not wait for
     // them. The faces index vertices at random: without it a read waits for memory at most corners.
     void prefetch(uint64_t i) const {
         const std::byte* rec = nullptr;
         if (storage_ == Storage::kMemory) {
-            rec = blocks_[i >> kBlockRecordsLog2].get() + (i & ((uint64_t{1} << kBlockRecordsLog2) - 1)) * stride_;
+            rec = records_->blocks_[i >> kBlockRecordsLog2].get() +
+                  (i & ((uint64_t{1} << kBlockRecordsLog2) - 1)) * stride_;
         } else if (i < file_records_) {
             const uint64_t at = file_offset_ % kPageBytes + i * stride_;
             const size_t slot = static_cast<size_t>(at / kPageBytes % page_tags_.size());
@@ -98,6 +105,9 @@ private:
     void spill();
     void flush_tail();
 
+    // The table whose records these are: this one, or the one split() was called on (its
+    // blocks, tail and file are read; the page cache is this one's own).
+    const VertexTable* records_ = this;
     uint64_t budget_bytes_ = 0;
     std::string tmpdir_;
     size_t attribute_bytes_ = 0;

@@ -396,6 +396,16 @@ TEST(Tiles, APlysCubeIsItsTrianglesEvenWithVerticesNoFaceUsesOutsideThem) {
         EXPECT_EQ(phases.count(sorting), std::string(name) == "outside" ? 2u : 1u);
         EXPECT_EQ(files_under(dir / name), files_under(dir / "stl"));
     }
+    // On two threads the PLY's corners are looked up on both (io::IndexedReadAhead): the same
+    // tileset as the STL's on two threads.
+    s.threads = 2;
+    s.input = kBunny;
+    s.outdir = dir / "stl2";
+    engine::tile_file(s, quiet);
+    s.input = dir / "outside.ply";
+    s.outdir = dir / "ply2";
+    engine::tile_file(s, quiet);
+    EXPECT_EQ(files_under(dir / "ply2"), files_under(dir / "stl2"));
 }
 
 TEST(Tiles, ANonEmptyDirectoryIsRefusedAndKept) {

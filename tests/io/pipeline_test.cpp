@@ -1,5 +1,5 @@
-// io::ReadAhead and io::WriteBehind: the same chunks, counts and bytes as the calls made on the
-// caller's thread, for every format; a reader's error comes after the chunks read before it,
+// io::ReadAhead, io::IndexedReadAhead and io::WriteBehind: the same chunks (triangles), counts and
+// bytes as the calls made on the caller's thread, for every format; a reader's error comes after the chunks read before it,
 // with its message; a writer's error stops the stream and leaves no file; stopping early joins.
 #include "io/pipeline.hpp"
 
@@ -9,6 +9,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <iterator>
 #include <string>
@@ -250,3 +253,152 @@ TEST(WriteBehind, RethrowsTheWritersErrorAndLeavesNoFile) {
 }
 
 }  // namespace
+
+// io::IndexedReadAhead against the reader's own next(): the same triangles (positions, colours,
+// vertex ids) in the same order and the same counts, whether the vertex table is in memory or
+// read from a file through two caches; a bad face's error after the triangles before it; a
+// refused triangle named as next() names it; a polygon larger than a chunk; stopping early.
+namespace {
+
+// A binary PLY of a k×k grid of coloured vertices (vertex (1, 1) has a NaN x): its squares as
+// triangles, every 7th as a quad, one 12-gon over the first row, a degenerate triangle, and,
+// when `bad_face` is given, a face there indexing past the vertices.
+std::string grid_ply(int k, int bad_face = -1) {
+    std::string body;
+    auto put = [&](const auto& v) { body.append(reinterpret_cast<const char*>(&v), sizeof v); };
+    for (int y = 0; y < k; ++y)
+        for (int x = 0; x < k; ++x) {
+            put(x == 1 && y == 1 ? std::nanf("") : float(x));
+            put(float(y));
+            put(float((x * y) % 5) * 0.25f);
+            const uint8_t rgb[3] = {uint8_t(x), uint8_t(y), uint8_t(x ^ y)};
+            body.append(reinterpret_cast<const char*>(rgb), 3);
+        }
+    int faces = 0;
+    auto face = [&](std::vector<int32_t> v) {
+        if (faces == bad_face) v[0] = k * k + 5;
+        put(uint8_t(v.size()));
+        for (int32_t i : v) put(i);
+        ++faces;
+    };
+    std::vector<int32_t> row;
+    for (int x = 0; x < 12; ++x) row.push_back(x);
+    face(row);  // 12 collinear corners: 10 triangles
+    face({3, 3, k + 3});  // degenerate
+    for (int y = 0; y + 1 < k; ++y)
+        for (int x = 0; x + 1 < k; ++x) {
+            const int32_t a = y * k + x, b = a + 1, c = a + k + 1, d = a + k;
+            if ((y * k + x) % 7 == 0) {
+                face({a, b, c, d});
+            } else {
+                face({a, b, c});
+                face({a, c, d});
+            }
+        }
+    return "ply\nformat binary_little_endian 1.0\nelement vertex " + std::to_string(k * k) +
+           "\nproperty float x\nproperty float y\nproperty float z\nproperty uchar red\nproperty uchar green\n"
+           "property uchar blue\nelement face " +
+           std::to_string(faces) + "\nproperty list uchar int vertex_indices\nend_header\n" + body;
+}
+
+// Every triangle read (positions, colours, vertex ids, in order), the counts, the error.
+struct Stream {
+    std::vector<float> xyz, rgba;
+    std::vector<uint64_t> ids;
+    uint64_t read = 0, dropped = 0, non_finite = 0, degenerate = 0;
+    std::string error;
+    bool operator==(const Stream&) const = default;
+};
+
+Stream read_ply(const std::string& path, uint64_t memory, io::BadTriangles policy, bool indexed, size_t capacity) {
+    Stream s;
+    io::ReadOptions options;
+    options.memory_budget_bytes = memory;
+    io::TriangleInput in(io::open_input(path, "", options), policy);
+    io::Channels channels = in.header().channels;
+    channels.vertex_id = true;
+    io::TriangleChunk chunk(capacity, channels);
+    auto take = [&] {
+        s.xyz.insert(s.xyz.end(), chunk.xyz().begin(), chunk.xyz().end());
+        for (size_t i = 0; i < chunk.size(); ++i) {
+            s.rgba.insert(s.rgba.end(), chunk.color_at(i), chunk.color_at(i) + 12);
+            s.ids.insert(s.ids.end(), chunk.id_at(i), chunk.id_at(i) + 3);
+        }
+    };
+    try {
+        if (indexed) {
+            EXPECT_TRUE(io::IndexedReadAhead::possible(in, channels));
+            io::IndexedReadAhead reader(in, capacity, channels, options.channels.of(in.header().channels));
+            while (reader.next(chunk)) take();
+        } else {
+            while (in.next(chunk)) take();
+        }
+    } catch (const io::Error& e) {
+        s.error = e.what();
+    }
+    s.read = in.count().read, s.dropped = in.count().dropped;
+    s.non_finite = in.non_finite(), s.degenerate = in.degenerate();
+    return s;
+}
+
+}  // namespace
+
+TEST(IndexedReadAhead, GivesTheTrianglesAndCountsOfTheReadersNext) {
+    TempDir dir;
+    spit(dir / "grid.ply", grid_ply(60));
+    for (uint64_t memory : {io::kDefaultMemoryBudget, uint64_t{4096}}) {  // 54 KB of vertices: in memory, in a file
+        for (size_t capacity : {size_t{7}, size_t{1000}}) {
+            SCOPED_TRACE("memory " + std::to_string(memory) + ", capacity " + std::to_string(capacity));
+            const Stream direct = read_ply(dir / "grid.ply", memory, io::BadTriangles::kDrop, false, capacity);
+            EXPECT_TRUE(direct.error.empty()) << direct.error;
+            EXPECT_EQ(direct.degenerate, 1u);
+            EXPECT_EQ(direct.non_finite, 6u);  // the squares at vertex (1, 1)
+            EXPECT_EQ(direct.read, 10u + 1u + uint64_t(59 * 59 * 2));
+            EXPECT_EQ(read_ply(dir / "grid.ply", memory, io::BadTriangles::kDrop, true, capacity), direct);
+        }
+    }
+}
+
+// An error read by both: the same message, after the same triangles, give or take the batch or
+// chunk it came in (next() drops the chunk it was filling too, and the two cut at other places).
+void expect_same_up_to_the_error(const Stream& indexed, const Stream& direct, size_t capacity) {
+    EXPECT_FALSE(direct.error.empty());
+    EXPECT_EQ(indexed.error, direct.error);
+    const size_t n = std::min(indexed.xyz.size(), direct.xyz.size());
+    EXPECT_EQ(std::memcmp(indexed.xyz.data(), direct.xyz.data(), n * sizeof(float)), 0);  // bit for bit: NaN kept
+    EXPECT_LE(std::max(indexed.xyz.size(), direct.xyz.size()) - n, 9 * (capacity + 10));
+    EXPECT_EQ(indexed.read, indexed.xyz.size() / 9 + indexed.dropped);
+}
+
+TEST(IndexedReadAhead, ErrorsComeAfterTheTrianglesBeforeThemAsTheReadersNextSaysThem) {
+    TempDir dir;
+    spit(dir / "bad.ply", grid_ply(60, 3000));
+    spit(dir / "grid.ply", grid_ply(60));
+    for (uint64_t memory : {io::kDefaultMemoryBudget, uint64_t{4096}}) {
+        SCOPED_TRACE("memory " + std::to_string(memory));
+        const Stream bad = read_ply(dir / "bad.ply", memory, io::BadTriangles::kKeep, false, 100);
+        EXPECT_NE(bad.error.find("out of range"), std::string::npos) << bad.error;
+        EXPECT_GT(bad.xyz.size(), 9u * 2000u);
+        expect_same_up_to_the_error(read_ply(dir / "bad.ply", memory, io::BadTriangles::kKeep, true, 100), bad, 100);
+        const Stream refused = read_ply(dir / "grid.ply", memory, io::BadTriangles::kRefuse, false, 100);
+        EXPECT_NE(refused.error.find("triangle 11 is degenerate"), std::string::npos) << refused.error;
+        expect_same_up_to_the_error(read_ply(dir / "grid.ply", memory, io::BadTriangles::kRefuse, true, 100), refused,
+                                    100);
+    }
+}
+
+TEST(IndexedReadAhead, StoppedEarlyJoinsItsThreads) {
+    TempDir dir;
+    spit(dir / "grid.ply", grid_ply(60));
+    io::ReadOptions options;
+    options.memory_budget_bytes = 4096;
+    io::TriangleInput in(io::open_input(dir / "grid.ply", "", options), io::BadTriangles::kKeep);
+    io::TriangleChunk chunk(50, in.header().channels);
+    {
+        io::IndexedReadAhead reader(in, 50, chunk.channels(), in.header().channels);
+        ASSERT_TRUE(reader.next(chunk));
+        EXPECT_EQ(chunk.size(), 50u);
+    }
+    EXPECT_EQ(in.count().read, 50u);
+    EXPECT_FALSE(in.at_end());
+}

@@ -12,6 +12,8 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstring>
+#include <memory>
+#include <thread>
 #include <vector>
 
 using namespace meshstream;
@@ -166,6 +168,29 @@ TEST(VertexTable, PositionsReadInBulkAndPrefetchedRecordsAreTheRecords) {
     const size_t xyz_offsets[3] = {2, 6, 10};
     auto t = io::VertexTable::of_input_file(dir / "v.bin", 5, n, 20, xyz_offsets, 16 << 10);
     expect_positions(*t);
+}
+
+// A split table and its second reader read every record right at once on two threads, in
+// memory and from a spilled file (each through half the budget's cache).
+TEST(VertexTable, ASplitTablesTwoReadersReadTheirRecordsOnTwoThreads) {
+    test::TempDir dir;
+    for (uint64_t budget : {uint64_t{64} << 20, uint64_t{64} << 10}) {
+        io::VertexTable t(budget, dir.path(), 3);
+        const uint64_t n = 150000;
+        for (uint64_t i = 0; i < n; ++i) {
+            const float xyz[3] = {static_cast<float>(i) * 0.5f, -static_cast<float>(i), 3.0f};
+            const std::byte attributes[3] = {std::byte{1}, static_cast<std::byte>(i), std::byte{2}};
+            t.append(xyz, attributes);
+        }
+        std::unique_ptr<io::VertexTable> second = t.split();
+        EXPECT_EQ(second->size(), n);
+        EXPECT_EQ(second->storage(), t.storage());
+        std::thread other([&] {
+            for (uint64_t i = n; i-- > 0;) expect_vertex(*second, (i * 7919) % n);
+        });
+        for (uint64_t i = 0; i < n; ++i) expect_vertex(t, (i * 104729) % n);
+        other.join();
+    }
 }
 
 namespace {
