@@ -261,7 +261,7 @@ bool IndexedReadAhead::next(TriangleChunk& chunk) {
             state = s;
             return s == State::kResolved || s == State::kEnd || s == State::kFailed;
         });
-        if (!ok) {  // stopped (only the destructor stops)
+        if (!ok) {  // stopped: the input ended or failed at an earlier call
             chunk.clear();
             return false;
         }
