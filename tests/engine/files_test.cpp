@@ -61,32 +61,32 @@ TEST(EngineFiles, APlysBoxIsItsTrianglesCornersNotItsUnusedVertices) {
     expect_the_triangles_box(dir / "m.ply");
 }
 
+// engine::input_box of kPly and kStl, written in `dir`, with the default options.
+engine::InputBox box_of(const test::TempDir& dir, const char* name, bool vertices_will_do) {
+    test::spit(dir / "m.ply", kPly);
+    test::spit(dir / "m.stl", kStl);
+    engine::QuietProgress progress;
+    return engine::input_box(dir / name, "", io::ReadOptions{}, progress, vertices_will_do);
+}
+
 TEST(EngineFiles, AVertexTablesBytesAreSaidAndNoneForAnStl) {
     // The 8 vertices of kPly, 12 bytes each (x, y, z): what a reader of it needs to hold them.
     test::TempDir dir;
-    test::spit(dir / "m.ply", kPly);
-    test::spit(dir / "m.stl", kStl);
-    io::ReadOptions options;
-    engine::QuietProgress progress;
     for (bool vertices : {false, true}) {
-        EXPECT_EQ(engine::input_box(dir / "m.ply", "", options, progress, vertices).vertex_table_bytes, 8u * 12u);
-        EXPECT_EQ(engine::input_box(dir / "m.stl", "", options, progress, vertices).vertex_table_bytes, 0u);
+        EXPECT_EQ(box_of(dir, "m.ply", vertices).vertex_table_bytes, 8u * 12u);
+        EXPECT_EQ(box_of(dir, "m.stl", vertices).vertex_table_bytes, 0u);
     }
 }
 
 TEST(EngineFiles, WhereVerticesWillDoAPlysBoxIsAllItsVerticesAndAnStlsItsTriangles) {
     test::TempDir dir;
-    test::spit(dir / "m.ply", kPly);
-    test::spit(dir / "m.stl", kStl);
-    io::ReadOptions options;
-    engine::QuietProgress progress;
-    const engine::InputBox ply = engine::input_box(dir / "m.ply", "", options, progress, true);
+    const engine::InputBox ply = box_of(dir, "m.ply", true);
     EXPECT_TRUE(ply.of_vertices);
     expect_box(ply.box, {-1, -100, -2}, {100, 3, 100});  // the unused vertex (100, -100, 100) too
-    const engine::InputBox stl = engine::input_box(dir / "m.stl", "", options, progress, true);
+    const engine::InputBox stl = box_of(dir, "m.stl", true);
     EXPECT_FALSE(stl.of_vertices);
     expect_box(stl.box, {-1, 0, -2}, {2, 3, 1});
-    EXPECT_FALSE(engine::input_box(dir / "m.ply", "", options, progress, false).of_vertices);
+    EXPECT_FALSE(box_of(dir, "m.ply", false).of_vertices);
 }
 
 TEST(EngineFiles, APlysNonFiniteCoordinateDecidesNothing) {

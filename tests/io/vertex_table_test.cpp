@@ -35,6 +35,30 @@ void expect_vertex(io::VertexTable& t, uint64_t i) {
     }
 }
 
+// Appends vertices 0 .. n-1 as expect_vertex reads them.
+void append_vertices(io::VertexTable& t, uint64_t n) {
+    for (uint64_t i = 0; i < n; ++i) {
+        const float xyz[3] = {static_cast<float>(i) * 0.5f, -static_cast<float>(i), 3.0f};
+        const std::byte attributes[3] = {std::byte{1}, static_cast<std::byte>(i), std::byte{2}};
+        t.append(xyz, attributes);
+    }
+}
+
+// A table of n vertices (expect_vertex's) read in place from `dir`/v.bin: 5 junk bytes, then
+// records of 20 bytes, pad(2) x y z pad(8); a cache of 16 KiB.
+std::unique_ptr<io::VertexTable> input_file_table(const test::TempDir& dir, uint64_t n) {
+    std::string bytes(5, 'j');
+    for (uint64_t i = 0; i < n; ++i) {
+        char rec[20] = {};
+        const float xyz[3] = {static_cast<float>(i) * 0.5f, -static_cast<float>(i), 3.0f};
+        std::memcpy(rec + 2, xyz, 12);
+        bytes.append(rec, 20);
+    }
+    test::spit(dir / "v.bin", bytes);
+    const size_t xyz_offsets[3] = {2, 6, 10};
+    return io::VertexTable::of_input_file(dir / "v.bin", 5, n, 20, xyz_offsets, 16 << 10);
+}
+
 }  // namespace
 
 TEST(VertexTable, SpillsPastTheBudgetAndReadsWhileAppending) {
@@ -109,18 +133,8 @@ TEST(VertexTable, ALowerBudgetSpillsOrShrinksTheCacheAndKeepsEveryRecord) {
 }
 TEST(VertexTable, ReadsRecordsOfAnInputFileInPlace) {
     test::TempDir dir;
-    // 5 junk bytes, then records of 20 bytes: pad(2) x y z pad(8) (stride 20).
-    std::string bytes(5, 'j');
     const uint64_t n = 5000;
-    for (uint64_t i = 0; i < n; ++i) {
-        char rec[20] = {};
-        const float xyz[3] = {static_cast<float>(i) * 0.5f, -static_cast<float>(i), 3.0f};
-        std::memcpy(rec + 2, xyz, 12);
-        bytes.append(rec, 20);
-    }
-    test::spit(dir / "v.bin", bytes);
-    const size_t xyz_offsets[3] = {2, 6, 10};
-    auto t = io::VertexTable::of_input_file(dir / "v.bin", 5, n, 20, xyz_offsets, 16 << 10);
+    auto t = input_file_table(dir, n);
     EXPECT_EQ(t->storage(), io::VertexTable::Storage::kInputFile);
     for (uint64_t i = n; i-- > 0;) expect_vertex(*t, (i * 31) % n);
 }
@@ -148,26 +162,11 @@ TEST(VertexTable, PositionsReadInBulkAndPrefetchedRecordsAreTheRecords) {
     };
     for (uint64_t budget : {uint64_t{64} << 20, uint64_t{1} << 20}) {
         io::VertexTable t(budget, dir.path(), 3);
-        for (uint64_t i = 0; i < 150000; ++i) {  // 2.25 MB
-            const float xyz[3] = {static_cast<float>(i) * 0.5f, -static_cast<float>(i), 3.0f};
-            const std::byte attributes[3] = {std::byte{1}, static_cast<std::byte>(i), std::byte{2}};
-            t.append(xyz, attributes);
-        }
+        append_vertices(t, 150000);  // 2.25 MB
         EXPECT_EQ(t.storage(), budget > (4u << 20) ? io::VertexTable::Storage::kMemory : io::VertexTable::Storage::kTempFile);
         expect_positions(t);
     }
-    std::string bytes(5, 'j');
-    const uint64_t n = 100000;  // 20-byte records: 2 MB
-    for (uint64_t i = 0; i < n; ++i) {
-        char rec[20] = {};
-        const float xyz[3] = {static_cast<float>(i) * 0.5f, -static_cast<float>(i), 3.0f};
-        std::memcpy(rec + 2, xyz, 12);
-        bytes.append(rec, 20);
-    }
-    test::spit(dir / "v.bin", bytes);
-    const size_t xyz_offsets[3] = {2, 6, 10};
-    auto t = io::VertexTable::of_input_file(dir / "v.bin", 5, n, 20, xyz_offsets, 16 << 10);
-    expect_positions(*t);
+    expect_positions(*input_file_table(dir, 100000));  // 2 MB
 }
 
 // A split table and its second reader read every record right at once on two threads, in
@@ -177,11 +176,7 @@ TEST(VertexTable, ASplitTablesTwoReadersReadTheirRecordsOnTwoThreads) {
     for (uint64_t budget : {uint64_t{64} << 20, uint64_t{64} << 10}) {
         io::VertexTable t(budget, dir.path(), 3);
         const uint64_t n = 150000;
-        for (uint64_t i = 0; i < n; ++i) {
-            const float xyz[3] = {static_cast<float>(i) * 0.5f, -static_cast<float>(i), 3.0f};
-            const std::byte attributes[3] = {std::byte{1}, static_cast<std::byte>(i), std::byte{2}};
-            t.append(xyz, attributes);
-        }
+        append_vertices(t, n);
         std::unique_ptr<io::VertexTable> second = t.split();
         EXPECT_EQ(second->size(), n);
         EXPECT_EQ(second->storage(), t.storage());
