@@ -13,7 +13,8 @@
 // per MPI rank: RangeProcesses) that sends its pieces here as it makes them.
 //
 // Each range re-opens the input. On threads of this process, a range of an unsorted binary STL
-// (fixed-size records in a file that can seek) goes straight to the record where its triangles
+// or triangle stream with a count (fixed-size records in a file that can seek:
+// io::Reader::select_triangles) goes straight to the record where its triangles
 // start if no triangle before it is dropped, and reads on from there; once the ranges before it
 // have read theirs without a drop it is confirmed (the seam pass reads none of its output before
 // that), else it starts again as below. Any other range (another input, a sorted one: a range

@@ -157,7 +157,8 @@ public:
     virtual bool next(TriangleChunk& chunk) = 0;
     // Makes the reader deliver the triangles [first, end) of the input only, reading none
     // before `first`, and returns true, when its records have a fixed size in a source that
-    // can seek (binary STL in a plain regular file) and its header at the end says of those
+    // can seek (a binary STL, or meshstream's triangle stream whose header states its count, in
+    // a plain regular file) and its header at the end says of those
     // triangles what it would of all of them (nothing counted while reading). Otherwise
     // returns false and changes nothing. Call it before the first next(), with first <= end <=
     // the header's triangle count.

@@ -207,13 +207,21 @@ public:
     bool next(TriangleChunk& chunk) override {
         chunk.clear();
         while (!chunk.full() && !ended_) {
+            // A selection that ends before the stream does stops there (the end marker, which
+            // counts every triangle, is the last range's to check).
+            if (end_ && read_ == *end_ && *end_ < *header_.triangle_count) {
+                ended_ = true;
+                break;
+            }
             if (left_in_chunk_ == 0) {
                 read_chunk_start();
                 continue;
             }
             // Decode whole records from the window in place; one straddling its end is copied.
             std::span<const std::byte> w = source_.window();
-            size_t n = std::min<uint64_t>({left_in_chunk_, chunk.capacity() - chunk.size(), w.size() / record_bytes_});
+            const uint64_t wanted = end_ && *end_ < *header_.triangle_count ? *end_ - read_ : left_in_chunk_;
+            size_t n = std::min<uint64_t>(
+                {left_in_chunk_, wanted, chunk.capacity() - chunk.size(), w.size() / record_bytes_});
             if (n == 0) {
                 if (source_.read(buffer_.data(), record_bytes_) != record_bytes_) truncated("inside a triangle record");
                 decode(buffer_.data(), chunk);
@@ -225,6 +233,38 @@ public:
             left_in_chunk_ -= n;
         }
         return !chunk.empty();
+    }
+
+    // A stream in a file that can seek, whose header states its count: goes to triangle `first`
+    // past whole chunks (each chunk's count read, its records sought past) and stops before
+    // `end`. A stream with fewer chunks than its count says is left to next() to report.
+    bool select_triangles(uint64_t first, uint64_t end) override {
+        if (read_ > 0 || left_in_chunk_ > 0 || ended_ || end_ || !header_.triangle_count || first > end ||
+            end > *header_.triangle_count || !source_.size())
+            return false;
+        const uint64_t start = source_.offset();  // the first chunk's
+        if (!source_.seek(start)) return false;   // (a gzip stream cannot)
+        auto give_up = [&] {
+            source_.seek(start);
+            return false;
+        };
+        for (uint64_t at = start, passed = 0;;) {
+            std::byte n_bytes[4];
+            if (source_.read(n_bytes, 4) != 4) return give_up();
+            const uint32_t n = load_le<uint32_t>(n_bytes);
+            if (n == 0 || n > kMaxChunkTriangles) return give_up();  // the end marker before `first`
+            if (passed + n > first) {
+                if (!source_.seek(at + 4 + (first - passed) * record_bytes_)) return give_up();
+                left_in_chunk_ = n - (first - passed);
+                break;
+            }
+            passed += n;
+            at += 4 + uint64_t{n} * record_bytes_;
+            if (!source_.seek(at)) return give_up();
+        }
+        read_ = first;
+        end_ = end;
+        return true;
     }
 
 private:
@@ -359,6 +399,7 @@ private:
     std::vector<std::byte> buffer_;  // one record straddling the window's end
     uint64_t left_in_chunk_ = 0;
     uint64_t read_ = 0;
+    std::optional<uint64_t> end_;  // select_triangles()'s end
     bool ended_ = false;
 };
 

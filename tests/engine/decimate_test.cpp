@@ -1,5 +1,6 @@
 // engine::decimate_file, decimate_part, convert_file and sort_file as a library user calls them:
-// exact counts, ranges on two threads (each reading its own records of a binary STL), part files
+// exact counts, ranges on two threads (each reading its own records of a binary STL or a
+// triangle stream with a count), part files
 // merged to the bytes two threads write, the
 // progress a sink sees, cancellation that leaves nothing behind, and settings refused as
 // io::OptionError naming the setting.
@@ -194,6 +195,38 @@ TEST(EngineDecimate, RangesOfABinaryStlReadTheirOwnRecords) {
         EXPECT_EQ(m.triangles_in, records);
         EXPECT_EQ(m.facts.skipped, 3u);
         EXPECT_EQ(slurp(dir / "merged.stl"), slurp(dir / "threads.stl")) << at[0];
+    }
+}
+
+TEST(EngineDecimate, RangesOfATriangleStreamWithACountReadTheirOwnRecords) {
+    // The bunny as meshstream's triangle stream with its count, in chunks of 1000: a range goes
+    // past whole chunks to its first triangle (io::Reader::select_triangles). Gzipped, it cannot,
+    // and reads its way there: the same output, byte for byte; at a ratio of 1, every triangle once.
+    TempDir dir;
+    for (const std::string name : {"in.mstream", "in.mstream.gz"}) {
+        io::TriangleInput in(io::open_input(kBunny), io::BadTriangles::kKeep);
+        io::WriteOptions wo;
+        wo.triangle_count = kBunnyTriangles;
+        io::Output out = io::open_output(dir / name, "stream", wo, 6);
+        io::TriangleChunk chunk(1000, in.header().channels);
+        while (in.next(chunk)) out.write(chunk);
+        out.finish();
+    }
+    engine::QuietProgress quiet;
+    for (const double ratio : {1.0, 0.1}) {
+        for (const std::string name : {"in.mstream", "in.mstream.gz"}) {
+            engine::DecimateSettings s = bunny_settings(dir / (name + ".stl"));
+            s.input = dir / name;
+            s.ratio = ratio;
+            s.threads = 2;
+            const engine::DecimateResult r = engine::decimate_file(s, quiet);
+            EXPECT_EQ(r.facts.threads, 2u) << name;
+            EXPECT_EQ(r.triangles_in, kBunnyTriangles) << name;
+        }
+        EXPECT_EQ(slurp(dir / "in.mstream.stl"), slurp(dir / "in.mstream.gz.stl")) << ratio;
+        if (ratio == 1.0) {
+            EXPECT_EQ(triangle_keys(dir / "in.mstream.stl"), triangle_keys(kBunny));
+        }
     }
 }
 

@@ -9,9 +9,13 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <bit>
 #include <cstring>
 #include <limits>
+#include <optional>
+#include <utility>
+#include <vector>
 
 namespace {
 
@@ -233,3 +237,46 @@ TEST(TriangleStream, DetectedByMagicWhateverTheName) {
 }
 
 }  // namespace
+
+// A stream with a count in a plain file is read from any triangle to any other, past whole
+// chunks; a stream without a count, or gzipped, cannot be: the reader says so and changes nothing.
+TEST(TriangleStream, ASelectionGoesPastWholeChunksToItsFirstTriangleAndStopsAtItsEnd) {
+    TempDir dir;
+    const io::TriangleChunk sample = sample_chunk(40);
+    auto write_in_chunks = [&](const std::string& path, std::optional<uint64_t> count) {
+        io::Output out = io::open_output(path, "stream", options_for(sample.channels(), count), 6);
+        for (size_t from = 0, n = 3; from < sample.size(); from += n, n = n % 9 + 4) {  // chunks of 3, 7, 11, 6, ...
+            io::TriangleChunk part(n, sample.channels());
+            for (size_t i = from; i < std::min(sample.size(), from + n); ++i) part.push_copy(sample, i);
+            out.write(part);
+        }
+        out.finish();
+    };
+    write_in_chunks(dir / "s.mstream", 40);
+    write_in_chunks(dir / "nocount.mstream", std::nullopt);
+    write_in_chunks(dir / "s.mstream.gz", 40);
+    const io::TriangleChunk all = read_all(dir / "s.mstream", 1000);
+    ASSERT_EQ(all.size(), 40u);
+    for (const auto& [first, end] : std::vector<std::pair<uint64_t, uint64_t>>{
+             {0, 40}, {0, 5}, {3, 10}, {10, 10}, {17, 33}, {21, 40}, {39, 40}, {40, 40}}) {
+        const std::string what = std::to_string(first) + ".." + std::to_string(end);
+        io::Input in = io::open_input(dir / "s.mstream");
+        if (first == 40) {  // nothing to go to: read as it comes
+            EXPECT_FALSE(in.reader->select_triangles(first, end)) << what;
+            continue;
+        }
+        ASSERT_TRUE(in.reader->select_triangles(first, end)) << what;
+        io::TriangleChunk part(4, sample.channels()), got(1000, sample.channels()), want(1000, sample.channels());
+        while (in.reader->next(part))
+            for (size_t i = 0; i < part.size(); ++i) got.push_copy(part, i);
+        for (uint64_t i = first; i < end; ++i) want.push_copy(all, i);
+        expect_same_bits(got, want, what);
+    }
+    for (const std::string& path : {dir / "nocount.mstream", dir / "s.mstream.gz"}) {
+        io::Input in = io::open_input(path);
+        EXPECT_FALSE(in.reader->select_triangles(5, 10)) << path;
+        io::TriangleChunk part(1000, sample.channels());
+        ASSERT_TRUE(in.reader->next(part)) << path;  // from the start, as before
+        EXPECT_EQ(std::memcmp(part.xyz().data(), all.xyz().data(), 36), 0) << path;
+    }
+}
