@@ -24,8 +24,7 @@ io::Bounds input_bounds(const std::string& path, std::string_view from, const io
 
 // input_bounds's box, or, for `vertices_will_do` and an input whose reader holds its vertices
 // apart from its faces (PLY: io::IndexedSource), the box of all its vertices, used by a face or
-// not, with `of_vertices` set: its vertices read in order, without its faces (a tenth of the
-// time at 10 M triangles). It contains the triangles' box, and is that box unless some vertex no
+// not, with `of_vertices` set: its vertices read in bulk, in order, without its faces. It contains the triangles' box, and is that box unless some vertex no
 // face uses lies outside it; a caller that needs the triangles' own box checks it against the
 // corners it reads later.
 struct InputBox {

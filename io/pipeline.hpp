@@ -116,7 +116,9 @@ private:
 // batch; a second thread looks up the rest, through a second way to the vertices with a cache of
 // its own (IndexedSource::split_lookup: a table read from a file gives it half of its budget).
 // next() hands the chunks over in file order, the policy applied and counted by `in` as its
-// next() does: the same triangles in the same order, in chunks cut at other places.
+// next() does: the same triangles in the same order, in chunks cut at other places. An error
+// (the reader's, a lookup's, a refused triangle) comes after the batches before its own, as
+// next()'s comes after the chunks before it.
 // Memory: kPipelineChunks batches of `capacity` triangles (their indices and chunks), counting
 // the caller's own chunk, as ReadAhead's.
 class IndexedReadAhead {
